@@ -1,0 +1,59 @@
+//! Read speed of the two formats whet reads most: a ~1M-triangle grid mesh as binary
+//! little-endian PLY and as ascii OFF, both held in memory.
+
+use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
+use whet_io::{read, write, Format, PlyEncoding, WriteOptions};
+use whet_mesh::{DVec3, Mesh};
+
+/// A wavy height-field grid of `n` x `n` vertices and `2 (n-1)^2` triangles.
+fn grid(n: u32) -> Mesh {
+    let mut positions = Vec::with_capacity((n * n) as usize);
+    for j in 0..n {
+        for i in 0..n {
+            let (x, y) = (f64::from(i) / f64::from(n), f64::from(j) / f64::from(n));
+            positions.push(DVec3::new(x, y, 0.05 * (7.0 * x).sin() * (5.0 * y).cos()));
+        }
+    }
+    let mut triangles = Vec::with_capacity(2 * ((n - 1) * (n - 1)) as usize);
+    for j in 0..n - 1 {
+        for i in 0..n - 1 {
+            let v = j * n + i;
+            triangles.push([v, v + 1, v + n + 1]);
+            triangles.push([v, v + n + 1, v + n]);
+        }
+    }
+    Mesh::new(positions, triangles)
+}
+
+fn bench_read(c: &mut Criterion) {
+    let mesh = grid(708);
+    let mut group = c.benchmark_group("read_1m_triangles");
+    group.sample_size(10);
+
+    let mut ply = Vec::new();
+    let opts = WriteOptions::DEFAULT.with_ply(PlyEncoding::BinaryLittleEndian);
+    write(&mut ply, &mesh, Format::Ply, &opts).expect("writing to memory cannot fail");
+    group.throughput(Throughput::Bytes(ply.len() as u64));
+    group.bench_function("ply_binary_le", |b| {
+        b.iter_batched(
+            || (),
+            |()| read(&ply[..], Format::Ply).expect("valid PLY"),
+            BatchSize::PerIteration,
+        )
+    });
+
+    let mut off = Vec::new();
+    write(&mut off, &mesh, Format::Off, &opts).expect("writing to memory cannot fail");
+    group.throughput(Throughput::Bytes(off.len() as u64));
+    group.bench_function("off_ascii", |b| {
+        b.iter_batched(
+            || (),
+            |()| read(&off[..], Format::Off).expect("valid OFF"),
+            BatchSize::PerIteration,
+        )
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench_read);
+criterion_main!(benches);

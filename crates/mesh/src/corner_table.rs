@@ -1,0 +1,504 @@
+//! The corner table (Rossignac's representation used by Edgebreaker): one entry per corner
+//! holding its vertex and its opposite corner.
+//!
+//! ```text
+//!            v(prev c)
+//!              /\
+//!             /  \          corner c sits at v(c) in triangle c / 3;
+//!            /    \         next(c), prev(c) are the other corners of that triangle
+//!           /  t   \        counter-clockwise; opposite(c) is the corner across the
+//!          /        \       edge v(next c) - v(prev c) in the neighbouring triangle.
+//!    v(c) ------------ v(next c)
+//!          \        /
+//!           \  t'  /
+//!            \    /
+//!             \/
+//!          v(opposite c)
+//! ```
+//!
+//! Invariants: every edge has at most two triangles, traversed in opposite directions; every
+//! vertex has a single fan (a disk or, at a boundary, a half-disk). `new` refuses anything
+//! else with the [`MeshError`] naming the first offender; cut such input with
+//! [`Mesh::make_manifold`] first. Boundary corners (whose opposite edge is a boundary edge)
+//! have no opposite. Building is linear in the number of corners for bounded valence (each
+//! vertex's outgoing edges are sorted once, O(k log k) for valence k).
+
+use crate::ids::{CornerId, VertexId};
+use crate::mesh::Mesh;
+use crate::topology::MeshError;
+
+const NONE: u32 = u32::MAX;
+
+/// Corner table of an oriented manifold triangle mesh.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct CornerTable {
+    /// Vertex of each corner.
+    corner_vertex: Vec<u32>,
+    /// Opposite of each corner, `NONE` at a boundary.
+    opposite: Vec<u32>,
+    /// For each vertex a corner at it from which [`CornerTable::swing`] visits the whole fan
+    /// (at a boundary vertex, the clockwise-most corner); `NONE` for an unused vertex.
+    vertex_corner: Vec<u32>,
+}
+
+impl CornerTable {
+    /// Builds the table of `mesh`, checking indices, edge- and vertex-manifoldness and
+    /// orientation on the way.
+    pub fn new(mesh: &Mesh) -> Result<CornerTable, MeshError> {
+        CornerTable::from_triangles(&mesh.triangles, mesh.positions.len())
+    }
+
+    /// Builds the table from triangles alone (positions are not needed).
+    pub fn from_triangles(
+        triangles: &[[u32; 3]],
+        vertex_count: usize,
+    ) -> Result<CornerTable, MeshError> {
+        let nt = triangles.len();
+        if nt > (u32::MAX as usize - 3) / 3 {
+            return Err(MeshError::TooLarge {
+                what: "triangle count",
+                count: nt,
+            });
+        }
+        if vertex_count >= NONE as usize {
+            return Err(MeshError::TooLarge {
+                what: "vertex count",
+                count: vertex_count,
+            });
+        }
+        let nc = 3 * nt;
+        let mut corner_vertex = Vec::with_capacity(nc);
+        for (t, tri) in triangles.iter().enumerate() {
+            for &v in tri {
+                if v as usize >= vertex_count {
+                    return Err(MeshError::IndexOutOfRange {
+                        triangle: t as u32,
+                        index: v,
+                        vertex_count: vertex_count as u32,
+                    });
+                }
+            }
+            if tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] {
+                let vertex = if tri[0] == tri[1] || tri[0] == tri[2] {
+                    tri[0]
+                } else {
+                    tri[1]
+                };
+                return Err(MeshError::RepeatedVertex {
+                    triangle: t as u32,
+                    vertex,
+                });
+            }
+            corner_vertex.extend_from_slice(tri);
+        }
+
+        // Bucket the directed edge opposite each corner c, v(next c) -> v(prev c), by its
+        // start vertex, sorted by end vertex inside the bucket.
+        let mut offsets = vec![0u32; vertex_count + 1];
+        for c in 0..nc {
+            offsets[corner_vertex[next_raw(c)] as usize + 1] += 1;
+        }
+        for v in 0..vertex_count {
+            offsets[v + 1] += offsets[v];
+        }
+        let mut fill = offsets.clone();
+        // (end vertex, corner)
+        let mut bucket = vec![(0u32, 0u32); nc];
+        for c in 0..nc {
+            let a = corner_vertex[next_raw(c)] as usize;
+            bucket[fill[a] as usize] = (corner_vertex[prev_raw(c)], c as u32);
+            fill[a] += 1;
+        }
+        drop(fill);
+        for v in 0..vertex_count {
+            let s = &mut bucket[offsets[v] as usize..offsets[v + 1] as usize];
+            if s.len() > 1 {
+                s.sort_unstable();
+            }
+        }
+        let find = |from: u32, to: u32| -> &[(u32, u32)] {
+            let s = &bucket[offsets[from as usize] as usize..offsets[from as usize + 1] as usize];
+            let lo = s.partition_point(|e| e.0 < to);
+            let hi = lo + s[lo..].partition_point(|e| e.0 == to);
+            &s[lo..hi]
+        };
+
+        let mut opposite = vec![NONE; nc];
+        for c in 0..nc {
+            let a = corner_vertex[next_raw(c)];
+            let b = corner_vertex[prev_raw(c)];
+            let same = find(a, b);
+            let reverse = find(b, a);
+            let count = same.len() + reverse.len();
+            if count > 2 {
+                let (lo, hi) = if a < b { (a, b) } else { (b, a) };
+                return Err(MeshError::NonManifoldEdge {
+                    a: lo,
+                    b: hi,
+                    count: count as u32,
+                });
+            }
+            if same.len() == 2 {
+                return Err(MeshError::InconsistentOrientation {
+                    a,
+                    b,
+                    t0: same[0].1 / 3,
+                    t1: same[1].1 / 3,
+                });
+            }
+            if let Some(&(_, o)) = reverse.first() {
+                opposite[c] = o;
+            }
+        }
+
+        let mut table = CornerTable {
+            corner_vertex,
+            opposite,
+            vertex_corner: vec![NONE; vertex_count],
+        };
+
+        // One start corner per vertex, then check that swinging from it visits every corner
+        // of the vertex: otherwise the vertex has several fans.
+        let mut valence = vec![0u32; vertex_count];
+        for &v in &table.corner_vertex {
+            valence[v as usize] += 1;
+        }
+        for c in 0..nc {
+            let v = table.corner_vertex[c] as usize;
+            if table.vertex_corner[v] == NONE {
+                table.vertex_corner[v] = c as u32;
+            }
+        }
+        for v in 0..vertex_count {
+            let c0 = table.vertex_corner[v];
+            if c0 == NONE {
+                continue;
+            }
+            // Walk clockwise to the first corner of an open fan (or all the way round).
+            let mut start = CornerId(c0);
+            while let Some(back) = table.swing_back(start) {
+                if back.0 == c0 {
+                    break;
+                }
+                start = back;
+            }
+            table.vertex_corner[v] = start.0;
+            let mut seen = 1u32;
+            let mut c = start;
+            while let Some(n) = table.swing(c) {
+                if n == start {
+                    break;
+                }
+                seen += 1;
+                if seen > valence[v] {
+                    break;
+                }
+                c = n;
+            }
+            if seen != valence[v] {
+                return Err(MeshError::NonManifoldVertex {
+                    vertex: v as u32,
+                    fans: table.count_fans(VertexId(v as u32)),
+                });
+            }
+        }
+        Ok(table)
+    }
+
+    // Error path only: the number of separate fans around `v` (a linear scan).
+    fn count_fans(&self, v: VertexId) -> u32 {
+        let corners: Vec<u32> = (0..self.corner_vertex.len() as u32)
+            .filter(|&c| self.corner_vertex[c as usize] == v.0)
+            .collect();
+        let mut seen = vec![false; corners.len()];
+        let mut fans = 0;
+        for i in 0..corners.len() {
+            if seen[i] {
+                continue;
+            }
+            fans += 1;
+            // Mark the whole fan through i, in both directions.
+            for dir in [true, false] {
+                let mut c = CornerId(corners[i]);
+                loop {
+                    if let Ok(k) = corners.binary_search(&c.0) {
+                        if seen[k] && c.0 != corners[i] {
+                            break;
+                        }
+                        seen[k] = true;
+                    }
+                    let n = if dir { self.swing(c) } else { self.swing_back(c) };
+                    match n {
+                        Some(n) if n.0 != corners[i] => c = n,
+                        _ => break,
+                    }
+                }
+            }
+        }
+        fans
+    }
+
+    /// Number of corners (three per triangle).
+    #[inline]
+    pub fn corner_count(&self) -> usize {
+        self.corner_vertex.len()
+    }
+
+    /// Number of triangles.
+    #[inline]
+    pub fn triangle_count(&self) -> usize {
+        self.corner_vertex.len() / 3
+    }
+
+    /// Number of vertices (including unused ones).
+    #[inline]
+    pub fn vertex_count(&self) -> usize {
+        self.vertex_corner.len()
+    }
+
+    /// All corners in order.
+    pub fn corners(&self) -> impl Iterator<Item = CornerId> + '_ {
+        (0..self.corner_vertex.len() as u32).map(CornerId)
+    }
+
+    /// Vertex at corner `c`.
+    #[inline]
+    pub fn vertex(&self, c: CornerId) -> VertexId {
+        VertexId(self.corner_vertex[c.index()])
+    }
+
+    /// Next corner of the same triangle (counter-clockwise).
+    #[inline]
+    pub fn next(&self, c: CornerId) -> CornerId {
+        CornerId(next_raw(c.index()) as u32)
+    }
+
+    /// Previous corner of the same triangle.
+    #[inline]
+    pub fn prev(&self, c: CornerId) -> CornerId {
+        CornerId(prev_raw(c.index()) as u32)
+    }
+
+    /// Corner across the edge opposite `c`; `None` when that edge is a boundary edge.
+    #[inline]
+    pub fn opposite(&self, c: CornerId) -> Option<CornerId> {
+        let o = self.opposite[c.index()];
+        (o != NONE).then_some(CornerId(o))
+    }
+
+    /// The corner of the same vertex in the next triangle counter-clockwise around it
+    /// (`next(opposite(next(c)))`); `None` at a boundary.
+    #[inline]
+    pub fn swing(&self, c: CornerId) -> Option<CornerId> {
+        self.opposite(self.next(c)).map(|o| self.next(o))
+    }
+
+    /// The corner of the same vertex in the next triangle clockwise around it
+    /// (`prev(opposite(prev(c)))`); `None` at a boundary.
+    #[inline]
+    pub fn swing_back(&self, c: CornerId) -> Option<CornerId> {
+        self.opposite(self.prev(c)).map(|o| self.prev(o))
+    }
+
+    /// A corner at `v` from which [`CornerTable::swing`] visits its whole fan (the
+    /// clockwise-most one at a boundary); `None` for a vertex no triangle uses.
+    #[inline]
+    pub fn vertex_corner(&self, v: VertexId) -> Option<CornerId> {
+        let c = self.vertex_corner[v.index()];
+        (c != NONE).then_some(CornerId(c))
+    }
+
+    /// True when the edge opposite `c` is a boundary edge.
+    #[inline]
+    pub fn is_boundary_corner(&self, c: CornerId) -> bool {
+        self.opposite[c.index()] == NONE
+    }
+
+    /// True when `v` lies on a boundary (its fan is open).
+    pub fn is_boundary_vertex(&self, v: VertexId) -> bool {
+        match self.vertex_corner(v) {
+            Some(c) => self.swing_back(c).is_none(),
+            None => false,
+        }
+    }
+
+    /// The corners around `v`, counter-clockwise, starting at [`CornerTable::vertex_corner`].
+    pub fn vertex_corners(&self, v: VertexId) -> VertexCorners<'_> {
+        let start = self.vertex_corner(v);
+        VertexCorners {
+            table: self,
+            start,
+            current: start,
+        }
+    }
+
+    /// Number of triangles around `v`.
+    pub fn valence(&self, v: VertexId) -> usize {
+        self.vertex_corners(v).count()
+    }
+}
+
+/// Iterator over the corners of one vertex; see [`CornerTable::vertex_corners`].
+pub struct VertexCorners<'a> {
+    table: &'a CornerTable,
+    start: Option<CornerId>,
+    current: Option<CornerId>,
+}
+
+impl Iterator for VertexCorners<'_> {
+    type Item = CornerId;
+    fn next(&mut self) -> Option<CornerId> {
+        let c = self.current?;
+        self.current = self.table.swing(c).filter(|&n| Some(n) != self.start);
+        Some(c)
+    }
+}
+
+#[inline]
+fn next_raw(c: usize) -> usize {
+    if c % 3 == 2 {
+        c - 2
+    } else {
+        c + 1
+    }
+}
+
+#[inline]
+fn prev_raw(c: usize) -> usize {
+    if c % 3 == 0 {
+        c + 2
+    } else {
+        c - 1
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    fn tetrahedron() -> Mesh {
+        Mesh::new(
+            vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z],
+            vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]],
+        )
+    }
+
+    #[test]
+    fn tetrahedron_is_closed_and_consistent() {
+        let m = tetrahedron();
+        let t = CornerTable::new(&m).unwrap();
+        assert_eq!(t.corner_count(), 12);
+        for c in t.corners() {
+            let o = t.opposite(c).expect("closed mesh");
+            assert_eq!(t.opposite(o), Some(c));
+            // The edge opposite c and the edge opposite o are the same edge, reversed.
+            assert_eq!(t.vertex(t.next(c)), t.vertex(t.prev(o)));
+            assert_eq!(t.vertex(t.prev(c)), t.vertex(t.next(o)));
+            assert_eq!(t.vertex(t.swing(c).unwrap()), t.vertex(c));
+            assert_eq!(t.swing_back(t.swing(c).unwrap()), Some(c));
+        }
+        for v in 0..4 {
+            assert_eq!(t.valence(VertexId(v)), 3);
+            assert!(!t.is_boundary_vertex(VertexId(v)));
+        }
+    }
+
+    #[test]
+    fn swing_is_counter_clockwise() {
+        // A fan of four triangles around vertex 0 in the xy plane, seen from +z.
+        let m = Mesh::new(
+            vec![DVec3::ZERO, DVec3::X, DVec3::Y, -DVec3::X, -DVec3::Y],
+            vec![[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1]],
+        );
+        let t = CornerTable::new(&m).unwrap();
+        let order: Vec<u32> = t
+            .vertex_corners(VertexId(0))
+            .map(|c| t.vertex(t.next(c)).0)
+            .collect();
+        // Counter-clockwise: the next vertex after the corner advances 1, 2, 3, 4 cyclically.
+        let pos = order.iter().position(|&v| v == 1).unwrap();
+        let rotated: Vec<u32> = (0..4).map(|i| order[(pos + i) % 4]).collect();
+        assert_eq!(rotated, vec![1, 2, 3, 4]);
+    }
+
+    #[test]
+    fn open_fan_starts_at_its_clockwise_end() {
+        // Three triangles of a fan around vertex 0, open between 4 and 1.
+        let m = Mesh::new(
+            vec![DVec3::ZERO, DVec3::X, DVec3::Y, -DVec3::X, -DVec3::Y],
+            vec![[0, 2, 3], [0, 1, 2], [0, 3, 4]],
+        );
+        let t = CornerTable::new(&m).unwrap();
+        assert!(t.is_boundary_vertex(VertexId(0)));
+        let around: Vec<u32> = t
+            .vertex_corners(VertexId(0))
+            .map(|c| t.vertex(t.next(c)).0)
+            .collect();
+        assert_eq!(around, vec![1, 2, 3]);
+        assert_eq!(t.valence(VertexId(0)), 3);
+        let boundary = t.corners().filter(|&c| t.is_boundary_corner(c)).count();
+        assert_eq!(boundary, 5, "three rim edges and two spokes are open");
+    }
+
+    #[test]
+    fn refuses_non_manifold_edge() {
+        let m = Mesh::new(
+            vec![DVec3::ZERO, DVec3::X, DVec3::Y, -DVec3::Y, DVec3::Z],
+            vec![[0, 1, 2], [1, 0, 3], [0, 1, 4]],
+        );
+        assert_eq!(
+            CornerTable::new(&m),
+            Err(MeshError::NonManifoldEdge {
+                a: 0,
+                b: 1,
+                count: 3
+            })
+        );
+    }
+
+    #[test]
+    fn refuses_bow_tie() {
+        let m = Mesh::new(
+            vec![
+                DVec3::ZERO,
+                DVec3::X,
+                DVec3::Y,
+                -DVec3::X,
+                -DVec3::Y,
+            ],
+            vec![[0, 1, 2], [0, 3, 4]],
+        );
+        assert!(matches!(
+            CornerTable::new(&m),
+            Err(MeshError::NonManifoldVertex { vertex: 0, .. })
+        ));
+    }
+
+    #[test]
+    fn refuses_flipped_neighbour() {
+        let m = Mesh::new(
+            vec![DVec3::ZERO, DVec3::X, DVec3::Y, -DVec3::Y],
+            vec![[0, 1, 2], [0, 1, 3]],
+        );
+        assert!(matches!(
+            CornerTable::new(&m),
+            Err(MeshError::InconsistentOrientation { a: 1, b: 0, .. })
+                | Err(MeshError::InconsistentOrientation { a: 0, b: 1, .. })
+        ));
+    }
+
+    #[test]
+    fn refuses_bad_indices() {
+        let m = Mesh::new(vec![DVec3::ZERO, DVec3::X], vec![[0, 1, 2]]);
+        assert!(matches!(
+            CornerTable::new(&m),
+            Err(MeshError::IndexOutOfRange { index: 2, .. })
+        ));
+        let m = Mesh::new(vec![DVec3::ZERO, DVec3::X, DVec3::Y], vec![[0, 1, 1]]);
+        assert!(matches!(
+            CornerTable::new(&m),
+            Err(MeshError::RepeatedVertex { vertex: 1, .. })
+        ));
+    }
+}

@@ -1,0 +1,90 @@
+//! whet-testkit owns the one way tests and benches find the public fixture meshes: the
+//! `shared/` folder that sits beside the checkout (`../shared` from the workspace root, as on
+//! developer machines and CI). Every lookup fails loudly, naming the path it tried, so a
+//! missing folder is never mistaken for a passing test. Set `WHET_SHARED_DIR` to point
+//! elsewhere. It is a dev-dependency only.
+//!
+//! ```no_run
+//! let fandisk = whet_testkit::shared_fixture("fandisk.off");
+//! assert!(fandisk.ends_with("fixtures/fandisk.off"));
+//! ```
+#![forbid(unsafe_code)]
+
+use std::path::{Path, PathBuf};
+
+/// The workspace root (the folder holding the root `Cargo.toml`).
+pub fn workspace_root() -> PathBuf {
+    // This crate lives at <root>/crates/testkit.
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .canonicalize()
+        .unwrap_or_else(|e| panic!("cannot resolve the workspace root: {e}"))
+}
+
+/// The shared folder (`WHET_SHARED_DIR`, else `<workspace root>/../shared`). Panics with the
+/// path it tried when the folder is missing.
+pub fn shared_dir() -> PathBuf {
+    let dir = match std::env::var_os("WHET_SHARED_DIR") {
+        Some(d) => PathBuf::from(d),
+        None => workspace_root().join("../shared"),
+    };
+    if !dir.is_dir() {
+        panic!(
+            "shared folder not found at {} (the public fixtures live in ../shared beside the \
+             checkout; set WHET_SHARED_DIR to override)",
+            dir.display()
+        );
+    }
+    dir
+}
+
+/// Path of a file in `shared/fixtures`; panics naming the path when it does not exist.
+pub fn shared_fixture(name: &str) -> PathBuf {
+    let p = shared_dir().join("fixtures").join(name);
+    if !p.is_file() {
+        panic!("shared fixture not found: {}", p.display());
+    }
+    p
+}
+
+/// Path of a file anywhere under `shared/` (e.g. `metro-reference.json`); panics when missing.
+pub fn shared_file(relative: &str) -> PathBuf {
+    let p = shared_dir().join(relative);
+    if !p.exists() {
+        panic!("shared file not found: {}", p.display());
+    }
+    p
+}
+
+/// The `.off` fixtures in `shared/fixtures`, sorted by name.
+pub fn shared_off_fixtures() -> Vec<PathBuf> {
+    let dir = shared_dir().join("fixtures");
+    let mut v: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("cannot list {}: {e}", dir.display()))
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "off"))
+        .collect();
+    v.sort();
+    v
+}
+
+/// Resolves a path as written in shared JSON files ("../shared/fixtures/x.off", relative to
+/// the checkout root) against the actual shared folder.
+pub fn resolve_shared_reference(path: &str) -> PathBuf {
+    match path.strip_prefix("../shared/") {
+        Some(rest) => shared_file(rest),
+        None => workspace_root().join(path),
+    }
+}
+
+/// A scratch folder unique to one test, emptied on creation, under the target directory.
+pub fn scratch_dir(test_name: &str) -> PathBuf {
+    let base = std::env::var_os("CARGO_TARGET_TMPDIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(std::env::temp_dir);
+    let dir = base.join(format!("whet-{}-{}", test_name, std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir)
+        .unwrap_or_else(|e| panic!("cannot create {}: {e}", dir.display()));
+    dir
+}

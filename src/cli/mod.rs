@@ -1,0 +1,97 @@
+//! Subcommands of the `whet` binary, one module each, and the mapping of failures to exit
+//! codes.
+
+mod convert;
+mod info;
+
+use clap::{Parser, Subcommand};
+use std::path::Path;
+
+/// whet: a mesh codec that re-tiles, codes connectivity with Edgebreaker and restores sharp
+/// features after decoding.
+#[derive(Parser, Debug)]
+#[command(name = "whet", version, about, long_about = None)]
+pub struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Print counts, topology and problems of a mesh.
+    Info(info::InfoArgs),
+    /// Convert a mesh between OFF, OBJ, PLY and STL.
+    Convert(convert::ConvertArgs),
+}
+
+/// A failed command: the error to print and the exit code.
+pub struct Failure {
+    pub code: u8,
+    pub error: anyhow::Error,
+}
+
+/// Exit code of an input that cannot be read as a mesh or stream.
+pub const EXIT_BAD_INPUT: u8 = 2;
+/// Exit code of every other failure.
+pub const EXIT_FAILURE: u8 = 1;
+
+impl Failure {
+    pub fn input(error: impl Into<anyhow::Error>) -> Failure {
+        Failure {
+            code: EXIT_BAD_INPUT,
+            error: error.into(),
+        }
+    }
+    pub fn other(error: impl Into<anyhow::Error>) -> Failure {
+        Failure {
+            code: EXIT_FAILURE,
+            error: error.into(),
+        }
+    }
+}
+
+pub type CliResult<T = ()> = Result<T, Failure>;
+
+pub fn run(cli: Cli) -> CliResult {
+    match cli.command {
+        Command::Info(a) => info::run(&a),
+        Command::Convert(a) => convert::run(&a),
+    }
+}
+
+/// Reads a mesh file, mapping unreadable input to exit code 2 with the path in the message.
+pub fn read_mesh(path: &Path, format: Option<whet::io::Format>) -> CliResult<whet::Mesh> {
+    whet::io::read_path(path, format).map_err(|e| {
+        let code = if e.is_input_error() || path_missing(path) {
+            EXIT_BAD_INPUT
+        } else {
+            EXIT_FAILURE
+        };
+        Failure {
+            code,
+            error: anyhow::Error::new(e).context(format!("cannot read {}", path.display())),
+        }
+    })
+}
+
+/// Writes a mesh file; any failure is exit code 1.
+pub fn write_mesh(
+    path: &Path,
+    mesh: &whet::Mesh,
+    format: Option<whet::io::Format>,
+    opts: &whet::io::WriteOptions,
+) -> CliResult {
+    whet::io::write_path(path, mesh, format, opts).map_err(|e| {
+        Failure::other(anyhow::Error::new(e).context(format!("cannot write {}", path.display())))
+    })
+}
+
+fn path_missing(path: &Path) -> bool {
+    !path.exists()
+}
+
+/// Prints one JSON value on stdout.
+pub fn print_json(value: &serde_json::Value) {
+    // serde_json's Display of a Value cannot fail.
+    println!("{value}");
+}
