@@ -23,12 +23,28 @@ fn fandisk_round_trips_through_every_format() {
         let mut args = vec!["convert", s(&src), "-o", s(&mid)];
         args.extend_from_slice(flags);
         let out = whet(&args);
-        assert!(out.status.success(), "{ext} {flags:?}: {}", String::from_utf8_lossy(&out.stderr));
+        assert!(
+            out.status.success(),
+            "{ext} {flags:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         let out = whet(&["convert", s(&mid), "-o", s(&back)]);
-        assert!(out.status.success(), "{ext} back: {}", String::from_utf8_lossy(&out.stderr));
+        assert!(
+            out.status.success(),
+            "{ext} back: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         let m = whet::io::read_path(&back, None).unwrap();
-        assert_eq!(m.positions.len(), original.positions.len(), "{ext} {flags:?}");
-        assert_eq!(m.triangles.len(), original.triangles.len(), "{ext} {flags:?}");
+        assert_eq!(
+            m.positions.len(),
+            original.positions.len(),
+            "{ext} {flags:?}"
+        );
+        assert_eq!(
+            m.triangles.len(),
+            original.triangles.len(),
+            "{ext} {flags:?}"
+        );
         if *ext == "stl" {
             // STL has no shared vertices: welding exactly equal coordinates restores them in
             // order of first appearance; binary STL stores f32.
@@ -40,7 +56,10 @@ fn fandisk_round_trips_through_every_format() {
                 }
             }
         } else {
-            assert_eq!(m, original, "{ext} {flags:?}: positions and triangles bit-exact");
+            assert_eq!(
+                m, original,
+                "{ext} {flags:?}: positions and triangles bit-exact"
+            );
         }
     }
 }

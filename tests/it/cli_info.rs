@@ -82,11 +82,7 @@ fn unreadable_files_exit_2() {
         b"v 0 0 0\nv 1 0 0\nv 0 inf 0\nf 1 2 3\n",
         "non-finite",
     );
-    expect_input_error(
-        "truncated.off",
-        b"OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n",
-        "",
-    );
+    expect_input_error("truncated.off", b"OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n", "");
     expect_input_error("garbage.ply", b"\x00\x01garbage\xff\xfe", "");
     expect_input_error(
         "range.off",
@@ -131,12 +127,18 @@ fn non_manifold_mesh_is_reported_not_refused() {
         .collect();
     assert!(kinds.contains(&"non_manifold_edge"), "{kinds:?}");
     let msgs = j["problems"].to_string();
-    assert!(msgs.contains("edge (0, 1) has 3 incident triangles"), "{msgs}");
+    assert!(
+        msgs.contains("edge (0, 1) has 3 incident triangles"),
+        "{msgs}"
+    );
 
     // The text form names the same problems.
     let out = whet(&["info", s(&p)]);
     assert!(out.status.success());
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("manifold        no"), "{text}");
-    assert!(text.contains("edge (0, 1) has 3 incident triangles"), "{text}");
+    assert!(
+        text.contains("edge (0, 1) has 3 incident triangles"),
+        "{text}"
+    );
 }

@@ -1,5 +1,6 @@
 //! End-to-end tests of the `whet` binary and the facade: one integration binary, one module
 //! per command.
+#![allow(clippy::unwrap_used)] // a panic is a test failure
 
 mod cli_convert;
 mod cli_info;

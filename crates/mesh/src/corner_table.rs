@@ -227,7 +227,11 @@ impl CornerTable {
                         }
                         seen[k] = true;
                     }
-                    let n = if dir { self.swing(c) } else { self.swing_back(c) };
+                    let n = if dir {
+                        self.swing(c)
+                    } else {
+                        self.swing_back(c)
+                    };
                     match n {
                         Some(n) if n.0 != corners[i] => c = n,
                         _ => break,
@@ -460,13 +464,7 @@ mod tests {
     #[test]
     fn refuses_bow_tie() {
         let m = Mesh::new(
-            vec![
-                DVec3::ZERO,
-                DVec3::X,
-                DVec3::Y,
-                -DVec3::X,
-                -DVec3::Y,
-            ],
+            vec![DVec3::ZERO, DVec3::X, DVec3::Y, -DVec3::X, -DVec3::Y],
             vec![[0, 1, 2], [0, 3, 4]],
         );
         assert!(matches!(

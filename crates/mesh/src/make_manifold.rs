@@ -82,7 +82,11 @@ impl Mesh {
             // Detach the offending triangles at their bad edges (round < 7) or entirely.
             for (t, k) in offenders {
                 let tri = self.triangles[t as usize];
-                let ks: &[usize] = if round < 7 { &[k, (k + 1) % 3] } else { &[0, 1, 2] };
+                let ks: &[usize] = if round < 7 {
+                    &[k, (k + 1) % 3]
+                } else {
+                    &[0, 1, 2]
+                };
                 for &kk in ks {
                     let p = self.positions[tri[kk] as usize];
                     self.positions.push(p);
@@ -171,7 +175,8 @@ impl Mesh {
             component.clear();
             while let Some(t) = queue.pop_front() {
                 component.push(t);
-                for &(n, same) in &adj[adj_off[t as usize] as usize..adj_off[t as usize + 1] as usize]
+                for &(n, same) in
+                    &adj[adj_off[t as usize] as usize..adj_off[t as usize + 1] as usize]
                 {
                     // Same direction on the shared edge means the two disagree.
                     let want = flip[t as usize] ^ same as u32;
@@ -200,7 +205,11 @@ impl Mesh {
 
     /// Steps 3 and 4. Returns the (triangle, slot) of leftover half-edges whose edge still has
     /// more than two triangles or two of one direction after the split.
-    fn split_by_pairing(&mut self, rep: &mut ManifoldRepair, count_cuts: bool) -> Vec<(u32, usize)> {
+    fn split_by_pairing(
+        &mut self,
+        rep: &mut ManifoldRepair,
+        count_cuts: bool,
+    ) -> Vec<(u32, usize)> {
         let nt = self.triangles.len();
         let usable = vec![true; nt];
         let half = sorted_half_edges(&self.triangles, &usable);

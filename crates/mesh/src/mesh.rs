@@ -151,7 +151,9 @@ impl Mesh {
 
     /// Areas of all triangles.
     pub fn face_areas(&self) -> Vec<f64> {
-        (0..self.triangles.len()).map(|t| self.face_area(t)).collect()
+        (0..self.triangles.len())
+            .map(|t| self.face_area(t))
+            .collect()
     }
 
     /// Total surface area.

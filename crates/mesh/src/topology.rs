@@ -8,7 +8,7 @@
 use crate::mesh::{edge_key, Mesh};
 
 /// A named problem of a mesh, pointing at the first element that shows it.
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 #[non_exhaustive]
 pub enum MeshError {
     /// The mesh has no triangles.
@@ -21,7 +21,9 @@ pub enum MeshError {
         vertex: u32,
     },
     /// A triangle refers to a vertex that does not exist.
-    #[error("triangle {triangle} refers to vertex {index}, but the mesh has {vertex_count} vertices")]
+    #[error(
+        "triangle {triangle} refers to vertex {index}, but the mesh has {vertex_count} vertices"
+    )]
     IndexOutOfRange {
         /// Offending triangle.
         triangle: u32,
@@ -75,7 +77,9 @@ pub enum MeshError {
         t1: u32,
     },
     /// The triangles around a vertex form several fans joined only at the vertex (a bow tie).
-    #[error("vertex {vertex} is non-manifold: its triangles form {fans} fans joined only at the vertex")]
+    #[error(
+        "vertex {vertex} is non-manifold: its triangles form {fans} fans joined only at the vertex"
+    )]
     NonManifoldVertex {
         /// Offending vertex.
         vertex: u32,
@@ -491,8 +495,8 @@ impl Mesh {
         }
         r.components = ncomp as usize;
         r.boundary_loops = loops.iter().sum::<i64>() as usize;
-        r.euler_characteristic = referenced as i64 - edges as i64
-            + usable.iter().filter(|&&u| u).count() as i64;
+        r.euler_characteristic =
+            referenced as i64 - edges as i64 + usable.iter().filter(|&&u| u).count() as i64;
         if r.manifold && r.oriented && nt > 0 {
             let mut genus = 0i64;
             let mut ok = true;
@@ -595,7 +599,10 @@ mod tests {
             vec![[0, 1, 2], [0, 2, 3]],
         );
         let r = m.topology_report();
-        assert_eq!((r.boundary_loops, r.boundary_edges, r.genus), (1, 4, Some(0)));
+        assert_eq!(
+            (r.boundary_loops, r.boundary_edges, r.genus),
+            (1, 4, Some(0))
+        );
         assert_eq!(r.components, 1);
     }
 
@@ -604,9 +611,13 @@ mod tests {
         let mut a = torus(4, 4);
         let b = torus(4, 4);
         let off = a.positions.len() as u32;
-        a.positions.extend(b.positions.iter().map(|p| *p + DVec3::X * 10.0));
-        a.triangles
-            .extend(b.triangles.iter().map(|t| [t[0] + off, t[1] + off, t[2] + off]));
+        a.positions
+            .extend(b.positions.iter().map(|p| *p + DVec3::X * 10.0));
+        a.triangles.extend(
+            b.triangles
+                .iter()
+                .map(|t| [t[0] + off, t[1] + off, t[2] + off]),
+        );
         a.positions.push(DVec3::ZERO);
         let r = a.topology_report();
         assert_eq!(r.components, 2);
@@ -624,7 +635,14 @@ mod tests {
     #[test]
     fn names_the_first_offender() {
         let m = Mesh::new(
-            vec![DVec3::ZERO, DVec3::X, DVec3::Y, -DVec3::Y, DVec3::Z, DVec3::NAN],
+            vec![
+                DVec3::ZERO,
+                DVec3::X,
+                DVec3::Y,
+                -DVec3::Y,
+                DVec3::Z,
+                DVec3::NAN,
+            ],
             vec![[0, 1, 2], [1, 0, 3], [0, 1, 4], [2, 2, 3], [0, 1, 7]],
         );
         let r = m.topology_report();

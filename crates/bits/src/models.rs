@@ -1,0 +1,373 @@
+//! Adaptive probability models for the range coder, and what a symbol costs under them.
+//!
+//! * [`BitModel`]: one adaptive binary probability (12 bits, updated by a shift of 5: fast
+//!   enough to follow the label statistics of a mesh region, precise enough for the 0.01-bit
+//!   symbols of a regular retiled mesh).
+//! * [`BitTree`]: `n`-bit values coded bit by bit, each bit in the context of the bits above
+//!   it (a binary decomposition of a `2^n`-symbol alphabet; the swing-angle coder uses it).
+//! * [`SymbolModel`]: an adaptive frequency table for small alphabets (the CLERS labels).
+//! * [`SignedIntModel`] / [`UnsignedIntModel`]: integers by bit length (adaptive), then
+//!   the top mantissa bits (adaptive per length) and the rest raw (position residuals).
+//!
+//! All of them implement their coding on any [`BitSink`], so an encoder can run the very same
+//! code on a [`crate::CostCounter`] to price a choice before committing it.
+
+use crate::range_coder::{RangeDecoder, RangeEncoder};
+
+/// Bits of probability precision.
+pub const PROB_BITS: u32 = 12;
+/// Probability scale: a [`BitModel`] holds P(bit = 0) in units of `1 / PROB_ONE`.
+pub const PROB_ONE: u32 = 1 << PROB_BITS;
+/// Initial probability (one half).
+pub const PROB_INIT: u16 = (PROB_ONE / 2) as u16;
+/// Adaptation speed: the probability moves `1 / 2^ADAPT_SHIFT` of the way to the seen bit.
+pub const ADAPT_SHIFT: u32 = 5;
+
+/// Something symbols can be coded into: the range encoder, or a cost counter.
+pub trait BitSink {
+    /// Codes one bit with an adaptive model (and updates it).
+    fn encode_bit(&mut self, model: &mut BitModel, bit: bool);
+    /// Codes `bits` raw bits of `value`.
+    fn encode_direct(&mut self, value: u32, bits: u32);
+    /// Codes a symbol with an adaptive frequency model (and updates it).
+    fn encode_symbol(&mut self, model: &mut SymbolModel, symbol: usize);
+    /// Codes a value through a bit tree.
+    fn encode_tree(&mut self, tree: &mut BitTree, value: u32) {
+        let bits = tree.bits();
+        let mut node = 1usize;
+        for i in (0..bits).rev() {
+            let bit = (value >> i) & 1 == 1;
+            self.encode_bit(tree.node(node), bit);
+            node = (node << 1) | bit as usize;
+        }
+    }
+}
+
+impl BitSink for RangeEncoder {
+    #[inline]
+    fn encode_bit(&mut self, model: &mut BitModel, bit: bool) {
+        RangeEncoder::encode_bit(self, model, bit)
+    }
+    #[inline]
+    fn encode_direct(&mut self, value: u32, bits: u32) {
+        RangeEncoder::encode_direct(self, value, bits)
+    }
+    #[inline]
+    fn encode_symbol(&mut self, model: &mut SymbolModel, symbol: usize) {
+        RangeEncoder::encode_symbol(self, model, symbol)
+    }
+    #[inline]
+    fn encode_tree(&mut self, tree: &mut BitTree, value: u32) {
+        RangeEncoder::encode_tree(self, tree, value)
+    }
+}
+
+/// An adaptive probability of a binary event.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BitModel(u16);
+
+impl Default for BitModel {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl BitModel {
+    /// Starts at probability one half.
+    pub const fn new() -> Self {
+        BitModel(PROB_INIT)
+    }
+
+    /// P(bit = 0) in units of `1 / PROB_ONE`; always in `[31, PROB_ONE - 31]`.
+    #[inline]
+    pub fn p0(&self) -> u16 {
+        self.0
+    }
+
+    /// Moves the probability towards the bit just seen.
+    #[inline]
+    pub fn update(&mut self, bit: bool) {
+        if bit {
+            self.0 -= self.0 >> ADAPT_SHIFT;
+        } else {
+            self.0 += ((PROB_ONE as u16) - self.0) >> ADAPT_SHIFT;
+        }
+    }
+
+    /// Cost of coding `bit` now, in 1/[`crate::COST_ONE`] bits (without updating).
+    #[inline]
+    pub fn cost(&self, bit: bool) -> u32 {
+        let p = if bit {
+            PROB_ONE - self.0 as u32
+        } else {
+            self.0 as u32
+        };
+        crate::cost::price(p)
+    }
+}
+
+/// `n`-bit values coded MSB first, each bit with its own model chosen by the bits above it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct BitTree {
+    bits: u32,
+    nodes: Vec<BitModel>,
+}
+
+impl BitTree {
+    /// A tree for values below `2^bits` (`bits` from 1 to 16).
+    pub fn new(bits: u32) -> Self {
+        let bits = bits.clamp(1, 16);
+        BitTree {
+            bits,
+            nodes: vec![BitModel::new(); 1 << bits],
+        }
+    }
+
+    /// Number of bits per value.
+    #[inline]
+    pub fn bits(&self) -> u32 {
+        self.bits
+    }
+
+    /// The model of internal node `i` (1-based heap order).
+    #[inline]
+    pub fn node(&mut self, i: usize) -> &mut BitModel {
+        // Callers walk from node 1 down `bits` levels, so i < 2^bits; the modulo keeps a
+        // hypothetical misuse from panicking.
+        let n = self.nodes.len();
+        &mut self.nodes[i % n]
+    }
+
+    /// Cost of coding `value` now, in 1/[`crate::COST_ONE`] bits.
+    pub fn cost(&self, value: u32) -> u32 {
+        let mut node = 1usize;
+        let mut c = 0;
+        for i in (0..self.bits).rev() {
+            let bit = (value >> i) & 1 == 1;
+            c += self.nodes[node % self.nodes.len()].cost(bit);
+            node = (node << 1) | bit as usize;
+        }
+        c
+    }
+}
+
+/// Adaptive frequency model for a small alphabet (up to 64 symbols).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SymbolModel {
+    freq: Vec<u32>,
+    total: u32,
+}
+
+impl SymbolModel {
+    /// Largest total before counts are halved; keeps `range / total >= 2^8`.
+    const LIMIT: u32 = 1 << 16;
+    /// Count added per occurrence.
+    const STEP: u32 = 32;
+
+    /// A model of `n` equally likely symbols (`n` clamped to 1..=64).
+    pub fn new(n: usize) -> Self {
+        let n = n.clamp(1, 64);
+        SymbolModel {
+            freq: vec![1; n],
+            total: n as u32,
+        }
+    }
+
+    /// Alphabet size.
+    pub fn len(&self) -> usize {
+        self.freq.len()
+    }
+
+    /// Always false: a model has at least one symbol.
+    pub fn is_empty(&self) -> bool {
+        self.freq.is_empty()
+    }
+
+    /// Sum of the counts.
+    #[inline]
+    pub fn total(&self) -> u32 {
+        self.total
+    }
+
+    /// `(cumulative count below, count, total)` of `symbol` (clamped into the alphabet).
+    #[inline]
+    pub fn interval(&self, symbol: usize) -> (u32, u32, u32) {
+        let s = symbol.min(self.freq.len() - 1);
+        let cum: u32 = self.freq[..s].iter().sum();
+        (cum, self.freq[s], self.total)
+    }
+
+    /// The symbol whose interval holds `target` (< total): `(symbol, cum, freq)`.
+    #[inline]
+    pub fn find(&self, target: u32) -> (usize, u32, u32) {
+        let mut cum = 0;
+        for (s, &f) in self.freq.iter().enumerate() {
+            if target < cum + f {
+                return (s, cum, f);
+            }
+            cum += f;
+        }
+        // target >= total cannot happen (the decoder clamps); answer the last symbol.
+        let last = self.freq.len() - 1;
+        (last, self.total - self.freq[last], self.freq[last])
+    }
+
+    /// Counts one more occurrence of `symbol`.
+    #[inline]
+    pub fn update(&mut self, symbol: usize) {
+        let s = symbol.min(self.freq.len() - 1);
+        self.freq[s] += Self::STEP;
+        self.total += Self::STEP;
+        if self.total > Self::LIMIT {
+            self.total = 0;
+            for f in &mut self.freq {
+                *f = (*f).div_ceil(2);
+                self.total += *f;
+            }
+        }
+    }
+
+    /// Cost of coding `symbol` now, in 1/[`crate::COST_ONE`] bits.
+    pub fn cost(&self, symbol: usize) -> u32 {
+        let (_, f, t) = self.interval(symbol);
+        crate::cost::ratio_cost(f, t)
+    }
+}
+
+/// Adaptive code for unsigned integers: the bit length through a bit tree, the two bits below
+/// the leading one with models per length, the rest raw.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct UnsignedIntModel {
+    length: BitTree,
+    mantissa: Vec<[BitModel; 3]>,
+}
+
+impl Default for UnsignedIntModel {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl UnsignedIntModel {
+    /// Modelled mantissa bits below the leading one.
+    const MODELLED: u32 = 2;
+
+    /// A fresh model.
+    pub fn new() -> Self {
+        UnsignedIntModel {
+            length: BitTree::new(6),
+            mantissa: vec![[BitModel::new(); 3]; 33],
+        }
+    }
+
+    /// Codes `v`.
+    pub fn encode<S: BitSink>(&mut self, sink: &mut S, v: u32) {
+        let len = 32 - v.leading_zeros();
+        sink.encode_tree(&mut self.length, len);
+        if len > 1 {
+            let rest = len - 1;
+            let modelled = rest.min(Self::MODELLED);
+            let models = &mut self.mantissa[len as usize];
+            // Top modelled bits, the second one in the context of the first.
+            let mut ctx = 0usize;
+            for i in 0..modelled {
+                let bit = (v >> (rest - 1 - i)) & 1 == 1;
+                sink.encode_bit(&mut models[ctx.min(2)], bit);
+                ctx = 1 + bit as usize;
+            }
+            let raw = rest - modelled;
+            if raw > 0 {
+                sink.encode_direct(v & ((1u32 << raw) - 1), raw);
+            }
+        }
+    }
+
+    /// Decodes a value coded by [`UnsignedIntModel::encode`].
+    pub fn decode(&mut self, d: &mut RangeDecoder<'_>) -> u32 {
+        let len = d.decode_tree(&mut self.length).min(32);
+        if len == 0 {
+            return 0;
+        }
+        let rest = len - 1;
+        let mut v: u64 = 1;
+        let modelled = rest.min(Self::MODELLED);
+        let models = &mut self.mantissa[len as usize];
+        let mut ctx = 0usize;
+        for _ in 0..modelled {
+            let bit = d.decode_bit(&mut models[ctx.min(2)]);
+            v = (v << 1) | bit as u64;
+            ctx = 1 + bit as usize;
+        }
+        let raw = rest - modelled;
+        if raw > 0 {
+            v = (v << raw) | d.decode_direct(raw) as u64;
+        }
+        v as u32
+    }
+
+    /// Cost of coding `v` now, in 1/[`crate::COST_ONE`] bits.
+    pub fn cost(&self, v: u32) -> u32 {
+        let len = 32 - v.leading_zeros();
+        let mut c = self.length.cost(len);
+        if len > 1 {
+            let rest = len - 1;
+            let modelled = rest.min(Self::MODELLED);
+            let models = &self.mantissa[len as usize];
+            let mut ctx = 0usize;
+            for i in 0..modelled {
+                let bit = (v >> (rest - 1 - i)) & 1 == 1;
+                c += models[ctx.min(2)].cost(bit);
+                ctx = 1 + bit as usize;
+            }
+            c += (rest - modelled) * crate::COST_ONE;
+        }
+        c
+    }
+}
+
+/// Adaptive code for signed integers: magnitude as [`UnsignedIntModel`], then an adaptive
+/// sign bit.
+#[derive(Clone, Debug, PartialEq, Eq, Default)]
+pub struct SignedIntModel {
+    magnitude: UnsignedIntModel,
+    sign: BitModel,
+}
+
+impl SignedIntModel {
+    /// A fresh model.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Codes `v`.
+    pub fn encode<S: BitSink>(&mut self, sink: &mut S, v: i32) {
+        self.magnitude.encode(sink, v.unsigned_abs());
+        if v != 0 {
+            sink.encode_bit(&mut self.sign, v < 0);
+        }
+    }
+
+    /// Decodes a value coded by [`SignedIntModel::encode`]. Garbage input gives some value,
+    /// never a panic.
+    pub fn decode(&mut self, d: &mut RangeDecoder<'_>) -> i32 {
+        let m = self.magnitude.decode(d);
+        if m == 0 {
+            return 0;
+        }
+        let negative = d.decode_bit(&mut self.sign);
+        if negative {
+            (m as i32).wrapping_neg()
+        } else {
+            m as i32
+        }
+    }
+
+    /// Cost of coding `v` now, in 1/[`crate::COST_ONE`] bits.
+    pub fn cost(&self, v: i32) -> u32 {
+        let mut c = self.magnitude.cost(v.unsigned_abs());
+        if v != 0 {
+            c += self.sign.cost(v < 0);
+        }
+        c
+    }
+}

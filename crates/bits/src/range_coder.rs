@@ -1,0 +1,400 @@
+//! The adaptive binary range coder every whet stream goes through (connectivity labels, swing
+//! angles, position residuals).
+//!
+//! The coder is the carry-propagating byte-oriented range coder of Schindler/Martin, in the
+//! arrangement the LZMA family uses: a 32-bit range, a 33-bit low with a cached byte and a run
+//! of pending 0xFF bytes for the carry, 11-bit adaptive bit probabilities updated by a shift of
+//! 5. Everything is integer arithmetic, so the output is the same on every machine.
+//!
+//! Invariants: after `normalize`, `range >= 2^24`. The encoder emits one leading zero byte
+//! (the initial cache) which the decoder checks, and flushes five bytes at the end, so a decoder
+//! never needs bytes past the end of a complete stream; reading past it means the stream is
+//! truncated, which [`RangeDecoder::finish`] reports. A corrupted stream decodes to garbage
+//! symbols but never panics.
+
+use crate::models::{BitModel, BitTree, SymbolModel, PROB_BITS, PROB_INIT};
+use crate::Error;
+
+const TOP: u32 = 1 << 24;
+
+/// Encodes symbols into bytes.
+#[derive(Clone, Debug)]
+pub struct RangeEncoder {
+    low: u64,
+    range: u32,
+    cache: u8,
+    cache_size: u64,
+    out: Vec<u8>,
+}
+
+impl Default for RangeEncoder {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl RangeEncoder {
+    /// A fresh encoder.
+    pub fn new() -> Self {
+        RangeEncoder {
+            low: 0,
+            range: u32::MAX,
+            cache: 0,
+            cache_size: 1,
+            out: Vec::new(),
+        }
+    }
+
+    /// Bytes emitted so far (the final size is this plus at most five).
+    pub fn bytes_written(&self) -> usize {
+        self.out.len() + self.cache_size as usize
+    }
+
+    #[inline]
+    fn shift_low(&mut self) {
+        if (self.low as u32) < 0xFF00_0000 || (self.low >> 32) != 0 {
+            let carry = (self.low >> 32) as u8;
+            let mut temp = self.cache;
+            loop {
+                self.out.push(temp.wrapping_add(carry));
+                temp = 0xFF;
+                self.cache_size -= 1;
+                if self.cache_size == 0 {
+                    break;
+                }
+            }
+            self.cache = ((self.low >> 24) & 0xFF) as u8;
+        }
+        self.cache_size += 1;
+        self.low = (self.low & 0x00FF_FFFF) << 8;
+    }
+
+    #[inline]
+    fn normalize(&mut self) {
+        while self.range < TOP {
+            self.range <<= 8;
+            self.shift_low();
+        }
+    }
+
+    /// Codes one bit with an adaptive probability, updating the model.
+    #[inline]
+    pub fn encode_bit(&mut self, model: &mut BitModel, bit: bool) {
+        let bound = (self.range >> PROB_BITS) * model.p0() as u32;
+        if bit {
+            self.low += bound as u64;
+            self.range -= bound;
+        } else {
+            self.range = bound;
+        }
+        model.update(bit);
+        self.normalize();
+    }
+
+    /// Codes the low `bits` bits of `value` (most significant first) with probability 1/2
+    /// each; `bits` at most 32.
+    #[inline]
+    pub fn encode_direct(&mut self, value: u32, bits: u32) {
+        for i in (0..bits.min(32)).rev() {
+            self.range >>= 1;
+            if (value >> i) & 1 == 1 {
+                self.low += self.range as u64;
+            }
+            self.normalize();
+        }
+    }
+
+    /// Codes `symbol` with an adaptive frequency model.
+    #[inline]
+    pub fn encode_symbol(&mut self, model: &mut SymbolModel, symbol: usize) {
+        let (cum, freq, total) = model.interval(symbol);
+        let r = self.range / total;
+        self.low += (r as u64) * (cum as u64);
+        self.range = r * freq;
+        model.update(symbol);
+        self.normalize();
+    }
+
+    /// Codes `value` (below `2^tree.bits()`) through a binary tree of adaptive bit models.
+    #[inline]
+    pub fn encode_tree(&mut self, tree: &mut BitTree, value: u32) {
+        let bits = tree.bits();
+        let mut node = 1usize;
+        for i in (0..bits).rev() {
+            let bit = (value >> i) & 1 == 1;
+            self.encode_bit(tree.node(node), bit);
+            node = (node << 1) | bit as usize;
+        }
+    }
+
+    /// Flushes and returns the coded bytes.
+    pub fn finish(mut self) -> Vec<u8> {
+        for _ in 0..5 {
+            self.shift_low();
+        }
+        self.out
+    }
+}
+
+/// Decodes what a [`RangeEncoder`] wrote.
+#[derive(Clone, Debug)]
+pub struct RangeDecoder<'a> {
+    input: &'a [u8],
+    pos: usize,
+    range: u32,
+    code: u32,
+    /// Bytes requested past the end of `input`.
+    overrun: usize,
+}
+
+impl<'a> RangeDecoder<'a> {
+    /// Starts decoding `input`. Fails when it is shorter than the five bytes every stream has
+    /// or does not start with the zero byte every stream starts with.
+    pub fn new(input: &'a [u8]) -> Result<Self, Error> {
+        if input.len() < 5 {
+            return Err(Error::Truncated);
+        }
+        if input[0] != 0 {
+            return Err(Error::Corrupt("range coder stream does not start with 0"));
+        }
+        let code = u32::from_be_bytes([input[1], input[2], input[3], input[4]]);
+        Ok(RangeDecoder {
+            input,
+            pos: 5,
+            range: u32::MAX,
+            code,
+            overrun: 0,
+        })
+    }
+
+    #[inline]
+    fn next_byte(&mut self) -> u8 {
+        match self.input.get(self.pos) {
+            Some(&b) => {
+                self.pos += 1;
+                b
+            }
+            None => {
+                self.overrun += 1;
+                0
+            }
+        }
+    }
+
+    #[inline]
+    fn normalize(&mut self) {
+        while self.range < TOP {
+            self.range <<= 8;
+            self.code = (self.code << 8) | self.next_byte() as u32;
+        }
+    }
+
+    /// Decodes one bit coded with `model`, updating it the same way the encoder did.
+    #[inline]
+    pub fn decode_bit(&mut self, model: &mut BitModel) -> bool {
+        let bound = (self.range >> PROB_BITS) * model.p0() as u32;
+        let bit = if self.code < bound {
+            self.range = bound;
+            false
+        } else {
+            self.code -= bound;
+            self.range -= bound;
+            true
+        };
+        model.update(bit);
+        self.normalize();
+        bit
+    }
+
+    /// Decodes `bits` equiprobable bits, most significant first.
+    #[inline]
+    pub fn decode_direct(&mut self, bits: u32) -> u32 {
+        let mut v = 0u32;
+        for _ in 0..bits.min(32) {
+            self.range >>= 1;
+            let bit = self.code >= self.range;
+            if bit {
+                self.code -= self.range;
+            }
+            v = (v << 1) | bit as u32;
+            self.normalize();
+        }
+        v
+    }
+
+    /// Decodes a symbol coded with `model`.
+    #[inline]
+    pub fn decode_symbol(&mut self, model: &mut SymbolModel) -> usize {
+        let total = model.total();
+        let r = self.range / total;
+        // A corrupt stream can put `code` past the last interval; clamp so the decoder stays
+        // in range (the symbol is garbage, which a CRC or a later check catches).
+        let target = (self.code / r).min(total - 1);
+        let (symbol, cum, freq) = model.find(target);
+        self.code = self.code.wrapping_sub(r * cum);
+        self.range = r * freq;
+        model.update(symbol);
+        self.normalize();
+        symbol
+    }
+
+    /// Decodes a value coded with [`RangeEncoder::encode_tree`].
+    #[inline]
+    pub fn decode_tree(&mut self, tree: &mut BitTree) -> u32 {
+        let bits = tree.bits();
+        let mut node = 1usize;
+        for _ in 0..bits {
+            let bit = self.decode_bit(tree.node(node));
+            node = (node << 1) | bit as usize;
+        }
+        (node - (1usize << bits)) as u32
+    }
+
+    /// Bytes consumed so far.
+    pub fn position(&self) -> usize {
+        self.pos
+    }
+
+    /// Ends decoding: an error when the decoder had to read past the end of its input (the
+    /// stream was cut short).
+    pub fn finish(self) -> Result<(), Error> {
+        if self.overrun > 0 {
+            Err(Error::Truncated)
+        } else {
+            Ok(())
+        }
+    }
+
+    /// True when the decoder has already read past the end of its input.
+    pub fn overran(&self) -> bool {
+        self.overrun > 0
+    }
+}
+
+// Keep the initial probability in one place for the models and the docs.
+const _: () = assert!(PROB_INIT == 1 << (PROB_BITS - 1));
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::models::SignedIntModel;
+    use proptest::prelude::*;
+
+    #[test]
+    fn empty_stream_round_trips() {
+        let bytes = RangeEncoder::new().finish();
+        assert_eq!(bytes.len(), 5);
+        let d = RangeDecoder::new(&bytes).unwrap();
+        d.finish().unwrap();
+    }
+
+    #[test]
+    fn skewed_bits_compress() {
+        let mut e = RangeEncoder::new();
+        let mut m = BitModel::new();
+        for i in 0..10_000 {
+            e.encode_bit(&mut m, i % 50 == 0);
+        }
+        let bytes = e.finish();
+        // Entropy of p = 0.02 is 0.1414 bits: 10k bits -> 177 bytes; adaptation costs a little.
+        assert!(bytes.len() < 230, "{}", bytes.len());
+        let mut d = RangeDecoder::new(&bytes).unwrap();
+        let mut m = BitModel::new();
+        for i in 0..10_000 {
+            assert_eq!(d.decode_bit(&mut m), i % 50 == 0);
+        }
+        d.finish().unwrap();
+    }
+
+    #[test]
+    fn truncation_is_reported() {
+        let mut e = RangeEncoder::new();
+        let mut m = BitModel::new();
+        for i in 0..1000u32 {
+            e.encode_bit(&mut m, i.wrapping_mul(2654435761) >> 31 == 1);
+        }
+        let bytes = e.finish();
+        let cut = &bytes[..bytes.len() - 3];
+        let mut d = RangeDecoder::new(cut).unwrap();
+        let mut m = BitModel::new();
+        for _ in 0..1000 {
+            d.decode_bit(&mut m);
+        }
+        assert_eq!(d.finish(), Err(Error::Truncated));
+        assert_eq!(RangeDecoder::new(&bytes[..4]).err(), Some(Error::Truncated));
+    }
+
+    #[derive(Debug, Clone)]
+    enum Op {
+        Bit(u8, bool),
+        Direct(u32, u32),
+        Symbol(u8, u8),
+        Tree(u32),
+        Int(i32),
+    }
+
+    fn op() -> impl Strategy<Value = Op> {
+        prop_oneof![
+            (0u8..4, any::<bool>()).prop_map(|(m, b)| Op::Bit(m, b)),
+            (any::<u32>(), 0u32..=32)
+                .prop_map(|(v, n)| Op::Direct(if n == 32 { v } else { v & ((1u32 << n) - 1) }, n)),
+            (0u8..3, 0u8..7).prop_map(|(m, s)| Op::Symbol(m, s)),
+            (0u32..256).prop_map(Op::Tree),
+            any::<i32>().prop_map(Op::Int),
+        ]
+    }
+
+    proptest! {
+        #[test]
+        fn mixed_operations_round_trip(ops in proptest::collection::vec(op(), 0..400)) {
+            let mut bits = [BitModel::new(); 4];
+            let mut syms: Vec<SymbolModel> = (0..3).map(|_| SymbolModel::new(7)).collect();
+            let mut tree = BitTree::new(8);
+            let mut ints = SignedIntModel::new();
+            let mut e = RangeEncoder::new();
+            for o in &ops {
+                match *o {
+                    Op::Bit(m, b) => e.encode_bit(&mut bits[m as usize], b),
+                    Op::Direct(v, n) => e.encode_direct(v, n),
+                    Op::Symbol(m, s) => e.encode_symbol(&mut syms[m as usize], s as usize),
+                    Op::Tree(v) => e.encode_tree(&mut tree, v),
+                    Op::Int(v) => ints.encode(&mut e, v),
+                }
+            }
+            let bytes = e.finish();
+            let mut bits = [BitModel::new(); 4];
+            let mut syms: Vec<SymbolModel> = (0..3).map(|_| SymbolModel::new(7)).collect();
+            let mut tree = BitTree::new(8);
+            let mut ints = SignedIntModel::new();
+            let mut d = RangeDecoder::new(&bytes).unwrap();
+            for o in &ops {
+                match *o {
+                    Op::Bit(m, b) => prop_assert_eq!(d.decode_bit(&mut bits[m as usize]), b),
+                    Op::Direct(v, n) => prop_assert_eq!(d.decode_direct(n), v),
+                    Op::Symbol(m, s) => prop_assert_eq!(d.decode_symbol(&mut syms[m as usize]), s as usize),
+                    Op::Tree(v) => prop_assert_eq!(d.decode_tree(&mut tree), v),
+                    Op::Int(v) => prop_assert_eq!(ints.decode(&mut d), v),
+                }
+            }
+            prop_assert!(d.finish().is_ok());
+        }
+
+        #[test]
+        fn garbage_never_panics(bytes in proptest::collection::vec(any::<u8>(), 0..64)) {
+            let mut input = bytes.clone();
+            if let Some(b) = input.first_mut() { *b = 0; }
+            if let Ok(mut d) = RangeDecoder::new(&input) {
+                let mut s = SymbolModel::new(5);
+                let mut t = BitTree::new(6);
+                let mut i = SignedIntModel::new();
+                for _ in 0..200 {
+                    d.decode_symbol(&mut s);
+                    d.decode_tree(&mut t);
+                    i.decode(&mut d);
+                    d.decode_direct(17);
+                }
+                let _ = d.finish();
+            }
+        }
+    }
+}

@@ -1,0 +1,405 @@
+//! Entropy coding of the connectivity: labels, handle contacts and hole dummies, and the
+//! whole-mesh encode/decode built on the traversal and the reverse decoder.
+//!
+//! Payload layout (inside the container's connectivity section; `docs/format.md`):
+//!
+//! | field | coding |
+//! |---|---|
+//! | symbols `N`, components `K`, split events, dummy vertices | four LEB128 varints |
+//! | split events, by increasing source | range coded: source delta, `source - split`, right bit |
+//! | dummy vertex positions in traversal order, increasing | range coded deltas |
+//! | labels in decoding order (last first), the forced first E omitted | range coded, context = remaining valence (6) x previous decoded label (5) |
+
+use crate::holes::close_holes;
+use crate::reverse_decoder::{ReverseDecoder, VALENCE_CONTEXTS};
+use crate::traversal::{traverse, Clers, SplitEvent, TraversalSummary};
+use crate::Error;
+use whet_bits::{
+    BitModel, BitSink, CostCounter, RangeDecoder, RangeEncoder, SymbolModel, UnsignedIntModel,
+};
+use whet_mesh::{CornerId, CornerTable, VertexId};
+
+/// The label models: one adaptive 5-symbol model per (valence, previous label) context.
+struct LabelModels {
+    models: Vec<SymbolModel>,
+}
+
+impl LabelModels {
+    fn new() -> Self {
+        LabelModels {
+            models: (0..VALENCE_CONTEXTS * 5)
+                .map(|_| SymbolModel::new(5))
+                .collect(),
+        }
+    }
+    #[inline]
+    fn get(&mut self, valence_ctx: usize, prev: Clers) -> &mut SymbolModel {
+        let i = (valence_ctx * 5 + prev as usize) % self.models.len();
+        &mut self.models[i]
+    }
+}
+
+/// Side models: split events and dummy positions.
+struct SideModels {
+    source_delta: UnsignedIntModel,
+    split_distance: UnsignedIntModel,
+    right: BitModel,
+    dummy_delta: UnsignedIntModel,
+}
+
+impl SideModels {
+    fn new() -> Self {
+        SideModels {
+            source_delta: UnsignedIntModel::new(),
+            split_distance: UnsignedIntModel::new(),
+            right: BitModel::new(),
+            dummy_delta: UnsignedIntModel::new(),
+        }
+    }
+}
+
+/// Bounds the decoder checks before allocating.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct ConnectivityLimits {
+    /// Most triangles (symbols plus components) a stream may announce.
+    pub max_triangles: u64,
+}
+
+impl ConnectivityLimits {
+    /// 2^26 triangles: about 1.6 GB of decoder state at most.
+    pub const DEFAULT: ConnectivityLimits = ConnectivityLimits {
+        max_triangles: 1 << 26,
+    };
+
+    /// Limits with another triangle bound.
+    pub const fn with_max_triangles(mut self, n: u64) -> Self {
+        self.max_triangles = n;
+        self
+    }
+}
+
+impl Default for ConnectivityLimits {
+    fn default() -> Self {
+        Self::DEFAULT
+    }
+}
+
+/// A closed corner table, its component start corners and its dummy vertices: what both the
+/// encoder and the decoder hand to a geometry coder, which walks it with
+/// [`crate::traverse`]`(table, Some(starts), ..)`.
+#[derive(Clone, Debug)]
+pub struct Connectivity {
+    /// The closed mesh (holes filled with dummy fans).
+    pub table: CornerTable,
+    /// Start corner of each component.
+    pub starts: Vec<CornerId>,
+    /// Per vertex of `table`: true for a hole's dummy vertex.
+    pub is_dummy: Vec<bool>,
+    /// The traversal's results on `table` from `starts`.
+    pub summary: TraversalSummary,
+}
+
+impl Connectivity {
+    /// The real triangles (dummy fans removed) with vertices renumbered in traversal order
+    /// (dummies skipped): the triangle list a decoder outputs.
+    pub fn output_triangles(&self) -> Vec<[u32; 3]> {
+        let rank = self.output_rank();
+        let mut out = Vec::with_capacity(self.table.triangle_count());
+        for t in 0..self.table.triangle_count() {
+            let c = CornerId((3 * t) as u32);
+            let vs = [
+                self.table.vertex(c),
+                self.table.vertex(self.table.next(c)),
+                self.table.vertex(self.table.prev(c)),
+            ];
+            if vs.iter().any(|v| self.is_dummy[v.index()]) {
+                continue;
+            }
+            out.push(vs.map(|v| rank[v.index()]));
+        }
+        out
+    }
+
+    /// Output index of each table vertex (`u32::MAX` for dummies and unused ids).
+    pub fn output_rank(&self) -> Vec<u32> {
+        let mut rank = vec![u32::MAX; self.table.vertex_count()];
+        let mut n = 0u32;
+        for &v in &self.summary.vertex_order {
+            if !self.is_dummy[v.index()] {
+                rank[v.index()] = n;
+                n += 1;
+            }
+        }
+        rank
+    }
+
+    /// The real vertices in output order (table ids).
+    pub fn output_vertices(&self) -> Vec<VertexId> {
+        self.summary
+            .vertex_order
+            .iter()
+            .copied()
+            .filter(|v| !self.is_dummy[v.index()])
+            .collect()
+    }
+}
+
+/// The encoder's result.
+#[derive(Clone, Debug)]
+pub struct EncodedConnectivity {
+    /// The payload.
+    pub bytes: Vec<u8>,
+    /// The encoder-side connectivity (original vertex ids; dummies numbered from the input's
+    /// vertex count on).
+    pub connectivity: Connectivity,
+}
+
+impl EncodedConnectivity {
+    /// Counts of C, L, E, R, S.
+    pub fn histogram(&self) -> [usize; 5] {
+        let mut h = [0usize; 5];
+        for &l in &self.connectivity.summary.labels {
+            h[l as usize] += 1;
+        }
+        h
+    }
+}
+
+fn write_varint(out: &mut Vec<u8>, mut v: u64) {
+    loop {
+        let byte = (v & 0x7F) as u8;
+        v >>= 7;
+        if v == 0 {
+            out.push(byte);
+            return;
+        }
+        out.push(byte | 0x80);
+    }
+}
+
+fn read_varint(bytes: &[u8], pos: &mut usize) -> Result<u64, Error> {
+    let mut v = 0u64;
+    for i in 0..10 {
+        let b = *bytes.get(*pos).ok_or(Error::Truncated)?;
+        *pos += 1;
+        if i == 9 && b > 1 {
+            return Err(Error::Corrupt("varint overflows 64 bits"));
+        }
+        v |= ((b & 0x7F) as u64) << (7 * i);
+        if b & 0x80 == 0 {
+            if b == 0 && i > 0 {
+                return Err(Error::Corrupt("overlong varint"));
+            }
+            return Ok(v);
+        }
+    }
+    Err(Error::Corrupt("varint longer than 10 bytes"))
+}
+
+/// Codes the labels in decoding order with their contexts, on any sink (the range encoder,
+/// or a cost counter to measure).
+fn code_labels<S: BitSink>(
+    sink: &mut S,
+    labels: &[Clers],
+    splits: &[SplitEvent],
+) -> Result<(), Error> {
+    let n = labels.len() as u32;
+    let mut dec = ReverseDecoder::new(n, splits, labels.len() + 1);
+    let mut models = LabelModels::new();
+    let mut prev = Clers::E;
+    for &sym in labels.iter().rev() {
+        if dec.next_is_forced_e() {
+            if sym != Clers::E {
+                return Err(Error::Corrupt("a component does not end with E"));
+            }
+        } else {
+            let ctx = dec.context();
+            sink.encode_symbol(models.get(ctx, prev), sym as usize);
+        }
+        dec.apply(sym)?;
+        prev = sym;
+    }
+    Ok(())
+}
+
+/// Encodes the connectivity of an oriented manifold (holes allowed). `vertex_count` may
+/// exceed the used vertices; unused ones are not coded.
+pub fn encode_connectivity(
+    triangles: &[[u32; 3]],
+    vertex_count: usize,
+) -> Result<EncodedConnectivity, Error> {
+    let open = CornerTable::from_triangles(triangles, vertex_count)?;
+    let (closed, dummies) = close_holes(triangles, &open, vertex_count)?;
+    drop(open);
+    let total_vertices = vertex_count + dummies;
+    let table = CornerTable::from_triangles(&closed, total_vertices)?;
+    let summary = traverse(&table, None, |_| {})?;
+    let starts = summary.starts.clone();
+    let mut is_dummy = vec![false; total_vertices];
+    for d in is_dummy.iter_mut().skip(vertex_count) {
+        *d = true;
+    }
+
+    let mut bytes = Vec::new();
+    let n = summary.labels.len() as u64;
+    write_varint(&mut bytes, n);
+    write_varint(&mut bytes, starts.len() as u64);
+    write_varint(&mut bytes, summary.splits.len() as u64);
+    write_varint(&mut bytes, dummies as u64);
+
+    let mut enc = RangeEncoder::new();
+    let mut side = SideModels::new();
+    let mut prev_source = 0u32;
+    for ev in &summary.splits {
+        side.source_delta.encode(&mut enc, ev.source - prev_source);
+        side.split_distance.encode(&mut enc, ev.source - ev.split);
+        enc.encode_bit(&mut side.right, ev.right);
+        prev_source = ev.source;
+    }
+    let mut prev_pos = 0u32;
+    for (pos, v) in summary.vertex_order.iter().enumerate() {
+        if is_dummy[v.index()] {
+            side.dummy_delta.encode(&mut enc, pos as u32 - prev_pos);
+            prev_pos = pos as u32;
+        }
+    }
+    code_labels(&mut enc, &summary.labels, &summary.splits)?;
+    bytes.extend_from_slice(&enc.finish());
+    Ok(EncodedConnectivity {
+        bytes,
+        connectivity: Connectivity {
+            table,
+            starts,
+            is_dummy,
+            summary,
+        },
+    })
+}
+
+/// Bits the labels alone cost with whet's contexts (measurement for reports and tests).
+pub fn label_bits(labels: &[Clers], splits: &[SplitEvent]) -> Result<f64, Error> {
+    let mut counter = CostCounter::new();
+    code_labels(&mut counter, labels, splits)?;
+    Ok(counter.bits())
+}
+
+/// Decodes a payload written by [`encode_connectivity`]. Returns the connectivity and the
+/// number of bytes consumed.
+pub fn decode_connectivity(
+    bytes: &[u8],
+    limits: &ConnectivityLimits,
+) -> Result<(Connectivity, usize), Error> {
+    let mut pos = 0usize;
+    let n = read_varint(bytes, &mut pos)?;
+    let k = read_varint(bytes, &mut pos)?;
+    let nsplits = read_varint(bytes, &mut pos)?;
+    let ndummies = read_varint(bytes, &mut pos)?;
+    let triangles = n
+        .checked_add(k)
+        .ok_or(Error::Corrupt("symbol count overflows"))?;
+    if triangles > limits.max_triangles {
+        return Err(Error::LimitExceeded {
+            what: "triangles",
+            limit: limits.max_triangles,
+            value: triangles,
+        });
+    }
+    // Every closed component has at least three symbols; two events per handle and a
+    // handle needs several symbols; one dummy per hole, holes need several symbols.
+    if k > n || nsplits > n || ndummies > n || (n > 0 && k == 0) {
+        return Err(Error::Corrupt("inconsistent connectivity counts"));
+    }
+    let payload = bytes.get(pos..).ok_or(Error::Truncated)?;
+    let mut dec = RangeDecoder::new(payload)?;
+    let mut side = SideModels::new();
+    let mut splits = Vec::with_capacity(nsplits.min(1 << 16) as usize);
+    let mut source = 0u32;
+    for _ in 0..nsplits {
+        source = source
+            .checked_add(side.source_delta.decode(&mut dec))
+            .ok_or(Error::Corrupt("split source overflows"))?;
+        let dist = side.split_distance.decode(&mut dec);
+        let split = source
+            .checked_sub(dist)
+            .ok_or(Error::Corrupt("split event before the first symbol"))?;
+        let right = dec.decode_bit(&mut side.right);
+        if source as u64 >= n || dist == 0 {
+            return Err(Error::Corrupt("split event out of range"));
+        }
+        splits.push(SplitEvent {
+            source,
+            split,
+            right,
+        });
+        if dec.overran() {
+            return Err(Error::Truncated);
+        }
+    }
+    let mut dummy_positions = Vec::with_capacity(ndummies.min(1 << 16) as usize);
+    let mut p = 0u64;
+    for i in 0..ndummies {
+        let d = side.dummy_delta.decode(&mut dec) as u64;
+        if i > 0 && d == 0 {
+            return Err(Error::Corrupt("dummy vertex listed twice"));
+        }
+        p += d;
+        dummy_positions.push(p);
+        if dec.overran() {
+            return Err(Error::Truncated);
+        }
+    }
+
+    let n32 = n as u32;
+    let mut rev = ReverseDecoder::new(n32, &splits, (triangles as usize).min(1 << 22));
+    let mut models = LabelModels::new();
+    let mut prev = Clers::E;
+    for i in 0..n32 {
+        let sym = if rev.next_is_forced_e() {
+            Clers::E
+        } else {
+            let ctx = rev.context();
+            let s = dec.decode_symbol(models.get(ctx, prev));
+            Clers::from_index(s).ok_or(Error::Corrupt("label out of range"))?
+        };
+        rev.apply(sym)?;
+        prev = sym;
+        // A stream cut short decodes zeros forever; stop early rather than building a
+        // huge garbage mesh.
+        if i % 4096 == 0 && dec.overran() {
+            return Err(Error::Truncated);
+        }
+    }
+    let consumed = pos + dec.position();
+    dec.finish()?;
+    let starts = rev.finish(k as usize)?;
+    let vertex_ids = rev.vertex_ids();
+    let v = std::mem::take(&mut rev.v);
+    drop(rev);
+    let tris: Vec<[u32; 3]> = v.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+    drop(v);
+    let table = CornerTable::from_triangles(&tris, vertex_ids)
+        .map_err(|_| Error::Corrupt("the decoded mesh is not a manifold"))?;
+    let starts: Vec<CornerId> = starts.into_iter().map(CornerId).collect();
+    let summary = traverse(&table, Some(&starts), |_| {})?;
+    let mut is_dummy = vec![false; vertex_ids];
+    for &p in &dummy_positions {
+        let v = summary
+            .vertex_order
+            .get(p as usize)
+            .ok_or(Error::Corrupt("dummy vertex position out of range"))?;
+        is_dummy[v.index()] = true;
+    }
+    if summary.labels.len() != n as usize {
+        return Err(Error::Corrupt("re-traversal disagrees with the labels"));
+    }
+    Ok((
+        Connectivity {
+            table,
+            starts,
+            is_dummy,
+            summary,
+        },
+        consumed,
+    ))
+}

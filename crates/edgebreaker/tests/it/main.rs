@@ -1,0 +1,8 @@
+//! Round trips, compression figures and corruption handling of the connectivity coder.
+#![allow(clippy::unwrap_used)] // a panic is a test failure
+
+mod fixtures;
+mod meshes;
+mod roundtrip;
+
+pub use meshes::*;
