@@ -1,0 +1,494 @@
+//! The `exact` mode's geometry: positions quantized to `Q` bits per axis, visited in the
+//! Edgebreaker traversal order, predicted by [`crate::parallelogram`] and coded as residuals.
+//!
+//! One function, [`code_positions`], walks the vertices for both sides; the encoder plugs in
+//! a [`ResidualIo`] that writes `actual - prediction` and the decoder one that reads it and
+//! writes `prediction + residual`, so the visiting order, the predictions and the contexts
+//! are the same code.
+//!
+//! Per component: the start triangle's first vertex raw (`Q` bits per axis), the second as a
+//! delta from the first, the third as a delta from their midpoint; then one residual triple per
+//! C tip. Residual contexts: how many parallelograms the prediction averaged (0, 1, 2+) x axis
+//! x bit length of the previous axis's residual of the same vertex (0..=5), which captures that
+//! a vertex badly predicted on one axis is usually badly predicted on the others.
+
+use crate::parallelogram::{average, candidates, gate_fallback, MAX_CANDIDATES};
+use whet_bits::{BitModel, BitSink, RangeDecoder, SignedIntModel};
+use whet_edgebreaker::{Connectivity, TraversalError};
+
+const CLASSES: usize = 4;
+const PREV_BUCKETS: usize = 6;
+
+/// Adaptive models of the position stream.
+pub(crate) struct PositionModels {
+    residual: Vec<SignedIntModel>,
+    seed: [SignedIntModel; 3],
+    /// "Average all candidates" flag, by candidate count - 1.
+    use_all: [BitModel; MAX_CANDIDATES],
+    /// Subset flags by (candidate count - 1, candidate index).
+    selection: [[BitModel; MAX_CANDIDATES]; MAX_CANDIDATES],
+}
+
+impl PositionModels {
+    pub(crate) fn new() -> Self {
+        PositionModels {
+            residual: (0..CLASSES * 3 * PREV_BUCKETS)
+                .map(|_| SignedIntModel::new())
+                .collect(),
+            seed: Default::default(),
+            use_all: [BitModel::new(); MAX_CANDIDATES],
+            selection: [[BitModel::new(); MAX_CANDIDATES]; MAX_CANDIDATES],
+        }
+    }
+}
+
+/// Reads or writes one vertex's grid coordinates given a prediction.
+pub(crate) trait ResidualIo {
+    /// Raw coordinates of a component's first vertex.
+    fn raw(&mut self, bits: u32, q: &mut [i32; 3]);
+    /// Chooses (encoder) or reads (decoder) which of the `cands` to average: a non-zero
+    /// mask over them.
+    fn select(&mut self, models: &mut PositionModels, cands: &[[i64; 3]], q: &[i32; 3]) -> u32;
+    /// Codes `q - prediction` with the model chosen for each axis by `model(axis, prev)`.
+    fn residual(
+        &mut self,
+        models: &mut PositionModels,
+        class: Option<usize>,
+        prediction: [i32; 3],
+        q: &mut [i32; 3],
+    );
+}
+
+#[inline]
+fn bucket(v: i32) -> usize {
+    ((32 - v.unsigned_abs().leading_zeros()) as usize).min(PREV_BUCKETS - 1)
+}
+
+/// Residual context class of a selection: how many parallelograms were averaged (1, 2, 3+).
+#[inline]
+fn class_of(mask: u32) -> usize {
+    (mask.count_ones() as usize).min(CLASSES - 1)
+}
+
+fn selection_cost(models: &PositionModels, k: usize, mask: u32) -> u32 {
+    let all = (1u32 << k) - 1;
+    let mut c = models.use_all[k - 1].cost(mask == all);
+    if mask == all || k == 1 {
+        return c;
+    }
+    let flags = &models.selection[k - 1];
+    for i in 0..k {
+        if i == k - 1 && mask & ((1 << i) - 1) == 0 {
+            break;
+        }
+        c += flags[i].cost(mask >> i & 1 == 1);
+    }
+    c
+}
+
+#[inline]
+fn model_index(class: usize, axis: usize, prev: usize) -> usize {
+    (class * 3 + axis) * PREV_BUCKETS + prev
+}
+
+/// Writes residuals to a sink.
+pub(crate) struct ResidualWriter<'a, S: BitSink> {
+    pub sink: &'a mut S,
+    /// Choose a subset of the parallelograms per vertex (else always average all).
+    pub constrained: bool,
+}
+
+impl<S: BitSink> ResidualIo for ResidualWriter<'_, S> {
+    fn select(&mut self, models: &mut PositionModels, cands: &[[i64; 3]], q: &[i32; 3]) -> u32 {
+        let k = cands.len();
+        if !self.constrained {
+            return (1u32 << k) - 1;
+        }
+        let mut best = (u64::MAX, 1u32);
+        for mask in 1..(1u32 << k) {
+            let p = average(cands, mask);
+            let class = class_of(mask);
+            let mut cost = selection_cost(models, k, mask) as u64;
+            let mut prev = 0usize;
+            for axis in 0..3 {
+                let r = q[axis].wrapping_sub(p[axis]);
+                cost += models.residual[model_index(class, axis, prev)].cost(r) as u64;
+                prev = bucket(r);
+            }
+            if cost < best.0 {
+                best = (cost, mask);
+            }
+        }
+        let mask = best.1;
+        let all = (1u32 << k) - 1;
+        self.sink
+            .encode_bit(&mut models.use_all[k - 1], mask == all);
+        if mask == all || k == 1 {
+            return mask;
+        }
+        let flags = &mut models.selection[k - 1];
+        for i in 0..k {
+            if i == k - 1 && mask & ((1 << i) - 1) == 0 {
+                break; // the last flag is implied when no earlier one was set
+            }
+            self.sink.encode_bit(&mut flags[i], mask >> i & 1 == 1);
+        }
+        mask
+    }
+    fn raw(&mut self, bits: u32, q: &mut [i32; 3]) {
+        for c in q.iter() {
+            self.sink.encode_direct(*c as u32, bits);
+        }
+    }
+    fn residual(
+        &mut self,
+        models: &mut PositionModels,
+        class: Option<usize>,
+        prediction: [i32; 3],
+        q: &mut [i32; 3],
+    ) {
+        let mut prev = 0usize;
+        for axis in 0..3 {
+            let r = q[axis].wrapping_sub(prediction[axis]);
+            let m = match class {
+                Some(cl) => &mut models.residual[model_index(cl, axis, prev)],
+                None => &mut models.seed[axis],
+            };
+            m.encode(self.sink, r);
+            prev = bucket(r);
+        }
+    }
+}
+
+/// Reads residuals from a range decoder.
+pub(crate) struct ResidualReader<'a, 'b> {
+    pub dec: &'a mut RangeDecoder<'b>,
+    /// The stream chose subsets per vertex.
+    pub constrained: bool,
+}
+
+impl ResidualIo for ResidualReader<'_, '_> {
+    fn select(&mut self, models: &mut PositionModels, cands: &[[i64; 3]], _q: &[i32; 3]) -> u32 {
+        let k = cands.len();
+        let all = (1u32 << k) - 1;
+        if !self.constrained {
+            return all;
+        }
+        if self.dec.decode_bit(&mut models.use_all[k - 1]) || k == 1 {
+            return all;
+        }
+        let flags = &mut models.selection[k - 1];
+        let mut mask = 0u32;
+        for i in 0..k {
+            if i == k - 1 && mask == 0 {
+                mask |= 1 << i;
+                break;
+            }
+            if self.dec.decode_bit(&mut flags[i]) {
+                mask |= 1 << i;
+            }
+        }
+        mask
+    }
+    fn raw(&mut self, bits: u32, q: &mut [i32; 3]) {
+        for c in q.iter_mut() {
+            *c = self.dec.decode_direct(bits) as i32;
+        }
+    }
+    fn residual(
+        &mut self,
+        models: &mut PositionModels,
+        class: Option<usize>,
+        prediction: [i32; 3],
+        q: &mut [i32; 3],
+    ) {
+        let mut prev = 0usize;
+        for axis in 0..3 {
+            let m = match class {
+                Some(cl) => &mut models.residual[model_index(cl, axis, prev)],
+                None => &mut models.seed[axis],
+            };
+            let r = m.decode(self.dec);
+            q[axis] = prediction[axis].wrapping_add(r);
+            prev = bucket(r);
+        }
+    }
+}
+
+/// Highest priority bucket of the prediction-degree order.
+const MAX_DEGREE: usize = 4;
+
+/// Codes each real vertex's grid coordinates through `io`, in the prediction-degree order
+/// (Draco's `MESH_TRAVERSAL_PREDICTION_DEGREE` idea): per component, the start triangle's
+/// vertices, then always a vertex with the most incident triangles whose two other vertices
+/// are known (ties: the most recently raised), so that most vertices are predicted from
+/// several parallelograms. The order depends only on the connectivity, which the decoder has
+/// in full before the positions. `q` is indexed by table vertex id; on return the vector marks
+/// every real vertex reached.
+pub(crate) fn code_positions<I: ResidualIo>(
+    conn: &Connectivity,
+    bits: u32,
+    q: &mut [[i32; 3]],
+    io: &mut I,
+) -> Result<Vec<bool>, TraversalError> {
+    let table = &conn.table;
+    let nv = table.vertex_count();
+    let mut known = vec![false; nv];
+    let mut degree = vec![0u8; nv];
+    let mut buckets: [Vec<u32>; MAX_DEGREE + 1] = Default::default();
+    let mut models = PositionModels::new();
+    let is_dummy = &conn.is_dummy;
+
+    // Each vertex's fan is walked from an anchor corner fixed by the order itself (the start
+    // corners, then the corner where a vertex was first met), never from the table's own
+    // vertex_corner: corner numbering differs between the encoder's table and the decoder's.
+    let mut anchor = vec![u32::MAX; nv];
+    // Raises the degree of the unknown neighbours of known vertex `u`.
+    let raise = |u: usize,
+                 known: &[bool],
+                 degree: &mut [u8],
+                 anchor: &mut [u32],
+                 buckets: &mut [Vec<u32>; MAX_DEGREE + 1]| {
+        let start = whet_mesh::CornerId(anchor[u]);
+        if start.index() >= table.corner_count() {
+            return;
+        }
+        let mut c = start;
+        let mut guard = 0usize;
+        loop {
+            let (ca, cb) = (table.next(c), table.prev(c));
+            let a = table.vertex(ca).index();
+            let b = table.vertex(cb).index();
+            for (x, y, cx) in [(a, b, ca), (b, a, cb)] {
+                if anchor[x] == u32::MAX {
+                    anchor[x] = cx.0;
+                }
+                if !known[x] && !is_dummy[x] {
+                    if known[y] {
+                        degree[x] = degree[x].saturating_add(1);
+                    }
+                    let d = (degree[x] as usize).min(MAX_DEGREE);
+                    buckets[d].push(x as u32);
+                }
+            }
+            match table.swing(c) {
+                Some(n) if n != start => c = n,
+                _ => break,
+            }
+            guard += 1;
+            if guard > table.corner_count() {
+                break;
+            }
+        }
+    };
+
+    for &start in &conn.starts {
+        if start.index() >= table.corner_count() {
+            return Err(TraversalError::BadStart(start.0));
+        }
+        let corners = [start, table.next(start), table.prev(start)];
+        let vs = corners.map(|c| table.vertex(c).index());
+        for (&vi, c) in vs.iter().zip(corners) {
+            if anchor[vi] == u32::MAX {
+                anchor[vi] = c.0;
+            }
+        }
+        let mut first: Option<[i32; 3]> = None;
+        let mut second: Option<[i32; 3]> = None;
+        for &vi in &vs {
+            if is_dummy[vi] || known[vi] {
+                continue;
+            }
+            let mut value = q[vi];
+            match (first, second) {
+                (None, _) => {
+                    io.raw(bits, &mut value);
+                    first = Some(value);
+                }
+                (Some(f), None) => {
+                    io.residual(&mut models, None, f, &mut value);
+                    second = Some(value);
+                }
+                (Some(f), Some(s)) => {
+                    let mid = [0, 1, 2].map(|k| (f[k] + s[k]).div_euclid(2));
+                    io.residual(&mut models, None, mid, &mut value);
+                }
+            }
+            q[vi] = value;
+            known[vi] = true;
+        }
+        for &vi in &vs {
+            if known[vi] {
+                raise(vi, &known, &mut degree, &mut anchor, &mut buckets);
+            }
+        }
+        loop {
+            let Some(v) = (0..=MAX_DEGREE).rev().find_map(|d| {
+                while let Some(&x) = buckets[d].last() {
+                    let x = x as usize;
+                    if known[x] || (degree[x] as usize).min(MAX_DEGREE) != d {
+                        buckets[d].pop();
+                        continue;
+                    }
+                    return buckets[d].pop().map(|x| x as usize);
+                }
+                None
+            }) else {
+                break;
+            };
+            // v was queued by a neighbour, so it has an anchor.
+            let corner = whet_mesh::CornerId(anchor[v]);
+            if corner.index() >= table.corner_count() {
+                continue;
+            }
+            let mut cands = [[0i64; 3]; MAX_CANDIDATES];
+            let k = candidates(table, corner, q, &known, &mut cands);
+            let mut value = q[v];
+            let (class, prediction) = if k == 0 {
+                (0, neighbour_fallback(table, corner, q, &known))
+            } else {
+                let mask = io.select(&mut models, &cands[..k], &value);
+                (class_of(mask), average(&cands[..k], mask))
+            };
+            io.residual(&mut models, Some(class), prediction, &mut value);
+            q[v] = value;
+            known[v] = true;
+            raise(v, &known, &mut degree, &mut anchor, &mut buckets);
+        }
+    }
+    Ok(known)
+}
+
+/// Prediction without a parallelogram: the midpoint of the first triangle around the vertex
+/// with both other vertices known, else the first known neighbour.
+fn neighbour_fallback(
+    table: &whet_mesh::CornerTable,
+    corner: whet_mesh::CornerId,
+    q: &[[i32; 3]],
+    known: &[bool],
+) -> [i32; 3] {
+    let mut c = corner;
+    let mut single: Option<usize> = None;
+    let mut guard = 0usize;
+    loop {
+        let a = table.vertex(table.next(c)).index();
+        let b = table.vertex(table.prev(c)).index();
+        if known[a] && known[b] {
+            return gate_fallback(table, c, q, known);
+        }
+        if single.is_none() {
+            single = [a, b].into_iter().find(|&x| known[x]);
+        }
+        match table.swing(c) {
+            Some(n) if n != corner => c = n,
+            _ => break,
+        }
+        guard += 1;
+        if guard > table.corner_count() {
+            break;
+        }
+    }
+    single.map(|x| q[x]).unwrap_or([0; 3])
+}
+
+/// The two payloads of an exact-mode stream and what the encoder knows about them.
+#[derive(Clone, Debug)]
+pub struct ExactPayloads {
+    /// Connectivity section payload.
+    pub connectivity: Vec<u8>,
+    /// Geometry section payload.
+    pub geometry: Vec<u8>,
+    /// The quantization grid.
+    pub quantizer: crate::Quantizer,
+    /// Input vertex of each output vertex (the decoder's vertex order).
+    pub vertex_order: Vec<u32>,
+    /// Components coded.
+    pub components: usize,
+    /// Triangles coded.
+    pub triangles: usize,
+    /// Counts of C, L, E, R, S.
+    pub clers_histogram: [usize; 5],
+}
+
+/// Encodes an oriented manifold (holes, handles, components allowed) in the exact mode.
+pub(crate) fn encode_exact(
+    mesh: &whet_mesh::Mesh,
+    bits: u32,
+) -> Result<ExactPayloads, crate::Error> {
+    let bbox = mesh.bounding_box();
+    let quantizer = crate::Quantizer::new(&bbox, bits);
+    let enc = whet_edgebreaker::encode_connectivity(&mesh.triangles, mesh.positions.len())?;
+    let clers_histogram = enc.histogram();
+    let conn = enc.connectivity;
+    let mut q: Vec<[i32; 3]> = vec![[0; 3]; conn.table.vertex_count()];
+    for (i, p) in mesh.positions.iter().enumerate() {
+        q[i] = quantizer.quantize(*p);
+    }
+    // Per mesh, keep the cheaper of the two prediction strategies: averaging every
+    // parallelogram suits smooth surfaces, choosing subsets suits creased CAD parts.
+    let mut geometry = Vec::new();
+    for constrained in [false, true] {
+        let mut qq = q.clone();
+        let mut range = whet_bits::RangeEncoder::new();
+        range.encode_direct(constrained as u32, 1);
+        let mut io = ResidualWriter {
+            sink: &mut range,
+            constrained,
+        };
+        code_positions(&conn, bits, &mut qq, &mut io).map_err(whet_edgebreaker::Error::from)?;
+        let bytes = range.finish();
+        if geometry.is_empty() || bytes.len() < geometry.len() {
+            geometry = bytes;
+        }
+    }
+    let vertex_order = conn.output_vertices().iter().map(|v| v.0).collect();
+    Ok(ExactPayloads {
+        connectivity: enc.bytes,
+        geometry,
+        quantizer,
+        vertex_order,
+        components: conn.starts.len(),
+        triangles: mesh.triangles.len(),
+        clers_histogram,
+    })
+}
+
+/// Decodes the two payloads of an exact-mode stream.
+pub(crate) fn decode_exact(
+    connectivity: &[u8],
+    geometry: &[u8],
+    quantizer: &crate::Quantizer,
+    limits: &whet_edgebreaker::ConnectivityLimits,
+) -> Result<whet_mesh::Mesh, crate::Error> {
+    let (conn, used) = whet_edgebreaker::decode_connectivity(connectivity, limits)?;
+    if used != connectivity.len() {
+        return Err(crate::Error::Corrupt(
+            "connectivity section has trailing bytes".into(),
+        ));
+    }
+    let mut q: Vec<[i32; 3]> = vec![[0; 3]; conn.table.vertex_count()];
+    let mut dec = RangeDecoder::new(geometry).map_err(|_| crate::Error::Truncated("geometry"))?;
+    let constrained = dec.decode_direct(1) == 1;
+    let mut io = ResidualReader {
+        dec: &mut dec,
+        constrained,
+    };
+    let known = code_positions(&conn, quantizer.bits, &mut q, &mut io)
+        .map_err(whet_edgebreaker::Error::from)?;
+    if dec.finish().is_err() {
+        return Err(crate::Error::Truncated("geometry"));
+    }
+    let max = quantizer.max_level();
+    let order = conn.output_vertices();
+    let mut positions = Vec::with_capacity(order.len());
+    for v in &order {
+        let g = q[v.index()];
+        if !known[v.index()] || g.iter().any(|&c| c < 0 || c > max) {
+            return Err(crate::Error::Corrupt(
+                "a decoded position falls outside the quantization grid".into(),
+            ));
+        }
+        positions.push(quantizer.dequantize(g));
+    }
+    Ok(whet_mesh::Mesh::new(positions, conn.output_triangles()))
+}
