@@ -148,7 +148,10 @@ mod tests {
         let e = Error::parse(12, "expected 3 coordinates");
         assert_eq!(e.to_string(), "line 12: expected 3 coordinates");
         let e = Error::parse(0, "face 3 has 2 vertices");
-        assert_eq!(e.to_string(), "malformed binary data: face 3 has 2 vertices");
+        assert_eq!(
+            e.to_string(),
+            "malformed binary data: face 3 has 2 vertices"
+        );
         let e = Error::IndexOutOfRange {
             face: 4,
             index: 9,

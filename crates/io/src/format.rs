@@ -47,7 +47,10 @@ impl fmt::Display for Format {
 /// The error of [`Format::from_str`]: the string names no known format.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 #[error("unknown mesh format '{0}': expected one of off, obj, ply, stl")]
-pub struct ParseFormatError(pub String);
+pub struct ParseFormatError(
+    /// The string that was not recognised.
+    pub String,
+);
 
 impl FromStr for Format {
     type Err = ParseFormatError;
@@ -85,7 +88,7 @@ pub enum StlEncoding {
     Binary,
 }
 
-/// Options of [`write`](crate::write) and [`write_path`](crate::write_path) for formats that
+/// Options of [`write`](crate::write()) and [`write_path`](crate::write_path) for formats that
 /// have several encodings.
 ///
 /// The struct is `#[non_exhaustive]`: start from [`WriteOptions::DEFAULT`] (or `Default`) and

@@ -11,14 +11,16 @@
 //! use whet_io::{read, write, Format, WriteOptions};
 //! use whet_mesh::{DVec3, Mesh};
 //!
+//! // A tetrahedron whose vertices appear in the triangles in index order.
 //! let mesh = Mesh::new(
-//!     vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::new(0.1, 0.2, 1.0 / 3.0)],
-//!     vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]],
+//!     vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::new(0.1, 0.2, -1.0 / 3.0)],
+//!     vec![[0, 1, 2], [0, 3, 1], [1, 3, 2], [2, 3, 0]],
 //! );
 //! for format in Format::ALL {
 //!     let mut bytes = Vec::new();
 //!     write(&mut bytes, &mesh, format, &WriteOptions::DEFAULT)?;
 //!     let back = read(&bytes[..], format)?;
+//!     // STL welds vertices in order of first appearance, so the triangles match here too.
 //!     assert_eq!(back.triangles, mesh.triangles);
 //!     if format != Format::Stl {
 //!         assert_eq!(back, mesh); // binary STL rounds coordinates to f32
@@ -27,6 +29,7 @@
 //! # Ok::<(), whet_io::Error>(())
 //! ```
 #![forbid(unsafe_code)]
+#![warn(missing_docs)]
 
 mod binary;
 mod error;
@@ -48,9 +51,9 @@ pub use format::{Format, ParseFormatError, PlyEncoding, StlEncoding, WriteOption
 
 /// Readers reserve at most this many vertices or triangles up front, whatever a header claims;
 /// beyond it vectors grow as data actually arrives.
-const MAX_PREALLOC: u64 = 1 << 22;
+const MAX_PREALLOC: u64 = 1 << 20;
 
-/// Buffer size of the readers and writers made by [`read_path`], [`write_path`] and [`write`].
+/// Buffer size of the readers and writers made by [`read_path`], [`write_path`] and [`write()`].
 const BUF_SIZE: usize = 1 << 16;
 
 /// Reads the mesh file at `path`.
@@ -58,7 +61,7 @@ const BUF_SIZE: usize = 1 << 16;
 /// With `format` `None` the format comes from the extension ([`Format::from_path`]); an
 /// unknown extension gives [`Error::UnknownFormat`]. The file is streamed through a
 /// `BufReader`. For STL the file size decides between ascii and binary when the header starts
-/// with `solid` (see [`read`]).
+/// with `solid` (see [`read()`]).
 pub fn read_path(path: &Path, format: Option<Format>) -> Result<Mesh, Error> {
     let format = resolve_format(path, format)?;
     let file = File::open(path)?;
@@ -93,7 +96,7 @@ fn read_impl<R: BufRead>(reader: R, format: Format, size: Option<u64>) -> Result
 /// Writes `mesh` to a new file at `path` (replacing any file there).
 ///
 /// With `format` `None` the format comes from the extension; an unknown extension gives
-/// [`Error::UnknownFormat`]. See [`write`] for what is checked and how each format is written.
+/// [`Error::UnknownFormat`]. See [`write()`] for what is checked and how each format is written.
 /// On error a partly written file may remain.
 pub fn write_path(
     path: &Path,
@@ -114,7 +117,12 @@ pub fn write_path(
 /// (with the triangle's index as `face`), before anything is written. Coordinates of the text
 /// encodings are printed in shortest round-trip form and PLY stores doubles, so everything but
 /// binary STL (f32) reads back bit for bit.
-pub fn write<W: Write>(w: W, mesh: &Mesh, format: Format, opts: &WriteOptions) -> Result<(), Error> {
+pub fn write<W: Write>(
+    w: W,
+    mesh: &Mesh,
+    format: Format,
+    opts: &WriteOptions,
+) -> Result<(), Error> {
     check_writable(mesh)?;
     let mut w = BufWriter::with_capacity(BUF_SIZE, w);
     match format {
@@ -132,7 +140,7 @@ pub fn write<W: Write>(w: W, mesh: &Mesh, format: Format, opts: &WriteOptions) -
 ///
 /// `quality` and `colors` each hold one entry per vertex, or are empty to leave that property
 /// out; any other length gives [`Error::LengthMismatch`]. Quality values are written as given
-/// (not checked for finiteness); the mesh is checked as in [`write`].
+/// (not checked for finiteness); the mesh is checked as in [`write()`].
 pub fn write_ply_with_quality<W: Write>(
     w: W,
     mesh: &Mesh,
@@ -291,11 +299,24 @@ mod tests {
         assert!(matches!(e, Error::NonFinite { vertex: 0 }));
         let bad = Mesh::new(vec![DVec3::ZERO; 3], vec![[0, 1, 2], [0, 1, 3]]);
         let e = write(&mut out, &bad, Format::Ply, &WriteOptions::DEFAULT).unwrap_err();
-        assert!(matches!(e, Error::IndexOutOfRange { face: 1, index: 3, .. }));
+        assert!(matches!(
+            e,
+            Error::IndexOutOfRange {
+                face: 1,
+                index: 3,
+                ..
+            }
+        ));
         assert!(out.is_empty());
         let ok = Mesh::new(vec![DVec3::ZERO; 3], vec![[0, 1, 2]]);
         let e = write_ply_with_quality(&mut out, &ok, &[1.0], &[], PlyEncoding::Ascii);
-        assert!(matches!(e, Err(Error::LengthMismatch { what: "quality", .. })));
+        assert!(matches!(
+            e,
+            Err(Error::LengthMismatch {
+                what: "quality",
+                ..
+            })
+        ));
     }
 
     #[test]

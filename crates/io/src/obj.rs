@@ -233,7 +233,14 @@ mod tests {
         assert_eq!(m.triangles, vec![[0, 1, 2], [3, 2, 1]]);
         let e = read_str("v 0 0 0\nv 1 0 0\nf -1 -2 -3\n").unwrap_err();
         assert!(
-            matches!(e, Error::IndexOutOfRange { face: 0, index: -1, vertex_count: 2 }),
+            matches!(
+                e,
+                Error::IndexOutOfRange {
+                    face: 0,
+                    index: -1,
+                    vertex_count: 2
+                }
+            ),
             "{e}"
         );
     }
@@ -244,7 +251,14 @@ mod tests {
         assert_eq!(m.triangles, vec![[0, 1, 2]]);
         let e = read_str("v 0 0 0\nv 1 0 0\nf 1 2 3\nf 1 2 9\nv 0 1 0\n").unwrap_err();
         assert!(
-            matches!(e, Error::IndexOutOfRange { face: 1, index: 8, vertex_count: 3 }),
+            matches!(
+                e,
+                Error::IndexOutOfRange {
+                    face: 1,
+                    index: 8,
+                    vertex_count: 3
+                }
+            ),
             "{e}"
         );
     }

@@ -70,7 +70,10 @@ fn parse_vertex(line: &[u8], line_no: usize, index: usize) -> Result<Option<DVec
         return Ok(None);
     };
     let mut xyz = [0.0; 3];
-    for (k, tok) in [Some(first), toks.next(), toks.next()].into_iter().enumerate() {
+    for (k, tok) in [Some(first), toks.next(), toks.next()]
+        .into_iter()
+        .enumerate()
+    {
         let Some(tok) = tok else {
             return Err(Error::parse(
                 line_no,
@@ -325,7 +328,10 @@ mod tests {
         assert!(matches!(e, Error::Truncated { .. }));
         assert!(matches!(read_str(""), Err(Error::Truncated { .. })));
         assert!(matches!(read_str("OFF\n"), Err(Error::Truncated { .. })));
-        assert!(matches!(read_str("OFF\n-1 2 0\n"), Err(Error::Parse { .. })));
+        assert!(matches!(
+            read_str("OFF\n-1 2 0\n"),
+            Err(Error::Parse { .. })
+        ));
     }
 
     #[test]
@@ -343,7 +349,10 @@ mod tests {
         let back = read(&out[..]).unwrap();
         assert_eq!(back.triangles, m.triangles);
         for (a, b) in back.positions.iter().zip(&m.positions) {
-            assert_eq!(a.to_array().map(f64::to_bits), b.to_array().map(f64::to_bits));
+            assert_eq!(
+                a.to_array().map(f64::to_bits),
+                b.to_array().map(f64::to_bits)
+            );
         }
     }
 }

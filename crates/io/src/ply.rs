@@ -23,7 +23,9 @@ use std::io::{BufRead, Read, Write};
 use whet_mesh::{DVec3, Mesh};
 
 use crate::binary::{ended, BinReader, Decode};
-use crate::text::{parse_f64, parse_i64, show, tokens, write_f64, LineReader, TokenReader, MAX_LINE};
+use crate::text::{
+    parse_f64, parse_i64, show, tokens, write_f64, LineReader, TokenReader, MAX_LINE,
+};
 use crate::{capacity, check_index, finite_point, Error, Fan, PlyEncoding};
 
 /// Longest header the reader accepts, in bytes.
@@ -59,6 +61,20 @@ impl Scalar {
             b"double" | b"float64" => Scalar::F64,
             _ => return None,
         })
+    }
+
+    /// The canonical PLY name of the type.
+    fn name(self) -> &'static str {
+        match self {
+            Scalar::I8 => "char",
+            Scalar::U8 => "uchar",
+            Scalar::I16 => "short",
+            Scalar::U16 => "ushort",
+            Scalar::I32 => "int",
+            Scalar::U32 => "uint",
+            Scalar::F32 => "float",
+            Scalar::F64 => "double",
+        }
     }
 
     fn size(self) -> usize {
@@ -99,8 +115,15 @@ impl Scalar {
 /// A property of an element.
 #[derive(Clone, Debug)]
 enum Property {
-    Scalar { ty: Scalar, name: String },
-    List { count: Scalar, item: Scalar, name: String },
+    Scalar {
+        ty: Scalar,
+        name: String,
+    },
+    List {
+        count: Scalar,
+        item: Scalar,
+        name: String,
+    },
 }
 
 impl Property {
@@ -205,10 +228,7 @@ fn read_header<R: BufRead>(lines: &mut LineReader<R>) -> Result<Header, Error> {
                     }
                 });
                 if !version.starts_with(b"1") {
-                    return Err(Error::unsupported(format!(
-                        "PLY version {}",
-                        show(version)
-                    )));
+                    return Err(Error::unsupported(format!("PLY version {}", show(version))));
                 }
             }
             b"element" => {
@@ -246,9 +266,8 @@ fn read_header<R: BufRead>(lines: &mut LineReader<R>) -> Result<Header, Error> {
             }
         }
     }
-    let encoding = encoding.ok_or_else(|| {
-        Error::parse(lines.line(), "the PLY header has no format line")
-    })?;
+    let encoding =
+        encoding.ok_or_else(|| Error::parse(lines.line(), "the PLY header has no format line"))?;
     Ok(Header { encoding, elements })
 }
 
@@ -258,9 +277,8 @@ fn parse_property<'a>(
 ) -> Result<Property, Error> {
     let ty = |tok: Option<&[u8]>| -> Result<Scalar, Error> {
         let tok = tok.ok_or_else(|| Error::parse(line_no, "incomplete property line"))?;
-        Scalar::from_name(tok).ok_or_else(|| {
-            Error::parse(line_no, format!("unknown PLY type '{}'", show(tok)))
-        })
+        Scalar::from_name(tok)
+            .ok_or_else(|| Error::parse(line_no, format!("unknown PLY type '{}'", show(tok))))
     };
     let first = toks.next();
     let property = if first == Some(b"list") {
@@ -326,15 +344,18 @@ fn plan(header: &Header) -> Result<Plan, Error> {
                 .iter()
                 .any(|e| e.name == "tristrips" && e.count > 0)
             {
-                return Err(Error::unsupported("PLY triangle strips (element tristrips)"));
+                return Err(Error::unsupported(
+                    "PLY triangle strips (element tristrips)",
+                ));
             }
             None
         }
         Some(f) => {
             let face_element = &elements[f];
             checked_count(face_element.count, "PLY face")?;
-            let list = face_element.props.iter().position(|p| {
-                matches!(p, Property::List { name, .. } if name == "vertex_indices" || name == "vertex_index")
+            let list = face_element.props.iter().position(|p| match p {
+                Property::List { name, .. } => name == "vertex_indices" || name == "vertex_index",
+                Property::Scalar { .. } => false,
             });
             let Some(list) = list else {
                 return Err(Error::unsupported(
@@ -344,7 +365,8 @@ fn plan(header: &Header) -> Result<Plan, Error> {
             if let Property::List { item, .. } = face_element.props[list] {
                 if !item.is_integer() {
                     return Err(Error::unsupported(format!(
-                        "PLY face indices of type {item:?}"
+                        "PLY face indices of type {}",
+                        item.name()
                     )));
                 }
             }
@@ -569,12 +591,18 @@ fn binary_faces<R: Read>(
                         let bytes = bin.get(c as usize * size).map_err(eof)?;
                         for chunk in bytes.chunks_exact(size) {
                             let index = item.i64_from(chunk, big);
-                            fan.push(check_index(index, face_index, vertex_count)?, &mut triangles);
+                            fan.push(
+                                check_index(index, face_index, vertex_count)?,
+                                &mut triangles,
+                            );
                         }
                     } else {
                         for _ in 0..c {
                             let index = item.i64_from(bin.get(size).map_err(eof)?, big);
-                            fan.push(check_index(index, face_index, vertex_count)?, &mut triangles);
+                            fan.push(
+                                check_index(index, face_index, vertex_count)?,
+                                &mut triangles,
+                            );
                         }
                     }
                 }
@@ -687,7 +715,9 @@ fn ascii_vertices<R: BufRead>(
                                 let shown = show(tok);
                                 return Err(Error::parse(
                                     toks.line(),
-                                    format!("invalid value '{shown}' for property {name} of vertex {i}"),
+                                    format!(
+                                        "invalid value '{shown}' for property {name} of vertex {i}"
+                                    ),
                                 ));
                             }
                         }
@@ -747,7 +777,10 @@ fn ascii_faces<R: BufRead>(
                                 format!("invalid vertex index '{shown}' in face {face}"),
                             ));
                         };
-                        fan.push(check_index(index, face_index, vertex_count)?, &mut triangles);
+                        fan.push(
+                            check_index(index, face_index, vertex_count)?,
+                            &mut triangles,
+                        );
                     }
                 }
             }
@@ -804,7 +837,10 @@ pub(crate) fn write<W: Write>(
         writeln!(w, "property double quality")?;
     }
     if !colors.is_empty() {
-        writeln!(w, "property uchar red\nproperty uchar green\nproperty uchar blue")?;
+        writeln!(
+            w,
+            "property uchar red\nproperty uchar green\nproperty uchar blue"
+        )?;
     }
     writeln!(w, "element face {}", mesh.triangles.len())?;
     writeln!(w, "property list uchar uint vertex_indices\nend_header")?;
@@ -832,8 +868,20 @@ pub(crate) fn write<W: Write>(
         }
         PlyEncoding::BinaryLittleEndian | PlyEncoding::BinaryBigEndian => {
             let big = encoding == PlyEncoding::BinaryBigEndian;
-            let f = |x: f64| if big { x.to_be_bytes() } else { x.to_le_bytes() };
-            let u = |x: u32| if big { x.to_be_bytes() } else { x.to_le_bytes() };
+            let f = |x: f64| {
+                if big {
+                    x.to_be_bytes()
+                } else {
+                    x.to_le_bytes()
+                }
+            };
+            let u = |x: u32| {
+                if big {
+                    x.to_be_bytes()
+                } else {
+                    x.to_le_bytes()
+                }
+            };
             let mut rec = Vec::with_capacity(35);
             for (i, p) in mesh.positions.iter().enumerate() {
                 rec.clear();
@@ -945,7 +993,11 @@ mod tests {
     }
 
     fn binary_file(big: bool, header: &str, body: impl FnOnce(&mut Vec<u8>, bool)) -> Vec<u8> {
-        let enc = if big { "binary_big_endian" } else { "binary_little_endian" };
+        let enc = if big {
+            "binary_big_endian"
+        } else {
+            "binary_little_endian"
+        };
         let mut out = format!("ply\nformat {enc} 1.0\n{header}end_header\n").into_bytes();
         body(&mut out, big);
         out
@@ -1003,7 +1055,9 @@ mod tests {
 
     #[test]
     fn fixed_layouts_of_every_type() {
-        for ty in ["char", "uchar", "short", "ushort", "int", "uint", "float", "double"] {
+        for ty in [
+            "char", "uchar", "short", "ushort", "int", "uint", "float", "double",
+        ] {
             for big in [false, true] {
                 let header = format!(
                     "element vertex 2\nproperty {ty} x\nproperty {ty} y\nproperty {ty} z\n\
@@ -1034,39 +1088,82 @@ mod tests {
         }
     }
 
+    /// An ascii PLY file made of `lines`, after the `ply` and `format` lines.
+    fn ascii(lines: &[&str]) -> Vec<u8> {
+        format!("ply\nformat ascii 1.0\n{}\n", lines.join("\n")).into_bytes()
+    }
+
+    const XYZ: &str = "property float x\nproperty float y\nproperty float z";
+
     #[test]
     fn header_errors() {
         let e = read(&b"plx\n"[..]).unwrap_err();
         assert!(matches!(e, Error::Parse { line: 1, .. }), "{e}");
-        let e = read(&b"ply\nformat ascii 1.0\nelement vertex 1\nproperty foo x\nend_header\n"[..])
-            .unwrap_err();
-        assert!(matches!(e, Error::Parse { line: 4, .. }), "{e}");
-        let e = read(&b"ply\nformat ascii 1.0\nelement face 0\nproperty list uchar int vertex_indices\nend_header\n"[..])
-            .unwrap_err();
+        let e = read(&ascii(&["element vertex 1", "property foo x", "end_header"])[..]);
+        assert!(matches!(e, Err(Error::Parse { line: 4, .. })), "{e:?}");
+        let file = ascii(&[
+            "element face 0",
+            "property list uchar int vertex_indices",
+            "end_header",
+        ]);
+        let e = read(&file[..]).unwrap_err();
         assert!(matches!(e, Error::Unsupported { .. }), "{e}");
-        let e = read(&b"ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\nend_header\n"[..])
-            .unwrap_err();
-        assert!(matches!(&e, Error::Unsupported { what } if what.contains("'z'")), "{e}");
-        let e = read(&b"ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\n"[..]).unwrap_err();
-        assert!(matches!(e, Error::Truncated { .. }), "{e}");
+        let file = ascii(&[
+            "element vertex 0",
+            "property float x",
+            "property float y",
+            "end_header",
+        ]);
+        let e = read(&file[..]).unwrap_err();
+        assert!(
+            matches!(&e, Error::Unsupported { what } if what.contains("'z'")),
+            "{e}"
+        );
+        let e = read(&b"ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\n"[..]);
+        assert!(matches!(e, Err(Error::Truncated { .. })), "{e:?}");
         let e = read(&b"ply\nelement vertex 0\nend_header\n"[..]).unwrap_err();
         assert!(matches!(e, Error::Parse { .. }), "{e}");
-        let e = read(&b"ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0 1 1 1"[..])
-            .unwrap_err();
+        let file = ascii(&[
+            "element vertex 4000000000",
+            XYZ,
+            "end_header",
+            "0 0 0 1 1 1",
+        ]);
+        let e = read(&file[..]).unwrap_err();
         assert!(matches!(e, Error::Truncated { .. }), "{e}");
-        let e = read(&b"ply\nformat ascii 1.0\nelement vertex 5000000000\nproperty float x\nproperty float y\nproperty float z\nend_header\n"[..])
-            .unwrap_err();
-        assert!(matches!(e, Error::TooLarge { count: 5000000000, .. }), "{e}");
+        let file = ascii(&["element vertex 5000000000", XYZ, "end_header"]);
+        let e = read(&file[..]).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                Error::TooLarge {
+                    count: 5_000_000_000,
+                    ..
+                }
+            ),
+            "{e}"
+        );
     }
 
     #[test]
     fn body_errors() {
-        let head = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
-                    property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+        let head = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n\
+                    property float y\nproperty float z\nelement face 1\n\
+                    property list uchar int vertex_indices\nend_header\n";
         let ok = format!("{head}0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
         assert_eq!(read(ok.as_bytes()).unwrap().triangles, vec![[0, 1, 2]]);
         let e = read(format!("{head}0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n").as_bytes()).unwrap_err();
-        assert!(matches!(e, Error::IndexOutOfRange { face: 0, index: 3, vertex_count: 3 }), "{e}");
+        assert!(
+            matches!(
+                e,
+                Error::IndexOutOfRange {
+                    face: 0,
+                    index: 3,
+                    vertex_count: 3
+                }
+            ),
+            "{e}"
+        );
         let e = read(format!("{head}0 0 0\n1 0 0\n0 1 0\n3 0 1 -1\n").as_bytes()).unwrap_err();
         assert!(matches!(e, Error::IndexOutOfRange { index: -1, .. }), "{e}");
         let e = read(format!("{head}0 0 0\n1 0 0\n0 1 0\n2 0 1\n").as_bytes()).unwrap_err();
@@ -1076,12 +1173,16 @@ mod tests {
         let e = read(format!("{head}0 0 0\n1 x 0\n0 1 0\n3 0 1 2\n").as_bytes()).unwrap_err();
         assert!(matches!(e, Error::Parse { line: 11, .. }), "{e}");
         let e = read(format!("{head}0 0 0\n1 0 0\n").as_bytes()).unwrap_err();
-        assert_eq!(e.to_string(), "file is truncated: expected 3 vertices, file ended after 2");
+        assert_eq!(
+            e.to_string(),
+            "file is truncated: expected 3 vertices, file ended after 2"
+        );
     }
 
     #[test]
     fn absurd_binary_counts() {
-        let header = "element vertex 4000000000\nproperty float x\nproperty float y\nproperty float z\n";
+        let header =
+            "element vertex 4000000000\nproperty float x\nproperty float y\nproperty float z\n";
         let file = binary_file(false, header, |out, _| out.extend_from_slice(&[0; 10]));
         let e = read(&file[..]).unwrap_err();
         assert!(
@@ -1095,7 +1196,10 @@ mod tests {
             out.extend_from_slice(&[0; 10]);
         });
         let e = read(&file[..]).unwrap_err();
-        assert!(matches!(e, Error::Truncated { .. } | Error::IndexOutOfRange { .. }), "{e}");
+        assert!(
+            matches!(e, Error::Truncated { .. } | Error::IndexOutOfRange { .. }),
+            "{e}"
+        );
         let header = "element vertex 0\nproperty float x\nproperty float y\nproperty float z\n\
                       element junk 9223372036854775807\nelement face 0\n\
                       property list uchar int vertex_indices\n";

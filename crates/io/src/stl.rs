@@ -92,9 +92,11 @@ struct Welder<K> {
 impl<K: Hash + Eq> Welder<K> {
     fn new(corners: u64) -> Self {
         // A closed mesh has about half as many vertices as triangles, a sixth of its corners.
+        // The map is kept smaller than `capacity` allows: unlike a vector's, its allocation is
+        // initialised, and the count comes from an untrusted header.
         let vertices = capacity(corners / 6);
         Welder {
-            map: HashMap::with_capacity(vertices),
+            map: HashMap::with_capacity(vertices.min(1 << 16)),
             positions: Vec::with_capacity(vertices),
         }
     }
@@ -138,7 +140,9 @@ fn key64(x: f64) -> u64 {
 fn read_binary<R: Read>(mut bin: BinReader<R>) -> Result<Mesh, Error> {
     let head = bin.get(HEAD).map_err(|e| {
         if e.kind() == ErrorKind::UnexpectedEof {
-            Error::truncated("a binary STL starts with an 84-byte header and count; the file is shorter")
+            Error::truncated(
+                "a binary STL starts with an 84-byte header and count; the file is shorter",
+            )
         } else {
             Error::Io(e)
         }
@@ -148,7 +152,9 @@ fn read_binary<R: Read>(mut bin: BinReader<R>) -> Result<Mesh, Error> {
     let mut weld = Welder::new(3 * n);
     let mut triangles = Vec::with_capacity(capacity(n));
     for i in 0..n {
-        let rec = bin.get(RECORD as usize).map_err(|e| ended(e, n, "triangles", i))?;
+        let rec = bin
+            .get(RECORD as usize)
+            .map_err(|e| ended(e, n, "triangles", i))?;
         let mut t = [0; 3];
         for (k, corner) in t.iter_mut().enumerate() {
             let o = 12 + 12 * k;
@@ -300,11 +306,7 @@ fn write_binary<W: Write>(w: &mut W, mesh: &Mesh) -> Result<(), Error> {
         what: "STL triangle".into(),
         count: mesh.triangles.len() as u64,
     })?;
-    if let Some(vertex) = mesh
-        .positions
-        .iter()
-        .position(|p| !p.as_vec3().is_finite())
-    {
+    if let Some(vertex) = mesh.positions.iter().position(|p| !p.as_vec3().is_finite()) {
         return Err(Error::unsupported(format!(
             "vertex {vertex} at {} does not fit binary STL's f32 coordinates",
             mesh.positions[vertex]
@@ -318,7 +320,12 @@ fn write_binary<W: Write>(w: &mut W, mesh: &Mesh) -> Result<(), Error> {
     let mut rec = [0u8; RECORD as usize];
     for t in &mesh.triangles {
         let n = normal(mesh, t);
-        let points = [n, mesh.positions[t[0] as usize], mesh.positions[t[1] as usize], mesh.positions[t[2] as usize]];
+        let points = [
+            n,
+            mesh.positions[t[0] as usize],
+            mesh.positions[t[1] as usize],
+            mesh.positions[t[2] as usize],
+        ];
         for (k, p) in points.iter().enumerate() {
             for (d, c) in p.as_vec3().to_array().iter().enumerate() {
                 let o = 12 * k + 4 * d;
@@ -378,9 +385,11 @@ mod tests {
 
     #[test]
     fn welding_unifies_signed_zeros_only() {
-        let text = "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n\
-                    endloop\nendfacet\nfacet normal 0 0 1\nouter loop\nvertex -0 0 0.0\nvertex 1 0 0\n\
-                    vertex 1.0000000000000002 1 0\nendloop\nendfacet\nendsolid t\n";
+        let text = "solid t\nfacet normal 0 0 1\nouter loop\n\
+                    vertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n\
+                    facet normal 0 0 1\nouter loop\n\
+                    vertex -0 0 0.0\nvertex 1 0 0\nvertex 1.0000000000000002 1 0\n\
+                    endloop\nendfacet\nendsolid t\n";
         let m = read(text.as_bytes(), None).unwrap();
         assert_eq!(m.positions.len(), 4);
         assert_eq!(m.triangles, vec![[0, 1, 2], [0, 1, 3]]);
@@ -404,7 +413,8 @@ mod tests {
 
     #[test]
     fn quads_and_case() {
-        let text = "SOLID\nFACET NORMAL 0 0 1\nOUTER LOOP\nVERTEX 0 0 0\nVERTEX 1 0 0\nVERTEX 1 1 0\n\
+        let text =
+            "SOLID\nFACET NORMAL 0 0 1\nOUTER LOOP\nVERTEX 0 0 0\nVERTEX 1 0 0\nVERTEX 1 1 0\n\
                     VERTEX 0 1 0\nENDLOOP\nENDFACET\nENDSOLID\nsolid second\nendsolid\n";
         let m = read(text.as_bytes(), None).unwrap();
         assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3]]);
@@ -416,8 +426,11 @@ mod tests {
         assert!(matches!(e, Error::Parse { line: 2, .. }), "{e}");
         let e = read(&b"solid x\nfacet\nouter loop\nvertex 0 0 nan\n"[..], None).unwrap_err();
         assert!(matches!(e, Error::NonFinite { vertex: 0 }), "{e}");
-        let e = read(&b"solid x\nfacet\nouter loop\nvertex 0 0 0\nvertex 0 1 0\nendloop\nendfacet\n"[..], None)
-            .unwrap_err();
+        let e = read(
+            &b"solid x\nfacet\nouter loop\nvertex 0 0 0\nvertex 0 1 0\nendloop\nendfacet\n"[..],
+            None,
+        )
+        .unwrap_err();
         assert!(matches!(e, Error::Parse { line: 7, .. }), "{e}");
         let e = read(&b"solid x\nfacet\nouter loop\nvertex 0 0 0\n"[..], None).unwrap_err();
         assert!(matches!(e, Error::Truncated { .. }), "{e}");

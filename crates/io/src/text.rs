@@ -59,7 +59,9 @@ impl<R: BufRead> LineReader<R> {
         self.buf.clear();
         self.start = 0;
         self.end = 0;
-        let limit = u64::try_from(self.max_len).unwrap_or(u64::MAX).saturating_add(1);
+        let limit = u64::try_from(self.max_len)
+            .unwrap_or(u64::MAX)
+            .saturating_add(1);
         let n = (&mut self.reader)
             .take(limit)
             .read_until(b'\n', &mut self.buf)?;
@@ -158,7 +160,8 @@ pub(crate) fn strip_comment(line: &[u8]) -> &[u8] {
 
 /// The whitespace-separated tokens of a line.
 pub(crate) fn tokens(line: &[u8]) -> impl Iterator<Item = &[u8]> {
-    line.split(u8::is_ascii_whitespace).filter(|t| !t.is_empty())
+    line.split(u8::is_ascii_whitespace)
+        .filter(|t| !t.is_empty())
 }
 
 /// Parses a decimal float (Rust syntax: `1`, `-2.5`, `1e-7`, `.5`, `inf`, `NaN`).
@@ -233,7 +236,7 @@ mod tests {
 
     #[test]
     fn long_lines_are_refused() {
-        let data = vec![b'x'; 100];
+        let data = [b'x'; 100];
         let mut r = LineReader::with_max_len(&data[..], 10);
         assert!(matches!(r.next_line(), Err(Error::Parse { line: 1, .. })));
         let mut r = LineReader::with_max_len(&b"0123456789\nab"[..], 10);
@@ -278,7 +281,7 @@ mod tests {
             f64::MIN_POSITIVE,
             5e-324,
             1e16,
-            123456789.123456789,
+            123_456_789.123_456_79,
             f64::MAX,
             -f64::MAX,
             2.97683e-21,

@@ -1,1 +1,8 @@
-mod placeholder {}
+//! Integration tests of whet-io: one binary, one module per concern.
+
+mod common;
+mod errors;
+mod fixtures;
+mod fuzz;
+mod roundtrip;
+mod samples;
