@@ -1,19 +1,52 @@
-//! whet-codec: work in progress.
+//! whet-codec owns whet's codec modes and their public entry points: the [`Encoder`] with its
+//! [`EncodeOptions`], and three decoders — [`decode`] from a slice, [`Decoder`] over any
+//! `Read`, and the sans-IO [`StreamingDecoder`] — all over the `.whet` container of
+//! whet-format. Today it carries the `exact` mode (Edgebreaker connectivity, positions
+//! quantized on one cubic grid and predicted by parallelograms in the prediction-degree
+//! order); the prediction code each mode shares between its encoder and decoder lives here
+//! so the two cannot drift.
+//!
+//! ```
+//! use whet_codec::{decode, encode, DecodeOptions, EncodeOptions};
+//! use whet_mesh::{DVec3, Mesh};
+//!
+//! let mesh = Mesh::new(
+//!     vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z],
+//!     vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]],
+//! );
+//! let encoded = encode(&mesh, &EncodeOptions::DEFAULT.with_quant_bits(12))?;
+//! let decoded = decode(&encoded.bytes, &DecodeOptions::DEFAULT)?;
+//! assert_eq!(decoded.triangles.len(), 4);
+//! for (i, &src) in encoded.report.vertex_order.iter().enumerate() {
+//!     assert!((decoded.positions[i] - mesh.positions[src as usize]).length() < 1e-3);
+//! }
+//! # Ok::<(), whet_codec::Error>(())
+//! ```
 #![forbid(unsafe_code)]
 
+mod decoder;
+mod encoder;
 mod exact;
 mod parallelogram;
 mod quantize;
 
+pub use decoder::{
+    decode, decode_container, peek_header, DecodeOptions, Decoder, StreamingDecoder,
+};
+pub use encoder::{encode, EncodeOptions, EncodeReport, Encoded, Encoder};
 pub use exact::ExactPayloads;
 pub use parallelogram::{average, candidates, gate_fallback, MAX_CANDIDATES};
 pub use quantize::Quantizer;
+pub use whet_format::{HeaderInfo, Limits, Mode, Progress, Version};
 
-/// Codec errors.
+/// Everything that can go wrong encoding or decoding.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum Error {
-    /// Connectivity coding failed.
+    /// The container is malformed, truncated, corrupt, of an unknown version, or over limits.
+    #[error(transparent)]
+    Format(#[from] whet_format::Error),
+    /// The connectivity section is corrupt (or the encoder's input could not be traversed).
     #[error(transparent)]
     Connectivity(#[from] whet_edgebreaker::Error),
     /// A section ended early.
@@ -22,6 +55,30 @@ pub enum Error {
     /// Decoded data is inconsistent.
     #[error("corrupt stream: {0}")]
     Corrupt(String),
+    /// A header field the mode needs is missing.
+    #[error("the stream lacks the {0} header field")]
+    MissingField(&'static str),
+    /// A section the mode needs is missing.
+    #[error("the stream lacks the {0} section")]
+    MissingSection(&'static str),
+    /// The encoder's input mesh cannot be coded (non-finite coordinates, or non-manifold with
+    /// repair off).
+    #[error("cannot encode this mesh: {0}")]
+    InvalidInput(whet_mesh::MeshError),
+    /// API misuse (an option out of range, a mode this build lacks).
+    #[error("{0}")]
+    Parameter(String),
+}
+
+impl Error {
+    /// True when the fault is in the bytes handed to a decoder (exit code 2 in the CLI).
+    pub fn is_input_error(&self) -> bool {
+        match self {
+            Error::Format(e) => !matches!(e, whet_format::Error::Io(_)),
+            Error::Parameter(_) => false,
+            _ => true,
+        }
+    }
 }
 
 #[doc(hidden)]

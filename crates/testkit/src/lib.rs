@@ -2,7 +2,8 @@
 //! `shared/` folder that sits beside the checkout (`../shared` from the workspace root, as on
 //! developer machines and CI). Every lookup fails loudly, naming the path it tried, so a
 //! missing folder is never mistaken for a passing test. Set `WHET_SHARED_DIR` to point
-//! elsewhere. It is a dev-dependency only.
+//! elsewhere. It also builds the small test meshes every crate's tests share ([`meshes`]). It is a
+//! dev-dependency only.
 //!
 //! ```no_run
 //! let fandisk = whet_testkit::shared_fixture("fandisk.off");
@@ -11,6 +12,8 @@
 #![forbid(unsafe_code)]
 
 use std::path::{Path, PathBuf};
+
+pub mod meshes;
 
 /// The workspace root (the folder holding the root `Cargo.toml`).
 pub fn workspace_root() -> PathBuf {

@@ -2,7 +2,6 @@
 #![allow(clippy::unwrap_used)] // a panic is a test failure
 
 mod fixtures;
-mod meshes;
 mod roundtrip;
 
-pub use meshes::*;
+pub use whet_testkit::meshes::*;

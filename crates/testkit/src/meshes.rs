@@ -1,4 +1,5 @@
-//! Test meshes built in code: subdivided icosahedra, torus grids, open grids, holes.
+//! Test meshes built in code: subdivided icosahedra, torus grids, open grids, unions,
+//! punched holes and deterministic relabelings.
 
 use whet_mesh::{DVec3, Mesh};
 

@@ -1,0 +1,33 @@
+//! Exact-mode encode and decode throughput on a ~1M-triangle mesh (issue target: decode at
+//! 20 M triangles/s, encode at 5 M triangles/s on one core).
+#![allow(clippy::unwrap_used)] // benches may panic on their own setup
+
+use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
+use whet_codec::{decode, encode, DecodeOptions, EncodeOptions};
+use whet_testkit::meshes::{icosphere, shuffle};
+
+fn bench(c: &mut Criterion) {
+    // Icosphere level 7: 327,680 triangles; level 8: 1,310,720.
+    let mesh = shuffle(&icosphere(8), 1);
+    let opts = EncodeOptions::DEFAULT.with_quant_bits(14);
+    let enc = encode(&mesh, &opts).unwrap();
+    eprintln!(
+        "icosphere(8): {} triangles, {} bytes ({:.3} bpt connectivity)",
+        mesh.triangles.len(),
+        enc.bytes.len(),
+        enc.report.connectivity_bits as f64 / mesh.triangles.len() as f64
+    );
+    let mut g = c.benchmark_group("exact");
+    g.sample_size(10);
+    g.throughput(Throughput::Elements(mesh.triangles.len() as u64));
+    g.bench_function("encode_1.3M", |b| {
+        b.iter(|| black_box(encode(&mesh, &opts).unwrap()))
+    });
+    g.bench_function("decode_1.3M", |b| {
+        b.iter(|| black_box(decode(&enc.bytes, &DecodeOptions::DEFAULT).unwrap()))
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -1,0 +1,156 @@
+//! The public decoders: from a slice, from any `Read`, and sans-IO chunk by chunk; all three
+//! parse the container with whet-format and hand its sections to the mode's decoder.
+
+use crate::exact::decode_exact;
+use crate::{Error, Quantizer};
+use std::io::Read;
+use whet_edgebreaker::ConnectivityLimits;
+use whet_format::{tag, Container, HeaderInfo, Limits, Mode, Progress, SectionKind};
+use whet_mesh::{Aabb, DVec3, Mesh};
+
+/// Options of the decoders.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct DecodeOptions {
+    /// Bounds on what a stream may make the decoder allocate.
+    pub limits: Limits,
+}
+
+impl DecodeOptions {
+    /// Safe default limits.
+    pub const DEFAULT: DecodeOptions = DecodeOptions {
+        limits: Limits::DEFAULT,
+    };
+
+    /// Sets the limits.
+    pub const fn with_limits(mut self, limits: Limits) -> Self {
+        self.limits = limits;
+        self
+    }
+}
+
+impl Default for DecodeOptions {
+    fn default() -> Self {
+        Self::DEFAULT
+    }
+}
+
+/// Decodes a whole `.whet` stream held in memory.
+pub fn decode(bytes: &[u8], opts: &DecodeOptions) -> Result<Mesh, Error> {
+    let container = whet_format::parse(bytes, &opts.limits)?;
+    decode_container(&container, opts)
+}
+
+/// Version, mode and counts of a stream, from its first bytes, without decoding.
+pub fn peek_header(bytes: &[u8]) -> Result<HeaderInfo, Error> {
+    Ok(whet_format::peek_header(bytes)?)
+}
+
+/// Decodes a parsed container.
+pub fn decode_container(container: &Container, opts: &DecodeOptions) -> Result<Mesh, Error> {
+    let h = &container.header;
+    opts.limits
+        .check_counts(h.vertex_count, h.triangle_count)
+        .map_err(Error::Format)?;
+    let mesh = match h.mode {
+        Mode::Exact => {
+            let bits = h
+                .get_u64(tag::QUANT_BITS)
+                .ok_or(Error::MissingField("quant_bits"))?;
+            if !(1..=30).contains(&bits) {
+                return Err(Error::Corrupt(format!(
+                    "quantization bits {bits} out of range"
+                )));
+            }
+            let (min, max) = h.bbox().ok_or(Error::MissingField("bbox"))?;
+            let bbox = Aabb {
+                min: DVec3::from_array(min),
+                max: DVec3::from_array(max),
+            };
+            if !bbox.min.is_finite() || !bbox.max.is_finite() {
+                return Err(Error::Corrupt("bounding box is not finite".into()));
+            }
+            let quantizer = Quantizer::new(&bbox, bits as u32);
+            let conn = container
+                .section(SectionKind::CONNECTIVITY)
+                .ok_or(Error::MissingSection("connectivity"))?;
+            let geom = container
+                .section(SectionKind::GEOMETRY)
+                .ok_or(Error::MissingSection("geometry"))?;
+            let limits = ConnectivityLimits::DEFAULT
+                .with_max_triangles(h.triangle_count.saturating_mul(2).saturating_add(64));
+            decode_exact(conn, geom, &quantizer, &limits)?
+        }
+        other => {
+            return Err(Error::Parameter(format!(
+                "mode {other} is not available in this build"
+            )))
+        }
+    };
+    if mesh.positions.len() as u64 != h.vertex_count
+        || mesh.triangles.len() as u64 != h.triangle_count
+    {
+        return Err(Error::Corrupt(format!(
+            "decoded {} vertices and {} triangles, the header says {} and {}",
+            mesh.positions.len(),
+            mesh.triangles.len(),
+            h.vertex_count,
+            h.triangle_count
+        )));
+    }
+    Ok(mesh)
+}
+
+/// A decoder over any reader: [`Decoder::read_header`] then [`Decoder::decode`].
+pub struct Decoder<R: Read> {
+    reader: R,
+    opts: DecodeOptions,
+}
+
+impl<R: Read> Decoder<R> {
+    /// A decoder reading from `reader`.
+    pub fn new(reader: R, opts: DecodeOptions) -> Self {
+        Decoder { reader, opts }
+    }
+
+    /// Reads the whole stream and decodes it.
+    pub fn decode(self) -> Result<Mesh, Error> {
+        let container = whet_format::read_from(self.reader, &self.opts.limits)?;
+        decode_container(&container, &self.opts)
+    }
+}
+
+/// Sans-IO decoder for servers that receive a stream in pieces: feed chunks with
+/// [`StreamingDecoder::update`]; when it reports [`Progress::Done`], [`StreamingDecoder::finish`]
+/// gives the mesh. Results do not depend on the chunking.
+pub struct StreamingDecoder {
+    inner: whet_format::StreamingDecoder,
+    opts: DecodeOptions,
+}
+
+impl StreamingDecoder {
+    /// A decoder with `opts`.
+    pub fn new(opts: DecodeOptions) -> Self {
+        StreamingDecoder {
+            inner: whet_format::StreamingDecoder::new(opts.limits),
+            opts,
+        }
+    }
+
+    /// Consumes a prefix of `chunk`; returns how many bytes were used and what was reached.
+    /// Call again with the rest until it is empty.
+    pub fn update(&mut self, chunk: &[u8]) -> Result<(usize, Progress), Error> {
+        Ok(self.inner.update(chunk)?)
+    }
+
+    /// True once the end marker was read.
+    pub fn is_done(&self) -> bool {
+        self.inner.is_done()
+    }
+
+    /// Decodes the mesh once the stream is complete.
+    pub fn finish(self) -> Result<Mesh, Error> {
+        let container = self.inner.finish()?;
+        decode_container(&container, &self.opts)
+    }
+}

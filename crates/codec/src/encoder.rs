@@ -1,0 +1,287 @@
+//! The public encoder: options, preparation of the input (validation, manifold repair,
+//! unused vertices), the mode's payloads, and the container.
+
+use crate::exact::encode_exact;
+use crate::Error;
+use whet_format::{tag, Container, Header, Mode, SectionKind, Version};
+use whet_mesh::{ManifoldRepair, Mesh};
+
+/// Options of [`Encoder`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct EncodeOptions {
+    /// Codec mode.
+    pub mode: Mode,
+    /// Position quantization bits per coordinate (exact mode), 1..=30.
+    pub quant_bits: u32,
+    /// Container version to write.
+    pub version: Version,
+    /// Cut non-manifold input with `Mesh::make_manifold` instead of refusing it.
+    pub repair: bool,
+}
+
+impl EncodeOptions {
+    /// Exact mode, 14 bits, current container version, repair on.
+    pub const DEFAULT: EncodeOptions = EncodeOptions {
+        mode: Mode::Exact,
+        quant_bits: 14,
+        version: Version::CURRENT,
+        repair: true,
+    };
+
+    /// Sets the mode.
+    pub const fn with_mode(mut self, mode: Mode) -> Self {
+        self.mode = mode;
+        self
+    }
+
+    /// Sets the quantization bits.
+    pub const fn with_quant_bits(mut self, bits: u32) -> Self {
+        self.quant_bits = bits;
+        self
+    }
+
+    /// Sets the container version to write.
+    pub const fn with_version(mut self, version: Version) -> Self {
+        self.version = version;
+        self
+    }
+
+    /// Turns manifold repair on or off.
+    pub const fn with_repair(mut self, repair: bool) -> Self {
+        self.repair = repair;
+        self
+    }
+}
+
+impl Default for EncodeOptions {
+    fn default() -> Self {
+        Self::DEFAULT
+    }
+}
+
+/// What the encoder did and what the stream costs.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct EncodeReport {
+    /// Total stream size.
+    pub bytes: usize,
+    /// Vertices in the stream (after repair, without unused ones).
+    pub vertices: usize,
+    /// Triangles in the stream.
+    pub triangles: usize,
+    /// Connectivity section payload, in bits.
+    pub connectivity_bits: u64,
+    /// Geometry section payload, in bits.
+    pub geometry_bits: u64,
+    /// Connected components.
+    pub components: usize,
+    /// Counts of the CLERS labels C, L, E, R, S.
+    pub clers_histogram: [usize; 5],
+    /// For each decoded vertex, the input vertex it came from (the decoder outputs vertices in
+    /// traversal order). Vertices added by repair map to the input vertex they copy.
+    pub vertex_order: Vec<u32>,
+    /// What manifold repair changed (all zero when nothing).
+    pub repair: ManifoldRepair,
+    /// Input vertices used by no triangle, left out of the stream.
+    pub dropped_unused_vertices: usize,
+}
+
+impl EncodeReport {
+    /// Whole-stream bits per vertex of the coded mesh.
+    pub fn bits_per_vertex(&self) -> f64 {
+        if self.vertices == 0 {
+            0.0
+        } else {
+            self.bytes as f64 * 8.0 / self.vertices as f64
+        }
+    }
+
+    /// Whole-stream bits per triangle.
+    pub fn bits_per_triangle(&self) -> f64 {
+        if self.triangles == 0 {
+            0.0
+        } else {
+            self.bytes as f64 * 8.0 / self.triangles as f64
+        }
+    }
+}
+
+/// An encoded stream and its report.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Encoded {
+    /// The `.whet` bytes.
+    pub bytes: Vec<u8>,
+    /// What it contains.
+    pub report: EncodeReport,
+}
+
+/// Encodes meshes with fixed options.
+#[derive(Clone, Debug, Default)]
+pub struct Encoder {
+    opts: EncodeOptions,
+}
+
+impl Encoder {
+    /// An encoder with `opts`.
+    pub fn new(opts: EncodeOptions) -> Self {
+        Encoder { opts }
+    }
+
+    /// The options.
+    pub fn options(&self) -> &EncodeOptions {
+        &self.opts
+    }
+
+    /// Encodes `mesh`.
+    pub fn encode(&self, mesh: &Mesh) -> Result<Encoded, Error> {
+        let opts = &self.opts;
+        if !(1..=30).contains(&opts.quant_bits) {
+            return Err(Error::Parameter(format!(
+                "quantization bits must be 1..=30, got {}",
+                opts.quant_bits
+            )));
+        }
+        if opts.version.major != Version::CURRENT.major {
+            return Err(Error::Parameter(format!(
+                "cannot write container version {}",
+                opts.version
+            )));
+        }
+        let prepared = prepare(mesh, opts.repair)?;
+        match opts.mode {
+            Mode::Exact => self.encode_exact(prepared),
+            other => Err(Error::Parameter(format!(
+                "mode {other} is not available in this build"
+            ))),
+        }
+    }
+
+    fn encode_exact(&self, p: Prepared) -> Result<Encoded, Error> {
+        let bits = self.opts.quant_bits;
+        let payloads = encode_exact(&p.mesh, bits)?;
+        let bbox = p.mesh.bounding_box();
+        let (min, max) = if bbox.is_empty() {
+            ([0.0; 3], [0.0; 3])
+        } else {
+            (bbox.min.to_array(), bbox.max.to_array())
+        };
+        let mut header = Header::new(
+            Mode::Exact,
+            payloads.vertex_order.len() as u64,
+            payloads.triangles as u64,
+        )
+        .with_version(self.opts.version)
+        .with(tag::COMPONENT_COUNT, payloads.components as u64)
+        .with(tag::QUANT_BITS, bits as u64);
+        header.set_bbox(min, max);
+        let container = Container::new(header)
+            .with_section(SectionKind::CONNECTIVITY, payloads.connectivity.clone())
+            .with_section(SectionKind::GEOMETRY, payloads.geometry.clone());
+        let bytes = container.to_bytes()?;
+        let vertex_order = payloads
+            .vertex_order
+            .iter()
+            .map(|&v| p.original[v as usize])
+            .collect();
+        let report = EncodeReport {
+            bytes: bytes.len(),
+            vertices: payloads.vertex_order.len(),
+            triangles: payloads.triangles,
+            connectivity_bits: payloads.connectivity.len() as u64 * 8,
+            geometry_bits: payloads.geometry.len() as u64 * 8,
+            components: payloads.components,
+            clers_histogram: payloads.clers_histogram,
+            vertex_order,
+            repair: p.repair,
+            dropped_unused_vertices: p.dropped_unused,
+        };
+        Ok(Encoded { bytes, report })
+    }
+}
+
+/// Encodes `mesh` with `opts` (see [`Encoder`]).
+pub fn encode(mesh: &Mesh, opts: &EncodeOptions) -> Result<Encoded, Error> {
+    Encoder::new(*opts).encode(mesh)
+}
+
+/// A mesh ready for a mode: finite, oriented manifold, no unused vertices.
+pub(crate) struct Prepared {
+    pub mesh: Mesh,
+    /// Input vertex of each prepared vertex.
+    pub original: Vec<u32>,
+    pub repair: ManifoldRepair,
+    pub dropped_unused: usize,
+}
+
+pub(crate) fn prepare(mesh: &Mesh, repair: bool) -> Result<Prepared, Error> {
+    if let Some(v) = mesh.positions.iter().position(|p| !p.is_finite()) {
+        return Err(Error::InvalidInput(
+            whet_mesh::MeshError::NonFiniteCoordinate { vertex: v as u32 },
+        ));
+    }
+    let mut work = mesh.clone();
+    let input_vertices = work.positions.len();
+    let mut rep = ManifoldRepair::default();
+    if let Err(e) = whet_mesh::CornerTable::new(&work) {
+        if !repair {
+            return Err(Error::InvalidInput(e));
+        }
+        rep = work.make_manifold();
+        whet_mesh::CornerTable::new(&work).map_err(Error::InvalidInput)?;
+    }
+    // Repair appends copies; remember which input vertex each one copies by position (the
+    // repair copies positions exactly, and the first input vertex at that position is the
+    // one it split from or an identical one).
+    let mut original: Vec<u32> = (0..work.positions.len() as u32).collect();
+    if work.positions.len() > input_vertices {
+        let mut by_bits: std::collections::HashMap<[u64; 3], u32> = Default::default();
+        for (i, p) in mesh.positions.iter().enumerate() {
+            by_bits
+                .entry([p.x.to_bits(), p.y.to_bits(), p.z.to_bits()])
+                .or_insert(i as u32);
+        }
+        for (i, p) in work.positions.iter().enumerate().skip(input_vertices) {
+            original[i] = by_bits
+                .get(&[p.x.to_bits(), p.y.to_bits(), p.z.to_bits()])
+                .copied()
+                .unwrap_or(i as u32);
+        }
+    }
+    // Drop unused vertices.
+    let mut used = vec![false; work.positions.len()];
+    for t in &work.triangles {
+        for &v in t {
+            used[v as usize] = true;
+        }
+    }
+    let dropped_unused = used[..input_vertices.min(used.len())]
+        .iter()
+        .filter(|&&u| !u)
+        .count();
+    if used.iter().any(|&u| !u) {
+        let mut remap = vec![u32::MAX; used.len()];
+        let mut positions = Vec::with_capacity(used.len());
+        let mut orig = Vec::with_capacity(used.len());
+        for (i, &u) in used.iter().enumerate() {
+            if u {
+                remap[i] = positions.len() as u32;
+                positions.push(work.positions[i]);
+                orig.push(original[i]);
+            }
+        }
+        for t in &mut work.triangles {
+            for v in t.iter_mut() {
+                *v = remap[*v as usize];
+            }
+        }
+        work.positions = positions;
+        original = orig;
+    }
+    Ok(Prepared {
+        mesh: work,
+        original,
+        repair: rep,
+        dropped_unused,
+    })
+}

@@ -1,0 +1,81 @@
+//! Truncated, bit-flipped, random and version-bumped streams give clear errors.
+
+use whet_codec::{decode, encode, DecodeOptions, EncodeOptions, Error};
+use whet_testkit::meshes::*;
+
+fn sample_stream() -> Vec<u8> {
+    let m = shuffle(
+        &union(torus(6, 5), &punch(&icosphere(2), |i| i % 9 == 0), 4.0),
+        1,
+    );
+    encode(&m, &EncodeOptions::DEFAULT.with_quant_bits(11))
+        .unwrap()
+        .bytes
+}
+
+#[test]
+fn every_truncation_is_an_error() {
+    let bytes = sample_stream();
+    for cut in 0..bytes.len() {
+        let e = decode(&bytes[..cut], &DecodeOptions::DEFAULT).unwrap_err();
+        assert!(e.is_input_error(), "cut {cut}: {e}");
+    }
+}
+
+#[test]
+fn every_bit_flip_is_an_error() {
+    let bytes = sample_stream();
+    for i in 0..bytes.len() * 8 {
+        let mut b = bytes.clone();
+        b[i / 8] ^= 1 << (i % 8);
+        let r = decode(&b, &DecodeOptions::DEFAULT);
+        assert!(r.is_err(), "flip of bit {i} decoded silently");
+    }
+}
+
+#[test]
+fn crc_mismatch_names_the_section() {
+    let bytes = sample_stream();
+    // The last bytes are the geometry section's payload, its CRC, and the end marker.
+    let mut b = bytes.clone();
+    let i = b.len() - 8;
+    b[i] ^= 0x10;
+    let e = decode(&b, &DecodeOptions::DEFAULT).unwrap_err();
+    assert!(e.to_string().contains("geometry"), "{e}");
+}
+
+#[test]
+fn newer_major_version_is_refused() {
+    let mut bytes = sample_stream();
+    bytes[4] = 2;
+    let e = decode(&bytes, &DecodeOptions::DEFAULT).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            Error::Format(whet_format::Error::Unsupported { major: 2, .. })
+        ),
+        "{e}"
+    );
+    assert!(e.to_string().contains("newer"), "{e}");
+}
+
+#[test]
+fn random_bytes_never_panic() {
+    let mut x = 0x1234_5678_9abc_def0u64;
+    for len in [0usize, 1, 5, 16, 64, 300] {
+        for _ in 0..200 {
+            let mut b: Vec<u8> = (0..len)
+                .map(|_| {
+                    x ^= x << 13;
+                    x ^= x >> 7;
+                    x ^= x << 17;
+                    x as u8
+                })
+                .collect();
+            if len > 6 {
+                b[..6].copy_from_slice(b"WHET\x01\x00");
+            }
+            assert!(decode(&b, &DecodeOptions::DEFAULT).is_err());
+        }
+    }
+}

@@ -1,0 +1,170 @@
+//! Round trips of the exact mode: same triangles up to the reported vertex permutation,
+//! positions within half a quantization step.
+
+use proptest::prelude::*;
+use whet_codec::{decode, encode, DecodeOptions, Decoder, EncodeOptions, StreamingDecoder};
+use whet_mesh::{DVec3, Mesh};
+use whet_testkit::meshes::*;
+
+fn canonical(t: [u32; 3]) -> [u32; 3] {
+    let r = (0..3).min_by_key(|&i| t[i]).unwrap();
+    [t[r], t[(r + 1) % 3], t[(r + 2) % 3]]
+}
+
+/// Checks a decoded mesh against its source through the report's vertex order.
+pub fn check_round_trip(mesh: &Mesh, bits: u32) -> Vec<u8> {
+    let enc = encode(mesh, &EncodeOptions::DEFAULT.with_quant_bits(bits)).unwrap();
+    let dec = decode(&enc.bytes, &DecodeOptions::DEFAULT).unwrap();
+    let order = &enc.report.vertex_order;
+    assert_eq!(dec.positions.len(), order.len());
+    let ext = mesh.bounding_box().size().max_element();
+    let half = if ext > 0.0 {
+        ext / ((1u64 << bits) - 1) as f64 * 0.5 * (1.0 + 1e-9)
+    } else {
+        0.0
+    };
+    for (i, &src) in order.iter().enumerate() {
+        let d = (dec.positions[i] - mesh.positions[src as usize])
+            .abs()
+            .max_element();
+        assert!(
+            d <= half + 1e-12,
+            "vertex {i}: off by {d}, half step {half}"
+        );
+    }
+    let mut want: Vec<[u32; 3]> = mesh.triangles.iter().map(|&t| canonical(t)).collect();
+    let mut got: Vec<[u32; 3]> = dec
+        .triangles
+        .iter()
+        .map(|t| canonical(t.map(|v| order[v as usize])))
+        .collect();
+    want.sort_unstable();
+    got.sort_unstable();
+    assert_eq!(got, want);
+    enc.bytes
+}
+
+#[test]
+fn fixtures_round_trip() {
+    for path in whet_testkit::shared_off_fixtures() {
+        let mesh = whet_io::read_path(&path, None).unwrap();
+        for bits in [8, 14] {
+            check_round_trip(&mesh, bits);
+        }
+    }
+}
+
+#[test]
+fn one_triangle_and_empty() {
+    let one = Mesh::new(vec![DVec3::ZERO, DVec3::X, DVec3::Y], vec![[0, 1, 2]]);
+    check_round_trip(&one, 10);
+    let empty = Mesh::default();
+    let enc = encode(&empty, &EncodeOptions::DEFAULT).unwrap();
+    let dec = decode(&enc.bytes, &DecodeOptions::DEFAULT).unwrap();
+    assert!(dec.positions.is_empty() && dec.triangles.is_empty());
+}
+
+#[test]
+fn holes_handles_components() {
+    let m = union(
+        union(torus(10, 7), &punch(&icosphere(3), |i| i % 41 == 5), 6.0),
+        &grid(4, 3),
+        12.0,
+    );
+    for seed in 0..3 {
+        check_round_trip(&shuffle(&m, seed), 12);
+    }
+}
+
+#[test]
+fn non_manifold_input_is_repaired_and_unused_vertices_dropped() {
+    let mut m = icosphere(1);
+    // A fin on an existing edge, a bow tie and an unused vertex.
+    let [a, b, _] = m.triangles[0];
+    m.positions.push(DVec3::new(3.0, 3.0, 3.0));
+    let fin = (m.positions.len() - 1) as u32;
+    m.triangles.push([a, b, fin]);
+    m.positions.push(DVec3::new(9.0, 9.0, 9.0));
+    let enc = encode(&m, &EncodeOptions::DEFAULT).unwrap();
+    assert_eq!(enc.report.repair.cut_edges, 1);
+    assert_eq!(enc.report.dropped_unused_vertices, 1);
+    let dec = decode(&enc.bytes, &DecodeOptions::DEFAULT).unwrap();
+    assert_eq!(dec.triangles.len(), m.triangles.len());
+    let r = dec.topology_report();
+    assert!(r.manifold && r.oriented);
+    let refuse = encode(&m, &EncodeOptions::DEFAULT.with_repair(false));
+    assert!(refuse.is_err());
+}
+
+#[test]
+fn nan_input_is_refused() {
+    let mut m = icosphere(0);
+    m.positions[3].y = f64::NAN;
+    let e = encode(&m, &EncodeOptions::DEFAULT).unwrap_err();
+    assert!(e.to_string().contains("non-finite"), "{e}");
+}
+
+#[test]
+fn read_and_streaming_decoders_agree_for_any_chunking() {
+    let m = shuffle(
+        &union(torus(9, 5), &punch(&icosphere(2), |i| i % 13 == 0), 4.0),
+        9,
+    );
+    let enc = encode(&m, &EncodeOptions::DEFAULT).unwrap();
+    let whole = decode(&enc.bytes, &DecodeOptions::DEFAULT).unwrap();
+    let from_read = Decoder::new(&enc.bytes[..], DecodeOptions::DEFAULT)
+        .decode()
+        .unwrap();
+    assert_eq!(from_read, whole);
+    for chunk in [1usize, 2, 3, 7, 64, 1000] {
+        let mut s = StreamingDecoder::new(DecodeOptions::DEFAULT);
+        for piece in enc.bytes.chunks(chunk) {
+            let mut rest = piece;
+            while !rest.is_empty() {
+                let (used, _) = s.update(rest).unwrap();
+                rest = &rest[used..];
+            }
+        }
+        assert!(s.is_done());
+        assert_eq!(s.finish().unwrap(), whole, "chunk {chunk}");
+    }
+}
+
+#[test]
+fn encoding_is_deterministic() {
+    let m = icosphere(3);
+    let a = encode(&m, &EncodeOptions::DEFAULT).unwrap();
+    let b = encode(&m, &EncodeOptions::DEFAULT).unwrap();
+    assert_eq!(a.bytes, b.bytes);
+}
+
+fn random_mesh() -> impl Strategy<Value = Mesh> {
+    (
+        0u32..3,
+        2u32..9,
+        2u32..7,
+        0u32..40,
+        any::<u64>(),
+        prop::bool::ANY,
+    )
+        .prop_map(|(levels, n, m, hole_every, seed, with_torus)| {
+            let mut mesh = icosphere(levels);
+            if with_torus {
+                mesh = union(mesh, &torus(n.max(3), m.max(3)), 5.0);
+            }
+            if hole_every > 2 {
+                mesh = punch(&mesh, |i| i as u32 % hole_every == 1);
+            }
+            shuffle(&mesh, seed)
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+    #[test]
+    fn random_meshes_round_trip(mesh in random_mesh(), bits in 4u32..20) {
+        if !mesh.triangles.is_empty() {
+            check_round_trip(&mesh, bits);
+        }
+    }
+}
