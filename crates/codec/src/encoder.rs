@@ -159,7 +159,7 @@ impl Encoder {
 
     fn encode_exact(&self, p: Prepared) -> Result<Encoded, Error> {
         let bits = self.opts.quant_bits;
-        let payloads = encode_exact(&p.mesh, bits)?;
+        let payloads = encode_exact(&p.mesh, p.table, bits)?;
         let bbox = p.mesh.bounding_box();
         let (min, max) = if bbox.is_empty() {
             ([0.0; 3], [0.0; 3])
@@ -208,6 +208,8 @@ pub fn encode(mesh: &Mesh, opts: &EncodeOptions) -> Result<Encoded, Error> {
 /// A mesh ready for a mode: finite, oriented manifold, no unused vertices.
 pub(crate) struct Prepared {
     pub mesh: Mesh,
+    /// Corner table of `mesh` (built once, reused by the connectivity coder).
+    pub table: whet_mesh::CornerTable,
     /// Input vertex of each prepared vertex.
     pub original: Vec<u32>,
     pub repair: ManifoldRepair,
@@ -228,7 +230,6 @@ pub(crate) fn prepare(mesh: &Mesh, repair: bool) -> Result<Prepared, Error> {
             return Err(Error::InvalidInput(e));
         }
         rep = work.make_manifold();
-        whet_mesh::CornerTable::new(&work).map_err(Error::InvalidInput)?;
     }
     // Repair appends copies; remember which input vertex each one copies by position (the
     // repair copies positions exactly, and the first input vertex at that position is the
@@ -278,7 +279,9 @@ pub(crate) fn prepare(mesh: &Mesh, repair: bool) -> Result<Prepared, Error> {
         work.positions = positions;
         original = orig;
     }
+    let table = whet_mesh::CornerTable::new(&work).map_err(Error::InvalidInput)?;
     Ok(Prepared {
+        table,
         mesh: work,
         original,
         repair: rep,

@@ -13,7 +13,7 @@
 //! a vertex badly predicted on one axis is usually badly predicted on the others.
 
 use crate::parallelogram::{average, candidates, gate_fallback, MAX_CANDIDATES};
-use whet_bits::{BitModel, BitSink, RangeDecoder, SignedIntModel};
+use whet_bits::{BitModel, RangeDecoder, SignedIntModel};
 use whet_edgebreaker::{Connectivity, TraversalError};
 
 const CLASSES: usize = 4;
@@ -44,6 +44,10 @@ impl PositionModels {
 
 /// Reads or writes one vertex's grid coordinates given a prediction.
 pub(crate) trait ResidualIo {
+    /// True when the encoder may stop early (its output already exceeds a budget).
+    fn exhausted(&self) -> bool {
+        false
+    }
     /// Raw coordinates of a component's first vertex.
     fn raw(&mut self, bits: u32, q: &mut [i32; 3]);
     /// Chooses (encoder) or reads (decoder) which of the `cands` to average: a non-zero
@@ -92,13 +96,18 @@ fn model_index(class: usize, axis: usize, prev: usize) -> usize {
 }
 
 /// Writes residuals to a sink.
-pub(crate) struct ResidualWriter<'a, S: BitSink> {
-    pub sink: &'a mut S,
+pub(crate) struct ResidualWriter<'a> {
+    pub sink: &'a mut whet_bits::RangeEncoder,
     /// Choose a subset of the parallelograms per vertex (else always average all).
     pub constrained: bool,
+    /// Give up once the output exceeds this many bytes (a cheaper alternative exists).
+    pub budget: usize,
 }
 
-impl<S: BitSink> ResidualIo for ResidualWriter<'_, S> {
+impl ResidualIo for ResidualWriter<'_> {
+    fn exhausted(&self) -> bool {
+        self.sink.bytes_written() > self.budget
+    }
     fn select(&mut self, models: &mut PositionModels, cands: &[[i64; 3]], q: &[i32; 3]) -> u32 {
         let k = cands.len();
         if !self.constrained {
@@ -354,6 +363,9 @@ pub(crate) fn code_positions<I: ResidualIo>(
             q[v] = value;
             known[v] = true;
             raise(v, &known, &mut degree, &mut anchor, &mut buckets);
+            if io.exhausted() {
+                return Ok(known);
+            }
         }
     }
     Ok(known)
@@ -413,11 +425,16 @@ pub struct ExactPayloads {
 /// Encodes an oriented manifold (holes, handles, components allowed) in the exact mode.
 pub(crate) fn encode_exact(
     mesh: &whet_mesh::Mesh,
+    table: whet_mesh::CornerTable,
     bits: u32,
 ) -> Result<ExactPayloads, crate::Error> {
     let bbox = mesh.bounding_box();
     let quantizer = crate::Quantizer::new(&bbox, bits);
-    let enc = whet_edgebreaker::encode_connectivity(&mesh.triangles, mesh.positions.len())?;
+    let enc = whet_edgebreaker::encode_connectivity_with_table(
+        table,
+        &mesh.triangles,
+        mesh.positions.len(),
+    )?;
     let clers_histogram = enc.histogram();
     let conn = enc.connectivity;
     let mut q: Vec<[i32; 3]> = vec![[0; 3]; conn.table.vertex_count()];
@@ -426,7 +443,8 @@ pub(crate) fn encode_exact(
     }
     // Per mesh, keep the cheaper of the two prediction strategies: averaging every
     // parallelogram suits smooth surfaces, choosing subsets suits creased CAD parts.
-    let mut geometry = Vec::new();
+    // The second pass stops as soon as it is larger than the first.
+    let mut geometry: Vec<u8> = Vec::new();
     for constrained in [false, true] {
         let mut qq = q.clone();
         let mut range = whet_bits::RangeEncoder::new();
@@ -434,10 +452,16 @@ pub(crate) fn encode_exact(
         let mut io = ResidualWriter {
             sink: &mut range,
             constrained,
+            budget: if geometry.is_empty() {
+                usize::MAX
+            } else {
+                geometry.len()
+            },
         };
         code_positions(&conn, bits, &mut qq, &mut io).map_err(whet_edgebreaker::Error::from)?;
+        let exhausted = io.exhausted();
         let bytes = range.finish();
-        if geometry.is_empty() || bytes.len() < geometry.len() {
+        if !exhausted && (geometry.is_empty() || bytes.len() < geometry.len()) {
             geometry = bytes;
         }
     }

@@ -83,7 +83,8 @@ impl Error {
 
 #[doc(hidden)]
 pub fn encode_exact_payloads(mesh: &whet_mesh::Mesh, bits: u32) -> Result<ExactPayloads, Error> {
-    exact::encode_exact(mesh, bits)
+    let table = whet_mesh::CornerTable::new(mesh).map_err(Error::InvalidInput)?;
+    exact::encode_exact(mesh, table, bits)
 }
 
 #[doc(hidden)]

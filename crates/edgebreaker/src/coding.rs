@@ -230,10 +230,28 @@ pub fn encode_connectivity(
     vertex_count: usize,
 ) -> Result<EncodedConnectivity, Error> {
     let open = CornerTable::from_triangles(triangles, vertex_count)?;
-    let (closed, dummies) = close_holes(triangles, &open, vertex_count)?;
-    drop(open);
+    encode_connectivity_with_table(open, triangles, vertex_count)
+}
+
+/// [`encode_connectivity`] for a caller that already built the corner table of
+/// `triangles` (saves building it twice).
+pub fn encode_connectivity_with_table(
+    open: CornerTable,
+    triangles: &[[u32; 3]],
+    vertex_count: usize,
+) -> Result<EncodedConnectivity, Error> {
+    let has_boundary = open.corners().any(|c| open.is_boundary_corner(c));
+    let (table, dummies) = if has_boundary {
+        let (closed, dummies) = close_holes(triangles, &open, vertex_count)?;
+        drop(open);
+        (
+            CornerTable::from_triangles(&closed, vertex_count + dummies)?,
+            dummies,
+        )
+    } else {
+        (open, 0)
+    };
     let total_vertices = vertex_count + dummies;
-    let table = CornerTable::from_triangles(&closed, total_vertices)?;
     let summary = traverse(&table, None, |_| {})?;
     let starts = summary.starts.clone();
     let mut is_dummy = vec![false; total_vertices];
@@ -375,10 +393,9 @@ pub fn decode_connectivity(
     let starts = rev.finish(k as usize)?;
     let vertex_ids = rev.vertex_ids();
     let v = std::mem::take(&mut rev.v);
+    let o = std::mem::take(&mut rev.o);
     drop(rev);
-    let tris: Vec<[u32; 3]> = v.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
-    drop(v);
-    let table = CornerTable::from_triangles(&tris, vertex_ids)
+    let table = CornerTable::from_raw(v, o, vertex_ids)
         .map_err(|_| Error::Corrupt("the decoded mesh is not a manifold"))?;
     let starts: Vec<CornerId> = starts.into_iter().map(CornerId).collect();
     let summary = traverse(&table, Some(&starts), |_| {})?;

@@ -24,8 +24,8 @@ mod reverse_decoder;
 mod traversal;
 
 pub use coding::{
-    decode_connectivity, encode_connectivity, label_bits, Connectivity, ConnectivityLimits,
-    EncodedConnectivity,
+    decode_connectivity, encode_connectivity, encode_connectivity_with_table, label_bits,
+    Connectivity, ConnectivityLimits, EncodedConnectivity,
 };
 pub use holes::close_holes;
 pub use traversal::{traverse, Clers, SplitEvent, Step, TraversalError, TraversalSummary};

@@ -92,107 +92,185 @@ impl CornerTable {
             corner_vertex.extend_from_slice(tri);
         }
 
-        // Bucket the directed edge opposite each corner c, v(next c) -> v(prev c), by its
-        // start vertex, sorted by end vertex inside the bucket.
+        // Pair the edges facing the corners. The edge facing c runs v(next c) -> v(prev c);
+        // bucket it by its lower vertex with (higher vertex, corner), sort each small bucket
+        // by the higher vertex, and pair the runs: two entries of opposite directions are
+        // twins, one is a boundary edge, anything else is refused. Two sequential passes with
+        // one scatter in between: linear for bounded valence.
         let mut offsets = vec![0u32; vertex_count + 1];
         for c in 0..nc {
-            offsets[corner_vertex[next_raw(c)] as usize + 1] += 1;
+            let a = corner_vertex[next_raw(c)];
+            let b = corner_vertex[prev_raw(c)];
+            offsets[a.min(b) as usize + 1] += 1;
         }
         for v in 0..vertex_count {
             offsets[v + 1] += offsets[v];
         }
         let mut fill = offsets.clone();
-        // (end vertex, corner)
         let mut bucket = vec![(0u32, 0u32); nc];
         for c in 0..nc {
-            let a = corner_vertex[next_raw(c)] as usize;
-            bucket[fill[a] as usize] = (corner_vertex[prev_raw(c)], c as u32);
-            fill[a] += 1;
+            let a = corner_vertex[next_raw(c)];
+            let b = corner_vertex[prev_raw(c)];
+            let lo = a.min(b) as usize;
+            bucket[fill[lo] as usize] = (a.max(b), c as u32);
+            fill[lo] += 1;
         }
         drop(fill);
+        let mut opposite = vec![NONE; nc];
         for v in 0..vertex_count {
             let s = &mut bucket[offsets[v] as usize..offsets[v + 1] as usize];
             if s.len() > 1 {
                 s.sort_unstable();
             }
+            let mut i = 0;
+            while i < s.len() {
+                let mut j = i + 1;
+                while j < s.len() && s[j].0 == s[i].0 {
+                    j += 1;
+                }
+                match j - i {
+                    1 => {}
+                    2 => {
+                        let (c1, c2) = (s[i].1 as usize, s[i + 1].1 as usize);
+                        // Twins run in opposite directions: c1's edge starts where c2's ends.
+                        if corner_vertex[next_raw(c1)] != corner_vertex[prev_raw(c2)] {
+                            return Err(MeshError::InconsistentOrientation {
+                                a: corner_vertex[next_raw(c1)],
+                                b: corner_vertex[prev_raw(c1)],
+                                t0: (c1 / 3) as u32,
+                                t1: (c2 / 3) as u32,
+                            });
+                        }
+                        opposite[c1] = c2 as u32;
+                        opposite[c2] = c1 as u32;
+                    }
+                    n => {
+                        return Err(MeshError::NonManifoldEdge {
+                            a: v as u32,
+                            b: s[i].0,
+                            count: n as u32,
+                        })
+                    }
+                }
+                i = j;
+            }
         }
-        let find = |from: u32, to: u32| -> &[(u32, u32)] {
-            let s = &bucket[offsets[from as usize] as usize..offsets[from as usize + 1] as usize];
-            let lo = s.partition_point(|e| e.0 < to);
-            let hi = lo + s[lo..].partition_point(|e| e.0 == to);
-            &s[lo..hi]
-        };
+        drop(bucket);
+        drop(offsets);
+        CornerTable::from_parts(corner_vertex, opposite, vertex_count)
+    }
 
-        let mut opposite = vec![NONE; nc];
+    /// Builds the table from corner vertices and opposites that are already paired (a
+    /// decoder that rebuilt them itself), checking that they are consistent: opposites are
+    /// mutual and face the same edge reversed, and every vertex has a single fan.
+    pub fn from_raw(
+        corner_vertex: Vec<u32>,
+        opposite: Vec<u32>,
+        vertex_count: usize,
+    ) -> Result<CornerTable, MeshError> {
+        let nc = corner_vertex.len();
+        if nc % 3 != 0 || opposite.len() != nc {
+            return Err(MeshError::TooLarge {
+                what: "corner arrays of unequal length",
+                count: nc,
+            });
+        }
+        if vertex_count >= NONE as usize {
+            return Err(MeshError::TooLarge {
+                what: "vertex count",
+                count: vertex_count,
+            });
+        }
         for c in 0..nc {
-            let a = corner_vertex[next_raw(c)];
-            let b = corner_vertex[prev_raw(c)];
-            let same = find(a, b);
-            let reverse = find(b, a);
-            let count = same.len() + reverse.len();
-            if count > 2 {
-                let (lo, hi) = if a < b { (a, b) } else { (b, a) };
+            let v = corner_vertex[c];
+            if v as usize >= vertex_count {
+                return Err(MeshError::IndexOutOfRange {
+                    triangle: (c / 3) as u32,
+                    index: v,
+                    vertex_count: vertex_count as u32,
+                });
+            }
+            let o = opposite[c];
+            if o == NONE {
+                continue;
+            }
+            let oi = o as usize;
+            if oi >= nc
+                || opposite[oi] != c as u32
+                || corner_vertex[next_raw(c)] != corner_vertex[prev_raw(oi)]
+                || corner_vertex[prev_raw(c)] != corner_vertex[next_raw(oi)]
+            {
+                let (a, b) = (corner_vertex[next_raw(c)], corner_vertex[prev_raw(c)]);
                 return Err(MeshError::NonManifoldEdge {
-                    a: lo,
-                    b: hi,
-                    count: count as u32,
+                    a: a.min(b),
+                    b: a.max(b),
+                    count: 3,
                 });
-            }
-            if same.len() == 2 {
-                return Err(MeshError::InconsistentOrientation {
-                    a,
-                    b,
-                    t0: same[0].1 / 3,
-                    t1: same[1].1 / 3,
-                });
-            }
-            if let Some(&(_, o)) = reverse.first() {
-                opposite[c] = o;
             }
         }
+        for t in 0..nc / 3 {
+            let [a, b, c] = [
+                corner_vertex[3 * t],
+                corner_vertex[3 * t + 1],
+                corner_vertex[3 * t + 2],
+            ];
+            if a == b || b == c || a == c {
+                return Err(MeshError::RepeatedVertex {
+                    triangle: t as u32,
+                    vertex: if a == b || a == c { a } else { b },
+                });
+            }
+        }
+        CornerTable::from_parts(corner_vertex, opposite, vertex_count)
+    }
 
+    /// Finishes a table whose opposites are paired: picks each vertex's start corner (the
+    /// clockwise-most at a boundary) and checks that swinging from it visits all the
+    /// vertex's corners.
+    fn from_parts(
+        corner_vertex: Vec<u32>,
+        opposite: Vec<u32>,
+        vertex_count: usize,
+    ) -> Result<CornerTable, MeshError> {
+        let nc = corner_vertex.len();
         let mut table = CornerTable {
             corner_vertex,
             opposite,
             vertex_corner: vec![NONE; vertex_count],
         };
-
-        // One start corner per vertex, then check that swinging from it visits every corner
-        // of the vertex: otherwise the vertex has several fans.
         let mut valence = vec![0u32; vertex_count];
-        for &v in &table.corner_vertex {
-            valence[v as usize] += 1;
-        }
+        let mut open_fans = vec![0u8; vertex_count];
         for c in 0..nc {
             let v = table.corner_vertex[c] as usize;
-            if table.vertex_corner[v] == NONE {
+            valence[v] += 1;
+            // c starts an open fan when the edge behind it, (v(prev c), v(c)), is a boundary.
+            if table.opposite[prev_raw(c)] == NONE {
+                open_fans[v] = open_fans[v].saturating_add(1);
+                table.vertex_corner[v] = c as u32;
+            } else if table.vertex_corner[v] == NONE {
                 table.vertex_corner[v] = c as u32;
             }
         }
         for v in 0..vertex_count {
-            let c0 = table.vertex_corner[v];
-            if c0 == NONE {
+            let start = table.vertex_corner[v];
+            if start == NONE {
                 continue;
             }
-            // Walk clockwise to the first corner of an open fan (or all the way round).
-            let mut start = CornerId(c0);
-            while let Some(back) = table.swing_back(start) {
-                if back.0 == c0 {
-                    break;
-                }
-                start = back;
+            if open_fans[v] > 1 {
+                return Err(MeshError::NonManifoldVertex {
+                    vertex: v as u32,
+                    fans: table.count_fans(VertexId(v as u32)),
+                });
             }
-            table.vertex_corner[v] = start.0;
+            // Open fans start at their clockwise end; a closed fan anywhere. Count the fan.
+            let start = CornerId(start);
             let mut seen = 1u32;
             let mut c = start;
             while let Some(n) = table.swing(c) {
-                if n == start {
+                if n == start || seen > valence[v] {
                     break;
                 }
                 seen += 1;
-                if seen > valence[v] {
-                    break;
-                }
                 c = n;
             }
             if seen != valence[v] {
