@@ -27,3 +27,12 @@ pub use whet_mesh::{
 pub mod io {
     pub use whet_io::*;
 }
+
+/// The codec: encoders, decoders, options and reports.
+pub mod codec {
+    pub use whet_codec::*;
+}
+
+pub use whet_codec::{
+    decode, encode, DecodeOptions, Decoder, EncodeOptions, Encoder, StreamingDecoder,
+};

@@ -68,8 +68,14 @@ pub fn run(args: &InfoArgs) -> CliResult {
             None => println!("  genus           undefined (not an oriented manifold)"),
         }
         println!("  euler char.     {}", r.euler_characteristic);
-        println!("  manifold        {}", if r.manifold { "yes" } else { "no" });
-        println!("  oriented        {}", if r.oriented { "yes" } else { "no" });
+        println!(
+            "  manifold        {}",
+            if r.manifold { "yes" } else { "no" }
+        );
+        println!(
+            "  oriented        {}",
+            if r.oriented { "yes" } else { "no" }
+        );
         println!("  bbox diagonal   {diagonal}");
         println!("  mean edge       {mean_edge}");
         if r.problem_count == 0 {

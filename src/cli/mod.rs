@@ -2,7 +2,11 @@
 //! codes.
 
 mod convert;
+mod decode;
+mod encode;
 mod info;
+mod metro;
+mod synth;
 
 use clap::{Parser, Subcommand};
 use std::path::Path;
@@ -22,6 +26,14 @@ enum Command {
     Info(info::InfoArgs),
     /// Convert a mesh between OFF, OBJ, PLY and STL.
     Convert(convert::ConvertArgs),
+    /// Encode a mesh into a .whet stream.
+    Encode(encode::EncodeArgs),
+    /// Decode a .whet stream into a mesh file.
+    Decode(decode::DecodeArgs),
+    /// Metro error (max, mean, RMS) between a reference and a test surface.
+    Metro(metro::MetroArgs),
+    /// Ground-truth shapes and their marching-cubes samplings.
+    Synth(synth::SynthArgs),
 }
 
 /// A failed command: the error to print and the exit code.
@@ -56,6 +68,10 @@ pub fn run(cli: Cli) -> CliResult {
     match cli.command {
         Command::Info(a) => info::run(&a),
         Command::Convert(a) => convert::run(&a),
+        Command::Encode(a) => encode::run(&a),
+        Command::Decode(a) => decode::run(&a),
+        Command::Metro(a) => metro::run(&a),
+        Command::Synth(a) => synth::run(&a),
     }
 }
 

@@ -2,8 +2,12 @@
 //! per command.
 #![allow(clippy::unwrap_used)] // a panic is a test failure
 
+mod cli_codec;
 mod cli_convert;
 mod cli_info;
+mod cli_metro;
+mod fixtures;
+mod fuzz_replay;
 
 use std::path::Path;
 use std::process::{Command, Output};

@@ -151,6 +151,11 @@ impl Encoder {
         let prepared = prepare(mesh, opts.repair)?;
         match opts.mode {
             Mode::Exact => self.encode_exact(prepared),
+            Mode::Swing => Err(Error::Parameter(
+                "the swing mode's encoder (the retiler) is whet_swing::SwingEncoder; \
+                 whet-codec only writes and reads swing streams"
+                    .into(),
+            )),
             other => Err(Error::Parameter(format!(
                 "mode {other} is not available in this build"
             ))),
@@ -203,6 +208,31 @@ impl Encoder {
 /// Encodes `mesh` with `opts` (see [`Encoder`]).
 pub fn encode(mesh: &Mesh, opts: &EncodeOptions) -> Result<Encoded, Error> {
     Encoder::new(*opts).encode(mesh)
+}
+
+/// An input mesh made ready for a codec mode by [`prepare_mesh`].
+#[derive(Clone, Debug)]
+#[non_exhaustive]
+pub struct PreparedMesh {
+    /// Finite, oriented manifold, without unused vertices.
+    pub mesh: Mesh,
+    /// What manifold repair changed.
+    pub repair: ManifoldRepair,
+    /// Input vertices used by no triangle, left out.
+    pub dropped_unused_vertices: usize,
+}
+
+/// Checks and repairs an input mesh the way [`Encoder`] does before any mode: refuses
+/// non-finite coordinates, cuts non-manifold input with `Mesh::make_manifold` when `repair`
+/// is on (else refuses it), and drops unused vertices. The swing encoder (whet-swing) starts
+/// from this.
+pub fn prepare_mesh(mesh: &Mesh, repair: bool) -> Result<PreparedMesh, Error> {
+    let p = prepare(mesh, repair)?;
+    Ok(PreparedMesh {
+        mesh: p.mesh,
+        repair: p.repair,
+        dropped_unused_vertices: p.dropped_unused,
+    })
 }
 
 /// A mesh ready for a mode: finite, oriented manifold, no unused vertices.

@@ -172,11 +172,18 @@ impl ResidualIo for ResidualWriter<'_> {
 /// Reads residuals from a range decoder.
 pub(crate) struct ResidualReader<'a, 'b> {
     pub dec: &'a mut RangeDecoder<'b>,
+    /// Largest valid grid coordinate.
+    pub max_level: i32,
+    /// Set when a decoded coordinate left the grid: the stream is corrupt, stop early.
+    pub invalid: bool,
     /// The stream chose subsets per vertex.
     pub constrained: bool,
 }
 
 impl ResidualIo for ResidualReader<'_, '_> {
+    fn exhausted(&self) -> bool {
+        self.invalid || self.dec.overran()
+    }
     fn select(&mut self, models: &mut PositionModels, cands: &[[i64; 3]], _q: &[i32; 3]) -> u32 {
         let k = cands.len();
         let all = (1u32 << k) - 1;
@@ -219,6 +226,9 @@ impl ResidualIo for ResidualReader<'_, '_> {
             };
             let r = m.decode(self.dec);
             q[axis] = prediction[axis].wrapping_add(r);
+            if q[axis] < 0 || q[axis] > self.max_level {
+                self.invalid = true;
+            }
             prev = bucket(r);
         }
     }
@@ -319,7 +329,8 @@ pub(crate) fn code_positions<I: ResidualIo>(
                     second = Some(value);
                 }
                 (Some(f), Some(s)) => {
-                    let mid = [0, 1, 2].map(|k| (f[k] + s[k]).div_euclid(2));
+                    // i64: a corrupt stream can decode values near the i32 limits.
+                    let mid = [0, 1, 2].map(|k| ((f[k] as i64 + s[k] as i64).div_euclid(2)) as i32);
                     io.residual(&mut models, None, mid, &mut value);
                 }
             }
@@ -496,6 +507,8 @@ pub(crate) fn decode_exact(
     let mut io = ResidualReader {
         dec: &mut dec,
         constrained,
+        max_level: quantizer.max_level(),
+        invalid: false,
     };
     let known = code_positions(&conn, quantizer.bits, &mut q, &mut io)
         .map_err(whet_edgebreaker::Error::from)?;

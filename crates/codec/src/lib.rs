@@ -1,10 +1,12 @@
 //! whet-codec owns whet's codec modes and their public entry points: the [`Encoder`] with its
 //! [`EncodeOptions`], and three decoders — [`decode`] from a slice, [`Decoder`] over any
 //! `Read`, and the sans-IO [`StreamingDecoder`] — all over the `.whet` container of
-//! whet-format. Today it carries the `exact` mode (Edgebreaker connectivity, positions
+//! whet-format. It carries the `exact` mode (Edgebreaker connectivity, positions
 //! quantized on one cubic grid and predicted by parallelograms in the prediction-degree
-//! order); the prediction code each mode shares between its encoder and decoder lives here
-//! so the two cannot drift.
+//! order) and the decoder and stream writer of the `swing` mode (SwingWrapper: the retiler
+//! that builds the retiled mesh lives in whet-swing, so a decode-only server does not carry
+//! it; [`swing`] holds the tip reconstruction both sides share). The prediction code each
+//! mode shares between its encoder and decoder lives here so the two cannot drift.
 //!
 //! ```
 //! use whet_codec::{decode, encode, DecodeOptions, EncodeOptions};
@@ -27,16 +29,26 @@
 mod decoder;
 mod encoder;
 mod exact;
+mod fuzz;
 mod parallelogram;
 mod quantize;
+pub mod swing;
 
 pub use decoder::{
     decode, decode_container, peek_header, DecodeOptions, Decoder, StreamingDecoder,
 };
-pub use encoder::{encode, EncodeOptions, EncodeReport, Encoded, Encoder};
+pub use encoder::{
+    encode, prepare_mesh, EncodeOptions, EncodeReport, Encoded, Encoder, PreparedMesh,
+};
 pub use exact::ExactPayloads;
+#[doc(hidden)]
+pub use fuzz::{fuzz_decode, fuzz_exact_payloads};
 pub use parallelogram::{average, candidates, gate_fallback, MAX_CANDIDATES};
 pub use quantize::Quantizer;
+pub use swing::{
+    encode_retiled, AngleTable, RetiledMesh, SwingEncoded, SwingFrame, SwingGeometry, SwingParams,
+    SwingStreamInfo, VertexSource,
+};
 pub use whet_format::{HeaderInfo, Limits, Mode, Progress, Version};
 
 /// Everything that can go wrong encoding or decoding.

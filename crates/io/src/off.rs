@@ -201,9 +201,23 @@ fn check_keyword(keyword: &[u8], line: usize) -> Result<(), Error> {
             show(keyword)
         )));
     }
-    let rest = prefix.strip_prefix(b"ST").unwrap_or(prefix);
-    let rest = rest.strip_prefix(b"C").unwrap_or(rest);
-    let rest = rest.strip_prefix(b"N").unwrap_or(rest);
+    // The prefixes in any order, each at most once (MeshLab writes `NCOFF`).
+    let mut rest = prefix;
+    let mut seen = [false; 3];
+    loop {
+        let before = rest.len();
+        for (i, p) in [&b"ST"[..], b"C", b"N"].iter().enumerate() {
+            if !seen[i] {
+                if let Some(r) = rest.strip_prefix(*p) {
+                    rest = r;
+                    seen[i] = true;
+                }
+            }
+        }
+        if rest.len() == before {
+            break;
+        }
+    }
     if rest.is_empty() {
         Ok(())
     } else {
@@ -264,7 +278,9 @@ mod tests {
 
     #[test]
     fn keyword_variants() {
-        for kw in ["OFF", "COFF", "NOFF", "CNOFF", "STOFF", "STCNOFF", "off"] {
+        for kw in [
+            "OFF", "COFF", "NOFF", "CNOFF", "NCOFF", "STOFF", "STCNOFF", "NSTOFF", "off",
+        ] {
             assert!(check_keyword(kw.as_bytes(), 1).is_ok(), "{kw}");
         }
         assert!(matches!(

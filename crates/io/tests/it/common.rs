@@ -186,16 +186,7 @@ pub fn awkward() -> Mesh {
 
 /// The shared fixtures folder (`shared/fixtures` beside the workspace).
 pub fn fixtures_dir() -> PathBuf {
-    let dir = PathBuf::from(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/fixtures"
-    ));
-    assert!(
-        dir.is_dir(),
-        "shared fixtures folder not found at {}",
-        dir.display()
-    );
-    dir
+    whet_testkit::shared_dir().join("fixtures")
 }
 
 /// A path in the temporary folder unique to this process and `name`.

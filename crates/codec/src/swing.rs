@@ -1,0 +1,897 @@
+//! The `swing` mode's geometry (SwingWrapper; Attene, Falcidieno, Spagnuolo, Rossignac, ACM
+//! TOG 22(4) 2003; `../shared/docs/algorithms.md` 1.3, 1.6, 1.8, 1.10): the one vertex
+//! reconstruction the retiler (whet-swing, encoder side) and the decoder both run, the coding
+//! of the swing indices, and the swing container's writer and reader.
+//!
+//! ```text
+//!                 tip = P(q·Δ)                    m  = (a + b) / 2
+//!                  *  ^ e2 (parent's normal)      r  = sqrt(L² - |b - a|² / 4)
+//!                 /|\ |                           e1 = away from c, in the parent's plane,
+//!             L  / | \ L                               perpendicular to the gate
+//!               /  |r \                           e2 = u × e1, u = (b - a) / |b - a|
+//!          a --+---m---+-- b   gate a -> b        P(θ) = m + r cos θ · e1 + r sin θ · e2
+//!               \  |  /
+//!                \ | /        parent (b, a, c)    θ = 0 continues the parent flat across
+//!                  c                              the gate; θ > 0 folds outwards.
+//! ```
+//!
+//! Invariants. Encoder and decoder compute every frame and tip with [`SwingFrame::new`] and
+//! [`SwingFrame::tip`] from *decoded* positions only, in f64, with the arithmetic spelled out
+//! component by component (no glam kernels, no `mul_add`, no std `sin`/`cos`: the angle
+//! table comes from `libm` once per stream), so the two sides agree to the last bit on every
+//! platform. Seeds (three vertices per component) are quantized on the stream's cubic grid
+//! and the encoder continues from their dequantized positions.
+//!
+//! Geometry payload (the container's `geometry` section): one byte giving its kind, then
+//!
+//! * kind 0, swing: one range-coded stream walked in the Edgebreaker traversal order of the
+//!   decoded connectivity: at each component start the seed's three vertices as raw
+//!   `quant_bits`-bit grid coordinates, at each `C` triangle the tip's swing index as a
+//!   zigzagged `angle_bits`-bit value through a bit tree chosen by the parent triangle's own
+//!   swing index (`docs/swing.md`);
+//! * kind 1, explicit: the exact mode's position coder on the retiled mesh quantized to
+//!   `quant_bits` (used when the retiled mesh is open, or as the safety net when the
+//!   encoder's self-check fails).
+//!
+//! Not handled here: the retiling itself (whet-swing), open retiled meshes in the swing kind.
+
+use crate::exact::{code_positions, ResidualReader, ResidualWriter};
+use crate::{EncodeReport, Error, Quantizer};
+use whet_bits::{BitSink, BitTree, RangeDecoder, RangeEncoder};
+use whet_edgebreaker::{traverse, Clers, Connectivity, ConnectivityLimits, Step};
+use whet_format::{tag, Container, Header, Mode, SectionKind, Version};
+use whet_mesh::{Aabb, DVec3, ManifoldRepair, Mesh, VertexId};
+
+/// Fewest angle bits a stream may use.
+pub const MIN_ANGLE_BITS: u32 = 3;
+/// Most angle bits a stream may use (the bit tree of the index coder is `2^bits` models).
+pub const MAX_ANGLE_BITS: u32 = 14;
+
+/// Geometry payload kinds (first byte of the geometry section).
+const KIND_SWING: u8 = 0;
+const KIND_EXPLICIT: u8 = 1;
+
+// --- Exact arithmetic helpers --------------------------------------------------------------
+// Spelled out so that the evaluation order is fixed by this file, not by a library version.
+
+#[inline]
+fn sub(a: DVec3, b: DVec3) -> DVec3 {
+    DVec3::new(a.x - b.x, a.y - b.y, a.z - b.z)
+}
+
+#[inline]
+fn add(a: DVec3, b: DVec3) -> DVec3 {
+    DVec3::new(a.x + b.x, a.y + b.y, a.z + b.z)
+}
+
+#[inline]
+fn scale(a: DVec3, s: f64) -> DVec3 {
+    DVec3::new(a.x * s, a.y * s, a.z * s)
+}
+
+#[inline]
+fn dot(a: DVec3, b: DVec3) -> f64 {
+    a.x * b.x + a.y * b.y + a.z * b.z
+}
+
+#[inline]
+fn cross(a: DVec3, b: DVec3) -> DVec3 {
+    DVec3::new(
+        a.y * b.z - a.z * b.y,
+        a.z * b.x - a.x * b.z,
+        a.x * b.y - a.y * b.x,
+    )
+}
+
+/// Cosines and sines of the `2^bits` quantized swing angles `q · 2π / 2^bits`,
+/// `q ∈ [-2^(bits-1), 2^(bits-1))`, computed once per stream with `libm`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AngleTable {
+    bits: u32,
+    cos: Vec<f64>,
+    sin: Vec<f64>,
+}
+
+impl AngleTable {
+    /// The table for `bits` angle bits ([`MIN_ANGLE_BITS`]..=[`MAX_ANGLE_BITS`]).
+    pub fn new(bits: u32) -> Option<AngleTable> {
+        if !(MIN_ANGLE_BITS..=MAX_ANGLE_BITS).contains(&bits) {
+            return None;
+        }
+        let n = 1usize << bits;
+        let step = Self::step_of(bits);
+        let mut cos = Vec::with_capacity(n);
+        let mut sin = Vec::with_capacity(n);
+        for s in 0..n as u32 {
+            let q = Self::signed_of(bits, s);
+            let theta = q as f64 * step;
+            cos.push(libm::cos(theta));
+            sin.push(libm::sin(theta));
+        }
+        Some(AngleTable { bits, cos, sin })
+    }
+
+    #[inline]
+    fn step_of(bits: u32) -> f64 {
+        // 2π / 2^bits: a division by a power of two, exact.
+        2.0 * std::f64::consts::PI / (1u64 << bits) as f64
+    }
+
+    #[inline]
+    fn signed_of(bits: u32, symbol: u32) -> i32 {
+        let half = 1i32 << (bits - 1);
+        let s = (symbol & ((1u32 << bits) - 1)) as i32;
+        if s >= half {
+            s - (1 << bits)
+        } else {
+            s
+        }
+    }
+
+    /// Angle bits.
+    #[inline]
+    pub fn bits(&self) -> u32 {
+        self.bits
+    }
+
+    /// The quantization step `Δ = 2π / 2^bits`.
+    #[inline]
+    pub fn step(&self) -> f64 {
+        Self::step_of(self.bits)
+    }
+
+    /// Smallest swing index.
+    #[inline]
+    pub fn min_index(&self) -> i32 {
+        -(1 << (self.bits - 1))
+    }
+
+    /// Largest swing index.
+    #[inline]
+    pub fn max_index(&self) -> i32 {
+        (1 << (self.bits - 1)) - 1
+    }
+
+    /// The swing index nearest to angle `theta` (radians, wrapped into the index range).
+    pub fn quantize(&self, theta: f64) -> i32 {
+        let q = (theta / self.step()).round();
+        if !q.is_finite() {
+            return 0;
+        }
+        let n = 1i64 << self.bits;
+        let q = (q as i64).rem_euclid(n) as u32;
+        Self::signed_of(self.bits, q)
+    }
+
+    /// The angle of index `q`.
+    #[inline]
+    pub fn angle(&self, q: i32) -> f64 {
+        q as f64 * self.step()
+    }
+
+    /// `(cos, sin)` of index `q` (taken modulo `2^bits`).
+    #[inline]
+    pub fn cos_sin(&self, q: i32) -> (f64, f64) {
+        let s = (q as u32 & ((1u32 << self.bits) - 1)) as usize;
+        (self.cos[s], self.sin[s])
+    }
+}
+
+/// The circle on which a swing tip lies: centre `m` (the gate's midpoint), radius `r` and the
+/// frame `(e1, e2)` of its plane (`algorithms.md` 1.3).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SwingFrame {
+    /// The gate's midpoint.
+    pub center: DVec3,
+    /// Radius: every point of the circle is at distance `L` from both gate ends.
+    pub radius: f64,
+    /// Unit gate direction `a -> b` (the circle's axis).
+    pub axis: DVec3,
+    /// Unit vector in the parent's plane, perpendicular to the gate, away from the parent.
+    pub e1: DVec3,
+    /// `axis × e1`: the parent's outward normal.
+    pub e2: DVec3,
+}
+
+impl SwingFrame {
+    /// The frame for gate `a -> b` whose parent triangle `(b, a, c)` is already built, with
+    /// target edge length `edge_length`. `None` when the swing does not exist: the gate is
+    /// not shorter than `2 L` (up to a relative 1e-9), the gate has no length, or `c` lies on
+    /// the gate's line. Encoder and decoder both call this, so they agree on `None` too.
+    pub fn new(a: DVec3, b: DVec3, c: DVec3, edge_length: f64) -> Option<SwingFrame> {
+        let d = sub(b, a);
+        let g2 = dot(d, d);
+        if !(g2 > 0.0) || !g2.is_finite() {
+            return None;
+        }
+        let g = g2.sqrt();
+        let l2 = edge_length * edge_length;
+        let r2 = l2 - 0.25 * g2;
+        if !(r2 > l2 * 1e-9) || !r2.is_finite() {
+            return None;
+        }
+        let radius = r2.sqrt();
+        let u = scale(d, 1.0 / g);
+        let m = scale(add(a, b), 0.5);
+        let w = sub(m, c);
+        let w_perp = sub(w, scale(u, dot(w, u)));
+        let len2 = dot(w_perp, w_perp);
+        if !(len2 > g2 * 1e-18) || !len2.is_finite() {
+            return None;
+        }
+        let e1 = scale(w_perp, 1.0 / len2.sqrt());
+        let e2 = cross(u, e1);
+        Some(SwingFrame {
+            center: m,
+            radius,
+            axis: u,
+            e1,
+            e2,
+        })
+    }
+
+    /// The point of the circle at angle `(cos, sin)`.
+    #[inline]
+    pub fn point(&self, cos: f64, sin: f64) -> DVec3 {
+        let rc = self.radius * cos;
+        let rs = self.radius * sin;
+        add(self.center, add(scale(self.e1, rc), scale(self.e2, rs)))
+    }
+
+    /// The tip of swing index `q`: the reconstruction both sides use.
+    #[inline]
+    pub fn tip(&self, table: &AngleTable, q: i32) -> DVec3 {
+        let (c, s) = table.cos_sin(q);
+        self.point(c, s)
+    }
+
+    /// The swing angle of point `p` (projected on the circle's plane), in `(-π, π]`.
+    /// Encoder-side helper: not part of the bit-exact reconstruction.
+    pub fn angle_of(&self, p: DVec3) -> f64 {
+        let d = p - self.center;
+        d.dot(self.e2).atan2(d.dot(self.e1))
+    }
+}
+
+/// The parameters of a swing stream that are not in the connectivity.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SwingParams {
+    /// Target edge length `L` (absolute units).
+    pub edge_length: f64,
+    /// The quantized angles.
+    pub angles: AngleTable,
+    /// The grid the seeds are quantized on.
+    pub quantizer: Quantizer,
+    /// The box the grid was made from (written to the header, so the decoder rebuilds the
+    /// very same grid).
+    pub bbox: Aabb,
+}
+
+impl SwingParams {
+    /// Parameters for edge length `edge_length`, `angle_bits` angle bits and seed positions
+    /// quantized to `quant_bits` bits in `bbox`.
+    pub fn new(
+        edge_length: f64,
+        angle_bits: u32,
+        bbox: &Aabb,
+        quant_bits: u32,
+    ) -> Result<SwingParams, Error> {
+        if !(edge_length > 0.0 && edge_length.is_finite()) {
+            return Err(Error::Parameter(format!(
+                "the swing edge length must be positive and finite, got {edge_length}"
+            )));
+        }
+        if bbox.is_empty() || !bbox.min.is_finite() || !bbox.max.is_finite() {
+            return Err(Error::Parameter(
+                "the swing mode needs a non-empty, finite bounding box".into(),
+            ));
+        }
+        if !(1..=30).contains(&quant_bits) {
+            return Err(Error::Parameter(format!(
+                "seed quantization bits must be 1..=30, got {quant_bits}"
+            )));
+        }
+        let angles = AngleTable::new(angle_bits).ok_or_else(|| {
+            Error::Parameter(format!(
+                "angle bits must be {MIN_ANGLE_BITS}..={MAX_ANGLE_BITS}, got {angle_bits}"
+            ))
+        })?;
+        Ok(SwingParams {
+            edge_length,
+            angles,
+            quantizer: Quantizer::new(bbox, quant_bits),
+            bbox: *bbox,
+        })
+    }
+
+    /// The grid point nearest to `p` and its dequantized position: where a seed vertex at
+    /// `p` really goes.
+    pub fn snap_seed(&self, p: DVec3) -> ([i32; 3], DVec3) {
+        let g = self.quantizer.quantize(p);
+        (g, self.quantizer.dequantize(g))
+    }
+
+    /// The frame of gate `a -> b` with parent vertex `c` at this stream's edge length.
+    #[inline]
+    pub fn frame(&self, a: DVec3, b: DVec3, c: DVec3) -> Option<SwingFrame> {
+        SwingFrame::new(a, b, c, self.edge_length)
+    }
+}
+
+/// How a vertex of a retiled mesh is coded.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VertexSource {
+    /// One of the three vertices of a component's seed triangle, at this grid point.
+    Seed([i32; 3]),
+    /// Created by a `C` triangle with this swing index.
+    Swing(i32),
+}
+
+/// A retiled mesh as the retiler built it: triangles in creation (= traversal) order, each
+/// `[tip, a, b]` (the seed `[x0, x1, x2]`), vertices in creation order.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RetiledMesh {
+    /// Positions: seeds dequantized, tips reconstructed with [`SwingFrame::tip`].
+    pub positions: Vec<DVec3>,
+    /// Triangles.
+    pub triangles: Vec<[u32; 3]>,
+    /// How each vertex is coded.
+    pub sources: Vec<VertexSource>,
+    /// The retiler's label for each non-seed triangle, in order.
+    pub labels: Vec<Clers>,
+    /// Connected components (seeds).
+    pub components: usize,
+    /// True when the retiler left boundary edges (open `M'`).
+    pub open: bool,
+}
+
+/// How the geometry of a swing stream was coded.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum SwingGeometry {
+    /// One swing index per vertex (the normal case).
+    Swing,
+    /// Explicit quantized positions, for the reason given.
+    Explicit(String),
+}
+
+/// A swing stream, its report and the mesh the decoder will output.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SwingEncoded {
+    /// The `.whet` bytes.
+    pub bytes: Vec<u8>,
+    /// Sizes and counts (of the retiled mesh).
+    pub report: EncodeReport,
+    /// Exactly what `decode(bytes)` returns.
+    pub decoded: Mesh,
+    /// How the geometry was coded.
+    pub geometry: SwingGeometry,
+}
+
+// --- Swing index models --------------------------------------------------------------------
+
+/// Contexts: the parent triangle was not created by a `C` (no index known), or the bucket
+/// of its own zigzagged index.
+const PARENT_BUCKETS: usize = 8;
+const CONTEXTS: usize = 1 + PARENT_BUCKETS;
+/// Marks a triangle without a swing index.
+const NO_INDEX: i16 = i16::MIN;
+
+struct SwingModels {
+    trees: Vec<BitTree>,
+}
+
+impl SwingModels {
+    fn new(bits: u32) -> Self {
+        SwingModels {
+            trees: (0..CONTEXTS).map(|_| BitTree::new(bits)).collect(),
+        }
+    }
+}
+
+#[inline]
+fn zigzag(q: i32) -> u32 {
+    ((q << 1) ^ (q >> 31)) as u32
+}
+
+#[inline]
+fn unzigzag(z: u32) -> i32 {
+    ((z >> 1) as i32) ^ -((z & 1) as i32)
+}
+
+#[inline]
+fn context(parent_index: i16) -> usize {
+    if parent_index == NO_INDEX {
+        0
+    } else {
+        let z = zigzag(parent_index as i32);
+        1 + ((32 - z.leading_zeros()) as usize).min(PARENT_BUCKETS - 1)
+    }
+}
+
+/// Reads or writes the values of the swing walk.
+trait SwingIo {
+    /// The grid coordinates of seed vertex `v`.
+    fn seed(&mut self, v: VertexId, bits: u32, grid: &mut [i32; 3]);
+    /// The swing index of the tip `v`.
+    fn index(&mut self, v: VertexId, tree: &mut BitTree, q: &mut i32) -> Result<(), Error>;
+}
+
+struct SwingWriter<'a> {
+    sink: &'a mut RangeEncoder,
+    sources: &'a [VertexSource],
+    /// Set when a seed vertex has no grid point (a retiler bug).
+    bad_seed: bool,
+}
+
+impl SwingIo for SwingWriter<'_> {
+    fn seed(&mut self, v: VertexId, bits: u32, grid: &mut [i32; 3]) {
+        match self.sources.get(v.index()) {
+            Some(&VertexSource::Seed(g)) => *grid = g,
+            _ => self.bad_seed = true,
+        }
+        for &c in grid.iter() {
+            self.sink.encode_direct(c as u32, bits);
+        }
+    }
+    fn index(&mut self, v: VertexId, tree: &mut BitTree, q: &mut i32) -> Result<(), Error> {
+        match self.sources.get(v.index()) {
+            Some(&VertexSource::Swing(i)) => {
+                *q = i;
+                BitSink::encode_tree(self.sink, tree, zigzag(i));
+                Ok(())
+            }
+            _ => Err(Error::Corrupt(format!(
+                "retiled vertex {} is created by a C triangle but has no swing index",
+                v.0
+            ))),
+        }
+    }
+}
+
+struct SwingReader<'a, 'b> {
+    dec: &'a mut RangeDecoder<'b>,
+    max_level: i32,
+}
+
+impl SwingIo for SwingReader<'_, '_> {
+    fn seed(&mut self, _v: VertexId, bits: u32, grid: &mut [i32; 3]) {
+        for c in grid.iter_mut() {
+            *c = (self.dec.decode_direct(bits) as i32).min(self.max_level);
+        }
+    }
+    fn index(&mut self, _v: VertexId, tree: &mut BitTree, q: &mut i32) -> Result<(), Error> {
+        *q = unzigzag(self.dec.decode_tree(tree));
+        Ok(())
+    }
+}
+
+/// Walks `conn` in traversal order, reconstructing every vertex through `io` into
+/// `positions` (indexed by table vertex) and listing the triangles in output order (table
+/// vertex ids, `[tip, n(tip), p(tip)]`). The same code runs in the encoder and the decoder.
+fn walk<I: SwingIo>(
+    conn: &Connectivity,
+    params: &SwingParams,
+    io: &mut I,
+    positions: &mut [DVec3],
+    triangles: &mut Vec<[u32; 3]>,
+) -> Result<(), Error> {
+    let table = &conn.table;
+    let bits = params.quantizer.bits;
+    let mut models = SwingModels::new(params.angles.bits());
+    let mut tri_index = vec![NO_INDEX; table.triangle_count()];
+    let mut failure: Option<Error> = None;
+    triangles.clear();
+    triangles.reserve(table.triangle_count());
+    traverse(table, Some(&conn.starts), |step| {
+        if failure.is_some() {
+            return;
+        }
+        match step {
+            Step::Start { corner } => {
+                let cs = [corner, table.next(corner), table.prev(corner)];
+                let vs = cs.map(|c| table.vertex(c));
+                for v in vs {
+                    let mut g = [0i32; 3];
+                    io.seed(v, bits, &mut g);
+                    positions[v.index()] = params.quantizer.dequantize(g);
+                }
+                triangles.push(vs.map(|v| v.0));
+            }
+            Step::Triangle { tip, label, .. } => {
+                let a = table.vertex(table.next(tip));
+                let b = table.vertex(table.prev(tip));
+                let v = table.vertex(tip);
+                if label == Clers::C {
+                    // The traversal only runs on closed tables: the opposite exists.
+                    let o = table.opposite(tip).unwrap_or(tip);
+                    let c = table.vertex(o);
+                    let parent_index = tri_index[o.face().index()];
+                    let frame = params.frame(
+                        positions[a.index()],
+                        positions[b.index()],
+                        positions[c.index()],
+                    );
+                    let Some(frame) = frame else {
+                        failure = Some(Error::Corrupt(
+                            "a swing gate is degenerate (longer than 2L or flat)".into(),
+                        ));
+                        return;
+                    };
+                    let mut q = 0i32;
+                    if let Err(e) = io.index(v, &mut models.trees[context(parent_index)], &mut q) {
+                        failure = Some(e);
+                        return;
+                    }
+                    tri_index[tip.face().index()] = q as i16;
+                    positions[v.index()] = frame.tip(&params.angles, q);
+                }
+                triangles.push([v.0, a.0, b.0]);
+            }
+        }
+    })
+    .map_err(whet_edgebreaker::Error::from)?;
+    match failure {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
+}
+
+/// The output mesh of a connectivity whose table vertices sit at `positions`: vertices in
+/// traversal order, triangles in traversal order as `[tip, n(tip), p(tip)]`, dummy fans left
+/// out. Encoder and decoder both build their result with it.
+fn output_mesh(conn: &Connectivity, positions: &[DVec3], triangles: &[[u32; 3]]) -> Mesh {
+    let rank = conn.output_rank();
+    let order = conn.output_vertices();
+    let out_positions: Vec<DVec3> = order.iter().map(|v| positions[v.index()]).collect();
+    let mut out_tris = Vec::with_capacity(triangles.len());
+    for t in triangles {
+        if t.iter().any(|&v| conn.is_dummy[v as usize]) {
+            continue;
+        }
+        out_tris.push(t.map(|v| rank[v as usize]));
+    }
+    Mesh::new(out_positions, out_tris)
+}
+
+/// Triangles of `conn` in traversal order (`[tip, n, p]`, table ids), dummies included.
+fn traversal_triangles(conn: &Connectivity) -> Result<Vec<[u32; 3]>, Error> {
+    let table = &conn.table;
+    let mut tris = Vec::with_capacity(table.triangle_count());
+    traverse(table, Some(&conn.starts), |step| {
+        let c = match step {
+            Step::Start { corner } => corner,
+            Step::Triangle { tip, .. } => tip,
+        };
+        tris.push([
+            table.vertex(c).0,
+            table.vertex(table.next(c)).0,
+            table.vertex(table.prev(c)).0,
+        ]);
+    })
+    .map_err(whet_edgebreaker::Error::from)?;
+    Ok(tris)
+}
+
+/// Everything the writer needs besides the retiled mesh.
+#[derive(Clone, Copy, Debug)]
+pub struct SwingStreamInfo<'a> {
+    /// Container version to write.
+    pub version: Version,
+    /// What manifold repair changed in the original.
+    pub repair: &'a ManifoldRepair,
+    /// Unused vertices of the original left out.
+    pub dropped_unused_vertices: usize,
+}
+
+/// Writes the swing stream of a retiled mesh, after checking that Edgebreaker reproduces the
+/// retiler's labels and vertex order and that the shared reconstruction reproduces every
+/// position bit for bit. When a check fails (a retiler bug: this panics in debug builds) or
+/// the retiled mesh is open, the geometry is coded explicitly instead
+/// ([`SwingGeometry::Explicit`]) and the stream is still valid.
+pub fn encode_retiled(
+    retiled: &RetiledMesh,
+    params: &SwingParams,
+    info: &SwingStreamInfo<'_>,
+) -> Result<SwingEncoded, Error> {
+    let nv = retiled.positions.len();
+    let enc = whet_edgebreaker::encode_connectivity(&retiled.triangles, nv)?;
+    let clers_histogram = enc.histogram();
+    let conn = &enc.connectivity;
+
+    let mut geometry_kind = SwingGeometry::Swing;
+    if retiled.open || conn.is_dummy.iter().any(|&d| d) {
+        geometry_kind = SwingGeometry::Explicit("the retiled mesh is open".into());
+    } else if conn.summary.labels != retiled.labels {
+        geometry_kind =
+            SwingGeometry::Explicit("Edgebreaker does not reproduce the retiler's labels".into());
+    } else if conn
+        .summary
+        .vertex_order
+        .iter()
+        .enumerate()
+        .any(|(i, v)| v.index() != i)
+    {
+        geometry_kind = SwingGeometry::Explicit(
+            "Edgebreaker does not reproduce the retiler's vertex order".into(),
+        );
+    }
+
+    let mut geometry = Vec::new();
+    let mut decoded = None;
+    if geometry_kind == SwingGeometry::Swing {
+        let mut range = RangeEncoder::new();
+        let mut positions = vec![DVec3::ZERO; nv];
+        let mut tris = Vec::new();
+        let mut io = SwingWriter {
+            sink: &mut range,
+            sources: &retiled.sources,
+            bad_seed: false,
+        };
+        let walked = walk(conn, params, &mut io, &mut positions, &mut tris);
+        let exact = walked.is_ok()
+            && !io.bad_seed
+            && positions
+                .iter()
+                .zip(&retiled.positions)
+                .all(|(p, r)| p.to_array().map(f64::to_bits) == r.to_array().map(f64::to_bits));
+        if exact {
+            geometry.push(KIND_SWING);
+            geometry.extend_from_slice(&range.finish());
+            decoded = Some(output_mesh(conn, &positions, &tris));
+        } else {
+            geometry_kind = SwingGeometry::Explicit(match walked {
+                Err(e) => format!("the swing walk failed: {e}"),
+                Ok(()) => {
+                    "the shared reconstruction does not reproduce the retiler's positions".into()
+                }
+            });
+        }
+    }
+    if let SwingGeometry::Explicit(reason) = &geometry_kind {
+        debug_assert!(
+            retiled.open,
+            "swing self-check failed on a closed retiled mesh: {reason}"
+        );
+        let (bytes, positions) = encode_explicit(conn, &retiled.positions, &params.quantizer)?;
+        geometry.push(KIND_EXPLICIT);
+        geometry.extend_from_slice(&bytes);
+        let tris = traversal_triangles(conn)?;
+        decoded = Some(output_mesh(conn, &positions, &tris));
+    }
+    let decoded = decoded.unwrap_or_default();
+
+    let (min, max) = (params.bbox.min.to_array(), params.bbox.max.to_array());
+    let mut header = Header::new(
+        Mode::Swing,
+        decoded.positions.len() as u64,
+        decoded.triangles.len() as u64,
+    )
+    .with_version(info.version)
+    .with(tag::COMPONENT_COUNT, conn.starts.len() as u64)
+    .with(tag::QUANT_BITS, params.quantizer.bits as u64)
+    .with(tag::EDGE_LENGTH, params.edge_length)
+    .with(tag::ANGLE_BITS, params.angles.bits() as u64);
+    header.set_bbox(min, max);
+    let connectivity_bits = enc.bytes.len() as u64 * 8;
+    let geometry_bits = geometry.len() as u64 * 8;
+    let container = Container::new(header)
+        .with_section(SectionKind::CONNECTIVITY, enc.bytes)
+        .with_section(SectionKind::GEOMETRY, geometry);
+    let bytes = container.to_bytes()?;
+    let report = EncodeReport {
+        bytes: bytes.len(),
+        vertices: decoded.positions.len(),
+        triangles: decoded.triangles.len(),
+        connectivity_bits,
+        geometry_bits,
+        components: conn.starts.len(),
+        clers_histogram,
+        vertex_order: Vec::new(),
+        repair: *info.repair,
+        dropped_unused_vertices: info.dropped_unused_vertices,
+    };
+    Ok(SwingEncoded {
+        bytes,
+        report,
+        decoded,
+        geometry: geometry_kind,
+    })
+}
+
+/// The explicit geometry: positions quantized on `quantizer`, coded by the exact mode's
+/// position coder. Returns the payload (without the kind byte) and the dequantized positions
+/// by table vertex.
+fn encode_explicit(
+    conn: &Connectivity,
+    positions: &[DVec3],
+    quantizer: &Quantizer,
+) -> Result<(Vec<u8>, Vec<DVec3>), Error> {
+    let nv = conn.table.vertex_count();
+    let mut q = vec![[0i32; 3]; nv];
+    for (i, p) in positions.iter().enumerate().take(nv) {
+        q[i] = quantizer.quantize(*p);
+    }
+    let mut range = RangeEncoder::new();
+    let mut io = ResidualWriter {
+        sink: &mut range,
+        constrained: false,
+        budget: usize::MAX,
+    };
+    code_positions(conn, quantizer.bits, &mut q, &mut io).map_err(whet_edgebreaker::Error::from)?;
+    let out = q.iter().map(|&g| quantizer.dequantize(g)).collect();
+    Ok((range.finish(), out))
+}
+
+/// Decodes a swing container (called by [`crate::decode_container`]).
+pub(crate) fn decode_swing(container: &Container) -> Result<Mesh, Error> {
+    let h = &container.header;
+    let edge_length = h
+        .get_f64(tag::EDGE_LENGTH)
+        .ok_or(Error::MissingField("edge_length"))?;
+    let angle_bits = h
+        .get_u64(tag::ANGLE_BITS)
+        .ok_or(Error::MissingField("angle_bits"))?;
+    let quant_bits = h
+        .get_u64(tag::QUANT_BITS)
+        .ok_or(Error::MissingField("quant_bits"))?;
+    let components = h
+        .get_u64(tag::COMPONENT_COUNT)
+        .ok_or(Error::MissingField("component_count"))?;
+    let (min, max) = h.bbox().ok_or(Error::MissingField("bbox"))?;
+    let bbox = Aabb {
+        min: DVec3::from_array(min),
+        max: DVec3::from_array(max),
+    };
+    if !bbox.min.is_finite() || !bbox.max.is_finite() {
+        return Err(Error::Corrupt("bounding box is not finite".into()));
+    }
+    if !(MIN_ANGLE_BITS as u64..=MAX_ANGLE_BITS as u64).contains(&angle_bits) {
+        return Err(Error::Corrupt(format!(
+            "angle bits {angle_bits} out of range"
+        )));
+    }
+    if !(1..=30).contains(&quant_bits) {
+        return Err(Error::Corrupt(format!(
+            "quantization bits {quant_bits} out of range"
+        )));
+    }
+    if !(edge_length > 0.0 && edge_length.is_finite()) {
+        return Err(Error::Corrupt(format!(
+            "edge length {edge_length} is not positive and finite"
+        )));
+    }
+    let params = SwingParams::new(edge_length, angle_bits as u32, &bbox, quant_bits as u32)?;
+    let conn_bytes = container
+        .section(SectionKind::CONNECTIVITY)
+        .ok_or(Error::MissingSection("connectivity"))?;
+    let geom = container
+        .section(SectionKind::GEOMETRY)
+        .ok_or(Error::MissingSection("geometry"))?;
+    // Dummy fans add at most one triangle per real one.
+    let limits = ConnectivityLimits::DEFAULT
+        .with_max_triangles(h.triangle_count.saturating_mul(2).saturating_add(64));
+    let (conn, used) = whet_edgebreaker::decode_connectivity(conn_bytes, &limits)?;
+    if used != conn_bytes.len() {
+        return Err(Error::Corrupt(
+            "connectivity section has trailing bytes".into(),
+        ));
+    }
+    if conn.starts.len() as u64 != components {
+        return Err(Error::Corrupt(format!(
+            "the header announces {components} components, the connectivity has {}",
+            conn.starts.len()
+        )));
+    }
+    let (&kind, payload) = geom.split_first().ok_or(Error::Truncated("geometry"))?;
+    let nv = conn.table.vertex_count();
+    let mut dec = RangeDecoder::new(payload).map_err(|_| Error::Truncated("geometry"))?;
+    match kind {
+        KIND_SWING => {
+            if conn.is_dummy.iter().any(|&d| d) {
+                return Err(Error::Corrupt(
+                    "swing geometry on an open connectivity".into(),
+                ));
+            }
+            let mut positions = vec![DVec3::ZERO; nv];
+            let mut tris = Vec::new();
+            let mut io = SwingReader {
+                dec: &mut dec,
+                max_level: params.quantizer.max_level(),
+            };
+            walk(&conn, &params, &mut io, &mut positions, &mut tris)?;
+            if dec.finish().is_err() {
+                return Err(Error::Truncated("geometry"));
+            }
+            if positions.iter().any(|p| !p.is_finite()) {
+                return Err(Error::Corrupt("a decoded position is not finite".into()));
+            }
+            Ok(output_mesh(&conn, &positions, &tris))
+        }
+        KIND_EXPLICIT => {
+            let mut q = vec![[0i32; 3]; nv];
+            let mut io = ResidualReader {
+                dec: &mut dec,
+                constrained: false,
+                max_level: params.quantizer.max_level(),
+                invalid: false,
+            };
+            let known = code_positions(&conn, quant_bits as u32, &mut q, &mut io)
+                .map_err(whet_edgebreaker::Error::from)?;
+            if dec.finish().is_err() {
+                return Err(Error::Truncated("geometry"));
+            }
+            let max = params.quantizer.max_level();
+            for v in conn.output_vertices() {
+                let g = q[v.index()];
+                if !known[v.index()] || g.iter().any(|&c| c < 0 || c > max) {
+                    return Err(Error::Corrupt(
+                        "a decoded position falls outside the quantization grid".into(),
+                    ));
+                }
+            }
+            let positions: Vec<DVec3> = q.iter().map(|&g| params.quantizer.dequantize(g)).collect();
+            let tris = traversal_triangles(&conn)?;
+            Ok(output_mesh(&conn, &positions, &tris))
+        }
+        other => Err(Error::Corrupt(format!(
+            "unknown swing geometry kind {other}"
+        ))),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn zigzag_round_trips() {
+        for q in -2048..2048 {
+            assert_eq!(unzigzag(zigzag(q)), q);
+        }
+        assert_eq!(zigzag(0), 0);
+        assert_eq!(zigzag(-1), 1);
+        assert_eq!(zigzag(1), 2);
+        // The index range of B bits maps onto [0, 2^B).
+        for bits in MIN_ANGLE_BITS..=MAX_ANGLE_BITS {
+            let t = AngleTable::new(bits).unwrap();
+            assert!(zigzag(t.min_index()) < 1 << bits);
+            assert!(zigzag(t.max_index()) < 1 << bits);
+        }
+    }
+
+    #[test]
+    fn angle_table_is_symmetric_and_quantizes() {
+        let t = AngleTable::new(8).unwrap();
+        assert_eq!(t.cos_sin(0), (1.0, 0.0));
+        assert_eq!(t.quantize(0.0), 0);
+        assert_eq!(t.quantize(t.step() * 3.4), 3);
+        assert_eq!(t.quantize(-t.step() * 3.6), -4);
+        // Angles past the range wrap (the index is an angle modulo 2π).
+        assert_eq!(t.quantize(std::f64::consts::PI), -128);
+        let (c, s) = t.cos_sin(64);
+        assert!(c.abs() < 1e-15 && (s - 1.0).abs() < 1e-15);
+        assert!(AngleTable::new(2).is_none() && AngleTable::new(15).is_none());
+    }
+
+    #[test]
+    fn frame_tip_is_at_distance_l_from_the_gate() {
+        let a = DVec3::new(0.0, 0.0, 0.0);
+        let b = DVec3::new(1.0, 0.0, 0.0);
+        let c = DVec3::new(0.5, -0.8, 0.0);
+        let f = SwingFrame::new(a, b, c, 1.0).unwrap();
+        // e1 points away from the parent, e2 along the parent's outward normal (b, a, c).
+        assert!((f.e1 - DVec3::Y).length() < 1e-15);
+        assert!((f.e2 - DVec3::Z).length() < 1e-15);
+        let t = AngleTable::new(7).unwrap();
+        for q in t.min_index()..=t.max_index() {
+            let p = f.tip(&t, q);
+            assert!(((p - a).length() - 1.0).abs() < 1e-12);
+            assert!(((p - b).length() - 1.0).abs() < 1e-12);
+            let back = t.quantize(f.angle_of(p));
+            assert_eq!(back, q);
+        }
+        // No swing for gates of length 2L or more, or a parent on the gate's line.
+        assert!(SwingFrame::new(a, DVec3::new(2.0, 0.0, 0.0), c, 1.0).is_none());
+        assert!(SwingFrame::new(a, b, DVec3::new(3.0, 0.0, 0.0), 1.0).is_none());
+    }
+}

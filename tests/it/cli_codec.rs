@@ -1,0 +1,98 @@
+//! `whet encode` / `whet decode`: the JSON contract, round trips and bad streams.
+
+use crate::{s, whet, whet_json};
+use whet_testkit::{scratch_dir, shared_fixture};
+
+#[test]
+fn encode_json_contract_and_round_trip() {
+    let dir = scratch_dir("cli-codec");
+    let src = shared_fixture("fandisk.off");
+    let stream = dir.join("fandisk.whet");
+    let j = whet_json(&[
+        "encode",
+        s(&src),
+        "-o",
+        s(&stream),
+        "--mode",
+        "exact",
+        "--quant-bits",
+        "11",
+        "--json",
+    ]);
+    for key in [
+        "bytes",
+        "triangles",
+        "vertices",
+        "connectivity_bits",
+        "geometry_bits",
+        "bits_per_vertex",
+        "bits_per_triangle",
+    ] {
+        assert!(j[key].is_number(), "missing {key}: {j}");
+    }
+    assert_eq!(j["triangles"], 12946);
+    assert_eq!(j["vertices"], 6475);
+    let bytes = std::fs::metadata(&stream).unwrap().len();
+    assert_eq!(j["bytes"], bytes);
+    // Draco needs 8537 bytes at q = 11, level 10 (../shared/anchors/draco.md).
+    assert!(bytes < 8537, "{bytes}");
+    let out = dir.join("fandisk.decoded.ply");
+    let o = whet(&["decode", s(&stream), "-o", s(&out)]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let info = whet_json(&["info", s(&out), "--json"]);
+    assert_eq!(info["triangles"], 12946);
+    assert_eq!(info["manifold"], true);
+    assert_eq!(info["genus"], 0);
+}
+
+#[test]
+fn bad_streams_exit_2() {
+    let dir = scratch_dir("cli-codec-bad");
+    let src = shared_fixture("partLp.off");
+    let stream = dir.join("p.whet");
+    let o = whet(&["encode", s(&src), "-o", s(&stream)]);
+    assert!(o.status.success());
+    let good = std::fs::read(&stream).unwrap();
+    let cases: Vec<(&str, Vec<u8>)> = vec![
+        ("truncated", good[..good.len() / 2].to_vec()),
+        ("garbage", b"this is not a whet stream at all".to_vec()),
+        ("flipped", {
+            let mut b = good.clone();
+            let i = b.len() / 3;
+            b[i] ^= 4;
+            b
+        }),
+        ("version", {
+            let mut b = good.clone();
+            b[4] = 9;
+            b
+        }),
+        ("empty", Vec::new()),
+    ];
+    for (name, bytes) in cases {
+        let p = dir.join(format!("{name}.whet"));
+        std::fs::write(&p, &bytes).unwrap();
+        let o = whet(&["decode", s(&p), "-o", s(&dir.join("out.obj"))]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{name}: {err}");
+        assert!(!err.contains("panicked"), "{name}: {err}");
+        assert!(err.contains("cannot decode"), "{name}: {err}");
+    }
+}
+
+#[test]
+fn non_manifold_input_is_cut_and_reported() {
+    let dir = scratch_dir("cli-codec-nm");
+    let p = dir.join("fin.off");
+    std::fs::write(
+        &p,
+        "OFF\n5 3 0\n0 0 0\n1 0 0\n0 1 0\n0 -1 0\n0 0 1\n3 0 1 2\n3 1 0 3\n3 0 1 4\n",
+    )
+    .unwrap();
+    let stream = dir.join("fin.whet");
+    let o = whet(&["encode", s(&p), "-o", s(&stream), "--json"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(j["repair"]["cut_edges"], 1);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("make_manifold"));
+}
