@@ -252,7 +252,7 @@ impl UnsignedIntModel {
     /// Modelled mantissa bits below the leading one.
     const MODELLED: u32 = 2;
 
-    /// A fresh model.
+    /// A fresh model for any `u32`.
     pub fn new() -> Self {
         UnsignedIntModel {
             length: BitTree::new(6),
@@ -260,8 +260,23 @@ impl UnsignedIntModel {
         }
     }
 
+    /// A fresh model for values below `2^31` only: the bit length then fits a 5-level tree,
+    /// one binary decision fewer per value. Larger values are coded as `2^31 - 1`; callers
+    /// guarantee they never occur (e.g. residuals of clamped predictions).
+    pub fn below_2_31() -> Self {
+        UnsignedIntModel {
+            length: BitTree::new(5),
+            mantissa: vec![[BitModel::new(); 3]; 33],
+        }
+    }
+
     /// Codes `v`.
     pub fn encode<S: BitSink>(&mut self, sink: &mut S, v: u32) {
+        let v = if self.length.bits() < 6 {
+            v.min((1 << 31) - 1)
+        } else {
+            v
+        };
         let len = 32 - v.leading_zeros();
         sink.encode_tree(&mut self.length, len);
         if len > 1 {
@@ -334,9 +349,17 @@ pub struct SignedIntModel {
 }
 
 impl SignedIntModel {
-    /// A fresh model.
+    /// A fresh model for any `i32`.
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// A fresh model for magnitudes below `2^31` (see [`UnsignedIntModel::below_2_31`]).
+    pub fn below_2_31() -> Self {
+        SignedIntModel {
+            magnitude: UnsignedIntModel::below_2_31(),
+            sign: BitModel::new(),
+        }
     }
 
     /// Codes `v`.

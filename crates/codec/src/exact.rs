@@ -32,10 +32,11 @@ pub(crate) struct PositionModels {
 impl PositionModels {
     pub(crate) fn new() -> Self {
         PositionModels {
+            // Predictions are clamped into the grid, so residuals stay below 2^30.
             residual: (0..CLASSES * 3 * PREV_BUCKETS)
-                .map(|_| SignedIntModel::new())
+                .map(|_| SignedIntModel::below_2_31())
                 .collect(),
-            seed: Default::default(),
+            seed: [(); 3].map(|_| SignedIntModel::below_2_31()),
             use_all: [BitModel::new(); MAX_CANDIDATES],
             selection: [[BitModel::new(); MAX_CANDIDATES]; MAX_CANDIDATES],
         }
@@ -252,6 +253,7 @@ pub(crate) fn code_positions<I: ResidualIo>(
 ) -> Result<Vec<bool>, TraversalError> {
     let table = &conn.table;
     let nv = table.vertex_count();
+    let max_level = ((1u64 << bits.clamp(1, 30)) - 1) as i32;
     let mut known = vec![false; nv];
     let mut degree = vec![0u8; nv];
     let mut buckets: [Vec<u32>; MAX_DEGREE + 1] = Default::default();
@@ -370,6 +372,9 @@ pub(crate) fn code_positions<I: ResidualIo>(
                 let mask = io.select(&mut models, &cands[..k], &value);
                 (class_of(mask), average(&cands[..k], mask))
             };
+            // A prediction off the grid is never better than the nearest grid point, and
+            // clamping keeps residuals below 2^30.
+            let prediction = prediction.map(|c| c.clamp(0, max_level));
             io.residual(&mut models, Some(class), prediction, &mut value);
             q[v] = value;
             known[v] = true;

@@ -395,7 +395,9 @@ pub fn decode_connectivity(
     let v = std::mem::take(&mut rev.v);
     let o = std::mem::take(&mut rev.o);
     drop(rev);
-    let table = CornerTable::from_raw(v, o, vertex_ids)
+    // The reverse decoder builds fans by construction; walks over the table stay bounded
+    // even if a corrupt stream produced a split fan, so the fan check is skipped.
+    let table = CornerTable::from_raw(v, o, vertex_ids, false)
         .map_err(|_| Error::Corrupt("the decoded mesh is not a manifold"))?;
     let starts: Vec<CornerId> = starts.into_iter().map(CornerId).collect();
     let summary = traverse(&table, Some(&starts), |_| {})?;

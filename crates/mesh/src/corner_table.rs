@@ -161,12 +161,16 @@ impl CornerTable {
     }
 
     /// Builds the table from corner vertices and opposites that are already paired (a
-    /// decoder that rebuilt them itself), checking that they are consistent: opposites are
-    /// mutual and face the same edge reversed, and every vertex has a single fan.
+    /// decoder that rebuilt them itself), checking that they are consistent: indices in
+    /// range, no repeated vertex in a triangle, opposites mutual and facing the same edge
+    /// reversed. With `check_fans` it also checks that every vertex has a single fan (a walk
+    /// around every vertex: the costliest check, which a decoder whose construction cannot
+    /// split fans may skip; every table walk stays bounded either way).
     pub fn from_raw(
         corner_vertex: Vec<u32>,
         opposite: Vec<u32>,
         vertex_count: usize,
+        check_fans: bool,
     ) -> Result<CornerTable, MeshError> {
         let nc = corner_vertex.len();
         if nc % 3 != 0 || opposite.len() != nc {
@@ -220,6 +224,20 @@ impl CornerTable {
                     vertex: if a == b || a == c { a } else { b },
                 });
             }
+        }
+        if !check_fans {
+            let mut vertex_corner = vec![NONE; vertex_count];
+            for (c, &v) in corner_vertex.iter().enumerate() {
+                let slot = &mut vertex_corner[v as usize];
+                if *slot == NONE || opposite[prev_raw(c)] == NONE {
+                    *slot = c as u32;
+                }
+            }
+            return Ok(CornerTable {
+                corner_vertex,
+                opposite,
+                vertex_corner,
+            });
         }
         CornerTable::from_parts(corner_vertex, opposite, vertex_count)
     }
