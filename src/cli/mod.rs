@@ -3,9 +3,11 @@
 
 mod convert;
 mod decode;
+mod demo;
 mod encode;
 mod info;
 mod metro;
+mod rd;
 mod synth;
 
 use clap::{Parser, Subcommand};
@@ -34,6 +36,10 @@ enum Command {
     Metro(metro::MetroArgs),
     /// Ground-truth shapes and their marching-cubes samplings.
     Synth(synth::SynthArgs),
+    /// Rate-distortion sweep: encode, decode, post-process and measure at several rates.
+    Rd(rd::RdArgs),
+    /// The main job on a mesh whet generates: a rate-distortion sweep of the synthetic fandisk.
+    Demo(demo::DemoArgs),
 }
 
 /// A failed command: the error to print and the exit code.
@@ -72,6 +78,8 @@ pub fn run(cli: Cli) -> CliResult {
         Command::Decode(a) => decode::run(&a),
         Command::Metro(a) => metro::run(&a),
         Command::Synth(a) => synth::run(&a),
+        Command::Rd(a) => rd::run(&a),
+        Command::Demo(a) => demo::run(&a),
     }
 }
 

@@ -6,6 +6,7 @@ mod cli_codec;
 mod cli_convert;
 mod cli_info;
 mod cli_metro;
+mod cli_rd;
 mod fixtures;
 mod fuzz_replay;
 

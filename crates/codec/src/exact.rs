@@ -344,20 +344,21 @@ pub(crate) fn code_positions<I: ResidualIo>(
                 raise(vi, &known, &mut degree, &mut anchor, &mut buckets);
             }
         }
-        loop {
-            let Some(v) = (0..=MAX_DEGREE).rev().find_map(|d| {
-                while let Some(&x) = buckets[d].last() {
-                    let x = x as usize;
-                    if known[x] || (degree[x] as usize).min(MAX_DEGREE) != d {
-                        buckets[d].pop();
-                        continue;
+        // Pop the vertex with the highest degree; stale entries (already known, or queued
+        // at a degree it no longer has) are dropped on the way.
+        let next_vertex =
+            |buckets: &mut [Vec<u32>; MAX_DEGREE + 1], known: &[bool], degree: &[u8]| {
+                (0..=MAX_DEGREE).rev().find_map(|d| {
+                    while let Some(x) = buckets[d].pop() {
+                        let x = x as usize;
+                        if !known[x] && (degree[x] as usize).min(MAX_DEGREE) == d {
+                            return Some(x);
+                        }
                     }
-                    return buckets[d].pop().map(|x| x as usize);
-                }
-                None
-            }) else {
-                break;
+                    None
+                })
             };
+        while let Some(v) = next_vertex(&mut buckets, &known, &degree) {
             // v was queued by a neighbour, so it has an anchor.
             let corner = whet_mesh::CornerId(anchor[v]);
             if corner.index() >= table.corner_count() {
