@@ -19,8 +19,8 @@
 #![forbid(unsafe_code)]
 
 pub use whet_mesh::{
-    angle_between, Aabb, CornerId, CornerTable, DVec3, EdgeLengthStats, FaceId, ManifoldRepair,
-    Mesh, MeshError, TopologyReport, VertexId,
+    angle_between, edge_key, Aabb, CornerId, CornerTable, DVec3, EdgeLengthStats, FaceId,
+    ManifoldRepair, Mesh, MeshError, TopologyReport, VertexId,
 };
 
 /// Mesh files: OFF, OBJ, PLY and STL readers and writers.

@@ -15,6 +15,19 @@ pub struct DecodeArgs {
     /// Output format, overriding the extension.
     #[arg(long)]
     output_format: Option<whet::io::Format>,
+    /// Run EdgeSharpener on the decoded mesh (restores the sharp edges and corners a uniform
+    /// retiling chamfered).
+    #[arg(long)]
+    sharpen: bool,
+    /// Then refine with Bender this many levels (needs --sharpen for its tags).
+    #[arg(long, value_name = "N", requires = "sharpen")]
+    bend: Option<u32>,
+    /// EdgeSharpener's smooth-edge factor.
+    #[arg(long, default_value_t = 2.0)]
+    smooth_factor: f64,
+    /// EdgeSharpener's method: extended (default) or papers.
+    #[arg(long, default_value = "extended")]
+    method: String,
 }
 
 pub fn run(args: &DecodeArgs) -> CliResult {
@@ -32,6 +45,23 @@ pub fn run(args: &DecodeArgs) -> CliResult {
             Failure::other(err)
         }
     })?;
+    let mesh = if args.sharpen {
+        let opts = super::sharpen::sharpen_options(&args.method, args.smooth_factor)?;
+        let s = super::sharpen::run_sharpen(&mesh, &opts)?;
+        match args.bend {
+            Some(levels) if levels > 8 => {
+                return Err(Failure::input(anyhow::anyhow!(
+                    "--bend {levels}: at most 8 levels"
+                )))
+            }
+            Some(levels) => {
+                super::sharpen::run_bend(&s.mesh, &super::sharpen::tag_edges(&s.tags), levels)?
+            }
+            None => s.mesh,
+        }
+    } else {
+        mesh
+    };
     write_mesh(
         &args.output,
         &mesh,

@@ -78,7 +78,7 @@ pub fn run(args: &DemoArgs) -> CliResult {
         draco: None,
     };
     let points = run_plan(vec![("synth-fandisk".into(), original)], &plan)?;
-    print!("{}", to_markdown(&points));
+    out!("{}", to_markdown(&points));
     eprintln!(
         "plot: {}  tables: {}/rd.csv, rd.json, rd.md",
         args.out.join("synth-fandisk.svg").display(),

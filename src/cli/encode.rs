@@ -95,7 +95,7 @@ pub fn run(args: &EncodeArgs) -> CliResult {
             "dropped_unused_vertices": r.dropped_unused_vertices,
         }));
     } else {
-        println!(
+        outln!(
             "{} -> {}: {} bytes, {} vertices, {} triangles, {:.3} bits/vertex, {:.3} bits/triangle (connectivity {} bits, geometry {} bits)",
             args.input.display(),
             args.output.display(),

@@ -54,39 +54,40 @@ pub fn run(args: &InfoArgs) -> CliResult {
             "problem_count": r.problem_count,
         }));
     } else {
-        println!("{}", args.mesh.display());
-        println!("  vertices        {}", r.vertices);
-        println!("  triangles       {}", r.triangles);
-        println!("  edges           {}", r.edges);
-        println!("  components      {}", r.components);
-        println!(
+        outln!("{}", args.mesh.display());
+        outln!("  vertices        {}", r.vertices);
+        outln!("  triangles       {}", r.triangles);
+        outln!("  edges           {}", r.edges);
+        outln!("  components      {}", r.components);
+        outln!(
             "  boundary loops  {} ({} edges)",
-            r.boundary_loops, r.boundary_edges
+            r.boundary_loops,
+            r.boundary_edges
         );
         match r.genus {
-            Some(g) => println!("  genus           {g}"),
-            None => println!("  genus           undefined (not an oriented manifold)"),
+            Some(g) => outln!("  genus           {g}"),
+            None => outln!("  genus           undefined (not an oriented manifold)"),
         }
-        println!("  euler char.     {}", r.euler_characteristic);
-        println!(
+        outln!("  euler char.     {}", r.euler_characteristic);
+        outln!(
             "  manifold        {}",
             if r.manifold { "yes" } else { "no" }
         );
-        println!(
+        outln!(
             "  oriented        {}",
             if r.oriented { "yes" } else { "no" }
         );
-        println!("  bbox diagonal   {diagonal}");
-        println!("  mean edge       {mean_edge}");
+        outln!("  bbox diagonal   {diagonal}");
+        outln!("  mean edge       {mean_edge}");
         if r.problem_count == 0 {
-            println!("  problems        none");
+            outln!("  problems        none");
         } else {
-            println!("  problems        {}", r.problem_count);
+            outln!("  problems        {}", r.problem_count);
             for p in &r.problems {
-                println!("    - {p}");
+                outln!("    - {p}");
             }
             if r.problem_count > r.problems.len() {
-                println!("    ... and {} more", r.problem_count - r.problems.len());
+                outln!("    ... and {} more", r.problem_count - r.problems.len());
             }
         }
     }

@@ -68,30 +68,43 @@ pub fn run(args: &MetroArgs) -> CliResult {
             .map_err(|e| Failure::other(anyhow::Error::new(e).context("metro report JSON")))?;
         print_json(&value);
     } else {
-        println!(
+        outln!(
             "reference {}  test {}",
             args.reference.display(),
             args.test.display()
         );
-        println!(
+        outln!(
             "diagonal {}  face samples per direction {}",
-            report.diagonal, report.samples
+            report.diagonal,
+            report.samples
         );
-        println!(
+        outln!(
             "{:<10} {:>14} {:>14} {:>14} {:>10} {:>10} {:>10}",
-            "", "max", "mean", "rms", "max %", "mean %", "rms %"
+            "",
+            "max",
+            "mean",
+            "rms",
+            "max %",
+            "mean %",
+            "rms %"
         );
         for (name, f) in [
             ("forward", &report.forward.figures),
             ("backward", &report.backward.figures),
             ("symmetric", &report.symmetric),
         ] {
-            println!(
+            outln!(
                 "{:<10} {:>14.6e} {:>14.6e} {:>14.6e} {:>10.5} {:>10.5} {:>10.5}",
-                name, f.max, f.mean, f.rms, f.max_pct, f.mean_pct, f.rms_pct
+                name,
+                f.max,
+                f.mean,
+                f.rms,
+                f.max_pct,
+                f.mean_pct,
+                f.rms_pct
             );
         }
-        println!("(forward: test sampled against reference; backward: the reverse)");
+        outln!("(forward: test sampled against reference; backward: the reverse)");
     }
     Ok(())
 }

@@ -1,6 +1,24 @@
 //! Subcommands of the `whet` binary, one module each, and the mapping of failures to exit
 //! codes.
 
+/// `print!` that ends the process quietly when stdout is a closed pipe (`whet info | head`)
+/// instead of panicking.
+macro_rules! out {
+    ($($arg:tt)*) => {
+        $crate::cli::write_stdout(&format!($($arg)*))
+    };
+}
+
+/// `println!` with the same pipe handling as [`out!`].
+macro_rules! outln {
+    () => {
+        $crate::cli::write_stdout("\n")
+    };
+    ($($arg:tt)*) => {
+        $crate::cli::write_stdout(&format!("{}\n", format!($($arg)*)))
+    };
+}
+
 mod convert;
 mod decode;
 mod demo;
@@ -8,6 +26,8 @@ mod encode;
 mod info;
 mod metro;
 mod rd;
+mod sharpen;
+mod subdivide;
 mod synth;
 
 use clap::{Parser, Subcommand};
@@ -36,6 +56,12 @@ enum Command {
     Metro(metro::MetroArgs),
     /// Ground-truth shapes and their marching-cubes samplings.
     Synth(synth::SynthArgs),
+    /// EdgeSharpener: restore the sharp edges and corners a uniform resampling chamfered.
+    Sharpen(sharpen::SharpenArgs),
+    /// Bender: feature-preserving interpolatory subdivision.
+    Bend(sharpen::BendArgs),
+    /// Semi-sharp Loop subdivision of a control mesh.
+    Subdivide(subdivide::SubdivideArgs),
     /// Rate-distortion sweep: encode, decode, post-process and measure at several rates.
     Rd(rd::RdArgs),
     /// The main job on a mesh whet generates: a rate-distortion sweep of the synthetic fandisk.
@@ -79,6 +105,9 @@ pub fn run(cli: Cli) -> CliResult {
         Command::Metro(a) => metro::run(&a),
         Command::Synth(a) => synth::run(&a),
         Command::Rd(a) => rd::run(&a),
+        Command::Subdivide(a) => subdivide::run(&a),
+        Command::Sharpen(a) => sharpen::run(&a),
+        Command::Bend(a) => sharpen::run_bend_cmd(&a),
         Command::Demo(a) => demo::run(&a),
     }
 }
@@ -117,5 +146,19 @@ fn path_missing(path: &Path) -> bool {
 /// Prints one JSON value on stdout.
 pub fn print_json(value: &serde_json::Value) {
     // serde_json's Display of a Value cannot fail.
-    println!("{value}");
+    outln!("{value}");
+}
+
+/// Writes to stdout; a closed pipe ends the process with success (the reader has what it
+/// wanted), any other error with exit code 1.
+pub fn write_stdout(text: &str) {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    if let Err(e) = out.write_all(text.as_bytes()).and_then(|_| out.flush()) {
+        if e.kind() == std::io::ErrorKind::BrokenPipe {
+            std::process::exit(0);
+        }
+        eprintln!("whet: cannot write to stdout: {e}");
+        std::process::exit(EXIT_FAILURE as i32);
+    }
 }

@@ -183,7 +183,7 @@ pub fn run(args: &RdArgs) -> CliResult {
         draco: args.draco.clone(),
     };
     let points = run_plan(meshes, &plan)?;
-    print!("{}", to_markdown(&points));
+    out!("{}", to_markdown(&points));
     eprintln!(
         "wrote {}/rd.csv, rd.json, rd.md and one SVG per mesh",
         plan.out.display()

@@ -60,7 +60,7 @@ fn parse_rotation(s: &str) -> Result<DQuat, Failure> {
 pub fn run(args: &SynthArgs) -> CliResult {
     if args.list {
         for kind in ShapeKind::ALL {
-            println!("{:<12} {}", kind.name(), kind.description());
+            outln!("{:<12} {}", kind.name(), kind.description());
         }
         return Ok(());
     }

@@ -7,6 +7,7 @@ mod cli_convert;
 mod cli_info;
 mod cli_metro;
 mod cli_rd;
+mod cli_sharpen;
 mod fixtures;
 mod fuzz_replay;
 

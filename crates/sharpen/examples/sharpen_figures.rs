@@ -1,0 +1,147 @@
+//! The EdgeSharpener figures of docs/results.md: Metro error before and after sharpening, for
+//! both methods, on marching-cubes samplings of the synth shapes and on stand-in retilings of
+//! the CAD fixtures.
+//!
+//! ```text
+//! cargo run --release -p whet-sharpen --example sharpen_figures            # everything
+//! cargo run --release -p whet-sharpen --example sharpen_figures -- synth   # marching cubes only
+//! cargo run --release -p whet-sharpen --example sharpen_figures -- retile  # fixtures only
+//! cargo run --release -p whet-sharpen --example sharpen_figures -- noise   # noise sweep
+//! ```
+//!
+//! Errors are symmetric Metro figures (whet-metro, default sampling: at least 10 samples per
+//! face and 1M per direction) in percent of the reference's bounding-box diagonal; the
+//! reference is the synth truth mesh or the original fixture. "reversed/new": new triangles
+//! facing against the reference plane they lie on, over all new triangles
+//! (`support::check`); a row is flagged INVALID if the output is not a manifold with the
+//! input's boundary and no new angle under 1 degree, WORSE if RMS or max grew.
+
+mod support;
+
+use std::time::Instant;
+
+use whet_mesh::Mesh;
+use whet_sharpen::{sharpen, Method, SharpenOptions};
+use whet_synth::{add_noise, marching_cubes, Shape, ShapeKind, ShapeParams};
+
+use support::{cached_stand_in, check, error, rotations};
+
+/// Face samples per Metro direction: the default rule unless `SHARPEN_FIGURES_SAMPLES` is set
+/// (for quick iterations; the tables in docs/results.md use the default).
+fn samples() -> Option<usize> {
+    std::env::var("SHARPEN_FIGURES_SAMPLES")
+        .ok()
+        .and_then(|s| s.parse().ok())
+}
+
+fn row(label: &str, reference: &Mesh, input: &Mesh) {
+    let e0 = error(reference, input, samples());
+    let mut line = format!(
+        "| {label} | {} | {:.4} | {:.3} |",
+        input.positions.len(),
+        e0.rms_pct,
+        e0.max_pct
+    );
+    for method in [Method::Papers, Method::Extended] {
+        let t = Instant::now();
+        let out = sharpen(input, &SharpenOptions::DEFAULT.with_method(method))
+            .unwrap_or_else(|e| panic!("{label}: {e}"));
+        let ms = t.elapsed().as_secs_f64() * 1e3;
+        let e = error(reference, &out.mesh, samples());
+        let c = check(reference, input, &out);
+        let valid = c.manifold && c.new_boundary_edges == 0 && c.min_new_angle >= 1.0 - 1e-9;
+        let worse = e.rms_pct > e0.rms_pct * 1.0001 || e.max_pct > e0.max_pct * 1.0001;
+        line += &format!(
+            " {:.4} | {:.3} | {:.2}x | {:.2}x | {}/{}{}{} | {ms:.1} |",
+            e.rms_pct,
+            e.max_pct,
+            e0.rms_pct / e.rms_pct,
+            e0.max_pct / e.max_pct,
+            c.reversed,
+            c.new_triangles,
+            if valid { "" } else { " INVALID" },
+            if worse { " WORSE" } else { "" },
+        );
+    }
+    println!("{line}");
+}
+
+fn header(first: &str) {
+    println!(
+        "| {first} | V | RMS % | max % | papers RMS % | max % | RMS gain | max gain | reversed/new | ms \
+         | extended RMS % | max % | RMS gain | max gain | reversed/new | ms |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+}
+
+fn synth() {
+    println!("\n### Marching cubes of synth shapes (reference: the truth mesh)\n");
+    header("shape, resolution, rotation");
+    for kind in [ShapeKind::Cube, ShapeKind::Pyramid, ShapeKind::Fandisk] {
+        for res in [32, 48, 64, 96, 128] {
+            for (ri, q) in rotations().iter().enumerate() {
+                let shape = Shape::new(kind, &ShapeParams::default().with_rotation(*q))
+                    .unwrap_or_else(|e| panic!("{e}"));
+                let input = marching_cubes(&shape, res).unwrap_or_else(|e| panic!("{e}"));
+                row(
+                    &format!("{} {res} r{ri}", kind.name()),
+                    shape.truth_mesh_ref(),
+                    &input,
+                );
+            }
+        }
+    }
+}
+
+fn retile(only: Option<String>) {
+    println!("\n### Stand-in retilings of the fixtures (reference: the original fixture)\n");
+    header("fixture, vertex ratio (grid)");
+    for name in [
+        "fandisk.off",
+        "cad_box_hole.off",
+        "cad_bracket.off",
+        "cad_cyl_fillet.off",
+        "block.off",
+        "partLp.off",
+        "joint.off",
+    ] {
+        if only.as_deref().is_some_and(|o| !name.starts_with(o)) {
+            continue;
+        }
+        for ratio in [0.5, 1.0, 2.0] {
+            let (original, input, res) = cached_stand_in(name, ratio);
+            row(&format!("{name} {ratio}x ({res})"), &original, &input);
+        }
+    }
+}
+
+fn noise() {
+    println!("\n### Normal noise (percent of the longest edge) on marching cubes at 64\n");
+    header("shape, noise");
+    for kind in [ShapeKind::Cube, ShapeKind::Fandisk] {
+        let shape = Shape::new(kind, &ShapeParams::default().with_rotation(rotations()[0]))
+            .unwrap_or_else(|e| panic!("{e}"));
+        let clean = marching_cubes(&shape, 64).unwrap_or_else(|e| panic!("{e}"));
+        for amount in [0.0, 0.1, 0.25, 0.5, 1.0] {
+            let input = add_noise(&clean, amount, 7);
+            row(
+                &format!("{} {:.0}%", kind.name(), amount * 100.0),
+                shape.truth_mesh_ref(),
+                &input,
+            );
+        }
+    }
+}
+
+fn main() {
+    let what = std::env::args().nth(1).unwrap_or_default();
+    if what.is_empty() || what == "synth" {
+        synth();
+    }
+    if what.is_empty() || what == "retile" {
+        retile(std::env::args().nth(2));
+    }
+    if what.is_empty() || what == "noise" {
+        noise();
+    }
+}

@@ -1,0 +1,1319 @@
+//! EdgeSharpener: Attene, Falcidieno, Rossignac, Spagnuolo, SGP 2003 (seed 000 section 3) and
+//! Attene, Falcidieno, Spagnuolo, Rossignac, ACM TOG 2005 (seed 001 sections 3 and 4.1).
+//!
+//! Pipeline (docs/sharpen.md has the rules and the degenerate cases in full):
+//!
+//! 1. smooth (brown) edges: normal angle under `smooth_factor` times the mesh mean;
+//! 2. filters 1-4 and 3bis paint red vertices, triangles and edges and tag sharp vertices;
+//!    [`Method::Extended`] then labels smooth regions and classifies the chamfer vertices
+//!    (`extended.rs`);
+//! 3. filters 5 and 6: blue chamfer edges and green corner triangles (extended: by labels, and
+//!    corner vertices moved onto their corner points; splits that would change nothing are
+//!    dropped);
+//! 4. one new vertex per chamfer edge and corner triangle, snapped onto the extrapolated planes
+//!    or left at the midpoint/centroid for a named reason;
+//! 5. every subdivided triangle is re-cut; snapped (or moved) vertices that make an edge too long
+//!    or reverse a piece are put back (`settle_positions`);
+//! 6. the sliver pass (`slivers.rs`) removes new triangles with an angle under 1 degree or
+//!    reversed.
+//!
+//! Invariants kept: input vertex `i` is output vertex `i`, bit-identical unless it is a chamfer
+//! vertex that the extended method moved; the output is an oriented manifold with the input's
+//! boundary; no new triangle has an angle under the threshold or faces against the plane it
+//! lies on. Not handled: features narrower than about three sampling steps (the papers' own
+//! limitation), blends within a few samples of radius, and self-intersections a snapped vertex
+//! may create with a distant part of the mesh.
+
+use std::time::Instant;
+
+use glam::DVec3;
+use whet_mesh::{CornerId, CornerTable, FaceId, Mesh, MeshError, VertexId};
+
+use crate::options::{Method, SharpenOptions};
+use crate::report::{SharpenReport, UnmovedReason};
+use crate::snap::{self, Plane, SnapLimits};
+use crate::tags::SharpTags;
+use crate::{Error, Sharpened};
+
+pub(crate) const NONE: u32 = u32::MAX;
+
+// Corner flags: properties of the edge opposite the corner, mirrored on both of its corners.
+pub(crate) const C_BROWN: u8 = 1;
+pub(crate) const C_RED: u8 = 2;
+pub(crate) const C_BLUE: u8 = 4;
+
+// Vertex flags.
+pub(crate) const V_USED: u8 = 1;
+pub(crate) const V_NOT_SMOOTH: u8 = 2;
+pub(crate) const V_CORE: u8 = 4;
+pub(crate) const V_RED: u8 = 8;
+pub(crate) const V_TAG: u8 = 16;
+pub(crate) const V_PLANE: u8 = 32;
+pub(crate) const V_MOVED: u8 = 64;
+pub(crate) const V_CHAMFER: u8 = 128;
+
+// Triangle flags.
+pub(crate) const T_RED: u8 = 1;
+pub(crate) const T_GREEN: u8 = 2;
+pub(crate) const T_DIAG: u8 = 4;
+pub(crate) const T_TOUCHED: u8 = 8;
+
+/// Pieces thinner than this (degrees) are left to the sliver pass by the orientation check of
+/// `settle_positions`: their normal is dominated by rounding and snapping noise.
+const SETTLE_MIN_ANGLE: f64 = 5.0;
+
+/// A split whose vertex would move by less than this fraction of its edge changes nothing
+/// (extended method: dropped, see `drop_idle_splits`).
+const IDLE_SPLIT: f64 = 1e-3;
+
+/// Status byte of a new vertex: snapped, or 1 + the [`UnmovedReason`] index.
+pub(crate) const SNAPPED: u8 = 0;
+
+/// Where a new vertex was inserted.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Kind {
+    /// In the middle of the chamfer edge opposite this corner (the lower of its two corners).
+    Edge(u32),
+    /// In the middle of this corner triangle.
+    Center(u32),
+}
+
+/// One inserted vertex.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct NewVertex {
+    pub kind: Kind,
+    /// Midpoint of the edge or centroid of the triangle: where it goes when unsnapped.
+    pub rest: DVec3,
+    /// [`SNAPPED`] or 1 + reason index.
+    pub status: u8,
+    /// The planes it was snapped onto (two for an edge, three or two for a corner).
+    pub planes: Planes,
+}
+
+/// Up to three planes (the ones a new vertex lies on).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Planes {
+    pub p: [Option<Plane>; 3],
+}
+
+impl Planes {
+    pub fn two(a: Plane, b: Plane) -> Planes {
+        Planes {
+            p: [Some(a), Some(b), None],
+        }
+    }
+    pub fn three(a: Plane, b: Plane, c: Plane) -> Planes {
+        Planes {
+            p: [Some(a), Some(b), Some(c)],
+        }
+    }
+}
+
+/// Reusable buffers, so an [`EdgeSharpener`] sharpening many meshes allocates once.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Scratch {
+    pub normals: Vec<DVec3>,
+    pub angles: Vec<f32>,
+    pub cflags: Vec<u8>,
+    pub vflags: Vec<u8>,
+    pub tflags: Vec<u8>,
+    pub edge_vertex: Vec<u32>,
+    pub center: Vec<u32>,
+    pub plane_of: Vec<u32>,
+    pub planes: Vec<Plane>,
+    pub new_vertices: Vec<NewVertex>,
+    pub stack: Vec<u32>,
+    pub touched: Vec<u32>,
+    /// Extended detection: smooth region of each red triangle, and label planes per vertex.
+    pub region: Vec<u32>,
+    pub lp_start: Vec<u32>,
+    pub lp_len: Vec<u8>,
+    pub lps: Vec<crate::extended::LabelPlane>,
+}
+
+fn reset<T: Clone>(v: &mut Vec<T>, n: usize, x: T) {
+    v.clear();
+    v.resize(n, x);
+}
+
+/// The EdgeSharpener engine: options plus scratch buffers kept between calls.
+///
+/// ```
+/// use whet_sharpen::{EdgeSharpener, SharpenOptions};
+/// use whet_synth::{marching_cubes, Shape, ShapeKind, ShapeParams};
+///
+/// let mut sharpener = EdgeSharpener::new(SharpenOptions::DEFAULT);
+/// for kind in [ShapeKind::Cube, ShapeKind::Pyramid] {
+///     let shape = Shape::new(kind, &ShapeParams::default()).unwrap();
+///     let out = sharpener.sharpen(&marching_cubes(&shape, 12).unwrap()).unwrap();
+///     assert!(out.report.chamfer_edges > 0);
+/// }
+/// ```
+#[derive(Clone, Debug)]
+pub struct EdgeSharpener {
+    options: SharpenOptions,
+    scratch: Scratch,
+}
+
+impl EdgeSharpener {
+    /// An engine with these options.
+    pub fn new(options: SharpenOptions) -> EdgeSharpener {
+        EdgeSharpener {
+            options,
+            scratch: Scratch::default(),
+        }
+    }
+
+    /// The options.
+    pub fn options(&self) -> &SharpenOptions {
+        &self.options
+    }
+
+    /// Sharpens `mesh`; see [`crate::sharpen`].
+    pub fn sharpen(&mut self, mesh: &Mesh) -> Result<Sharpened, Error> {
+        let start = Instant::now();
+        self.options.validate()?;
+        if let Some(v) = mesh.positions.iter().position(|p| !p.is_finite()) {
+            return Err(Error::InvalidInput(MeshError::NonFiniteCoordinate {
+                vertex: v as u32,
+            }));
+        }
+        let mut report = SharpenReport {
+            method: self.options.method,
+            smooth_factor: self.options.smooth_factor,
+            input_vertices: mesh.positions.len(),
+            input_triangles: mesh.triangles.len(),
+            ..SharpenReport::default()
+        };
+        if mesh.triangles.is_empty() {
+            report.output_vertices = mesh.positions.len();
+            report.time = start.elapsed();
+            return Ok(Sharpened {
+                mesh: mesh.clone(),
+                parents: Vec::new(),
+                tags: SharpTags::default(),
+                report,
+            });
+        }
+        let table = CornerTable::new(mesh).map_err(Error::InvalidInput)?;
+        if mesh.positions.len() as u64 + 2 * mesh.triangles.len() as u64 >= u64::from(NONE) {
+            return Err(Error::InvalidInput(MeshError::TooLarge {
+                what: "vertex count after sharpening",
+                count: mesh.positions.len() + 2 * mesh.triangles.len(),
+            }));
+        }
+        let mut run = Run {
+            mesh,
+            table: &table,
+            opts: &self.options,
+            s: &mut self.scratch,
+            report,
+            positions: Vec::new(),
+            max_edge: 0.0,
+            limits: SnapLimits::new(0.0),
+            ref_normals: std::collections::HashMap::new(),
+            snap_cache: std::collections::HashMap::new(),
+        };
+        let (out, parents, tags) = run.run();
+        let mut report = run.report;
+        report.time = start.elapsed();
+        Ok(Sharpened {
+            mesh: out,
+            parents,
+            tags,
+            report,
+        })
+    }
+}
+
+/// One run over one mesh.
+pub(crate) struct Run<'a> {
+    pub mesh: &'a Mesh,
+    pub table: &'a CornerTable,
+    pub opts: &'a SharpenOptions,
+    pub s: &'a mut Scratch,
+    pub report: SharpenReport,
+    /// Output positions: the input's, then the new vertices'.
+    pub positions: Vec<DVec3>,
+    /// Longest input edge.
+    pub max_edge: f64,
+    pub limits: SnapLimits,
+    /// Reference normals of the touched input triangles (see `reference_normal`).
+    pub ref_normals: std::collections::HashMap<u32, DVec3>,
+    /// Edge snaps computed while dropping idle splits, by the lower corner of their edge.
+    pub snap_cache: std::collections::HashMap<u32, Result<(DVec3, Planes), UnmovedReason>>,
+}
+
+#[inline]
+pub(crate) fn next(c: usize) -> usize {
+    if c % 3 == 2 {
+        c - 2
+    } else {
+        c + 1
+    }
+}
+
+#[inline]
+pub(crate) fn prev(c: usize) -> usize {
+    if c % 3 == 0 {
+        c + 2
+    } else {
+        c - 1
+    }
+}
+
+impl Run<'_> {
+    fn run(&mut self) -> (Mesh, Vec<FaceId>, SharpTags) {
+        self.detect();
+        self.insert_vertices();
+        self.cache_reference_normals();
+        self.settle_positions();
+        let mut out = crate::slivers::Output::assemble(self);
+        out.remove_slivers(self);
+        let (mesh, parents) = out.finish(self);
+        let tags = self.tags(&mesh);
+        (mesh, parents, tags)
+    }
+
+    /// Smooth edges, the filters, the extended classification, chamfer edges and corner
+    /// triangles.
+    fn detect(&mut self) {
+        let nt = self.mesh.triangles.len();
+        let nc = 3 * nt;
+        let nv = self.mesh.positions.len();
+        reset(&mut self.s.cflags, nc, 0);
+        reset(&mut self.s.vflags, nv, 0);
+        reset(&mut self.s.tflags, nt, 0);
+        self.positions.clear();
+        self.positions.reserve(nv + nt / 8);
+        self.positions.extend_from_slice(&self.mesh.positions);
+        self.smooth_edges();
+        self.filters();
+        if self.opts.method == Method::Extended {
+            self.extend_detection();
+        }
+        self.chamfer_edges();
+        if self.opts.method == Method::Extended {
+            if crate::extended::corner_vertices(self) > 0 {
+                // Corner vertices changed labels: find the chamfer edges again.
+                for f in self.s.cflags.iter_mut() {
+                    *f &= !C_BLUE;
+                }
+                for f in self.s.tflags.iter_mut() {
+                    *f &= !T_GREEN;
+                }
+                self.chamfer_edges();
+            }
+            self.drop_idle_splits();
+        }
+    }
+
+    /// Smooth edges: face normals, the angle of every interior edge, the mean, brown flags.
+    fn smooth_edges(&mut self) {
+        let mesh = self.mesh;
+        let nt = mesh.triangles.len();
+        let nc = 3 * nt;
+        let s = &mut *self.s;
+        s.normals.clear();
+        s.normals.extend((0..nt).map(|t| mesh.face_normal(t)));
+        reset(&mut s.angles, nc, -1.0);
+        let mut sum = 0.0f64;
+        let mut count = 0usize;
+        let mut max_edge2 = 0.0f64;
+        for c in 0..nc {
+            let o = self.table.opposite(CornerId(c as u32));
+            if let Some(o) = o {
+                if o.index() < c {
+                    continue;
+                }
+            }
+            let a = mesh.positions[mesh.triangles[next(c) / 3][next(c) % 3] as usize];
+            let b = mesh.positions[mesh.triangles[prev(c) / 3][prev(c) % 3] as usize];
+            max_edge2 = max_edge2.max(a.distance_squared(b));
+            let Some(o) = o else { continue };
+            let (n1, n2) = (s.normals[c / 3], s.normals[o.index() / 3]);
+            if n1 == DVec3::ZERO || n2 == DVec3::ZERO {
+                continue;
+            }
+            let angle = normal_angle(n1, n2);
+            s.angles[c] = angle as f32;
+            sum += angle;
+            count += 1;
+        }
+        self.max_edge = max_edge2.sqrt();
+        let mean = if count > 0 { sum / count as f64 } else { 0.0 };
+        let threshold = self.opts.smooth_factor * mean;
+        self.report.mean_angle_degrees = mean.to_degrees();
+        self.report.smooth_threshold_degrees = threshold.to_degrees();
+        self.limits = SnapLimits::new(threshold);
+        let thr = threshold as f32;
+        let mut smooth = 0;
+        for c in 0..nc {
+            let a = s.angles[c];
+            if a >= 0.0 && a < thr {
+                // Only the lower corner of an interior edge holds its angle.
+                if let Some(o) = self.table.opposite(CornerId(c as u32)) {
+                    s.cflags[c] |= C_BROWN;
+                    s.cflags[o.index()] |= C_BROWN;
+                    smooth += 1;
+                }
+            }
+        }
+        self.report.smooth_edges = smooth;
+    }
+
+    /// Filters 1-4 and 3bis.
+    fn filters(&mut self) {
+        let mesh = self.mesh;
+        let table = self.table;
+        let nt = mesh.triangles.len();
+        let nc = 3 * nt;
+        let s = &mut *self.s;
+        // Filter 1: red (core) vertices, all of whose edges are brown.
+        for c in 0..nc {
+            let v = mesh.triangles[c / 3][c % 3] as usize;
+            s.vflags[v] |= V_USED;
+            if s.cflags[next(c)] & s.cflags[prev(c)] & C_BROWN == 0 {
+                s.vflags[v] |= V_NOT_SMOOTH;
+            }
+        }
+        for f in s.vflags.iter_mut() {
+            if *f & (V_USED | V_NOT_SMOOTH) == V_USED {
+                *f |= V_CORE;
+            }
+        }
+        // Filter 2: triangles with a core vertex.
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            if tri.iter().any(|&v| s.vflags[v as usize] & V_CORE != 0) {
+                s.tflags[t] |= T_RED;
+            }
+        }
+        // Filter 3: grow through brown edges (explicit stack), from every core triangle at once.
+        s.stack.clear();
+        s.stack
+            .extend((0..nt as u32).filter(|&t| s.tflags[t as usize] & T_RED != 0));
+        while let Some(t) = s.stack.pop() {
+            for c in 3 * t as usize..3 * t as usize + 3 {
+                if s.cflags[c] & C_BROWN == 0 {
+                    continue;
+                }
+                if let Some(o) = table.opposite(CornerId(c as u32)) {
+                    let u = o.index() / 3;
+                    if s.tflags[u] & T_RED == 0 {
+                        s.tflags[u] |= T_RED;
+                        s.stack.push(u as u32);
+                    }
+                }
+            }
+        }
+        if self.opts.method == Method::Extended {
+            label_regions(s, table, nt);
+        }
+        // Filter 3bis: tag the ends of non-brown edges between two red triangles ...
+        for c in 0..nc {
+            if s.cflags[c] & C_BROWN != 0 || s.tflags[c / 3] & T_RED == 0 {
+                continue;
+            }
+            if let Some(o) = table.opposite(CornerId(c as u32)) {
+                if s.tflags[o.index() / 3] & T_RED != 0 {
+                    let tri_a = mesh.triangles[next(c) / 3][next(c) % 3];
+                    let tri_b = mesh.triangles[prev(c) / 3][prev(c) % 3];
+                    s.vflags[tri_a as usize] |= V_TAG;
+                    s.vflags[tri_b as usize] |= V_TAG;
+                }
+            }
+        }
+        // ... and vertices whose red triangles form more than one fan, counted in filter 4's
+        // loop. A red corner k starts a run of red triangles around its vertex when the
+        // triangle clockwise before it, across the edge opposite prev(k), is not red: so each
+        // red-region border edge (opposite corner c of a red triangle) starts a run at next(c).
+        let mut runs = vec![0u8; mesh.positions.len()];
+        // Filter 4: edges and vertices of red triangles.
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            if s.tflags[t] & T_RED == 0 {
+                continue;
+            }
+            for k in 0..3 {
+                let c = 3 * t + k;
+                s.cflags[c] |= C_RED;
+                s.vflags[tri[k] as usize] |= V_RED;
+                let border = match table.opposite(CornerId(c as u32)) {
+                    Some(o) => {
+                        s.cflags[o.index()] |= C_RED;
+                        s.tflags[o.index() / 3] & T_RED == 0
+                    }
+                    None => true,
+                };
+                if border {
+                    let v = tri[(k + 1) % 3] as usize;
+                    runs[v] = runs[v].saturating_add(1);
+                }
+            }
+        }
+        for (v, &r) in runs.iter().enumerate() {
+            if r > 1 {
+                s.vflags[v] |= V_TAG;
+            }
+        }
+    }
+
+    /// Vertex at corner `c` of the input.
+    #[inline]
+    pub(crate) fn cv(&self, c: usize) -> u32 {
+        self.mesh.triangles[c / 3][c % 3]
+    }
+
+    /// Filters 5 and 6: blue chamfer edges (interior, not red, two red ends; extended: two
+    /// ends with non-parallel label planes) and green corner triangles (three blue edges).
+    fn chamfer_edges(&mut self) {
+        let nt = self.mesh.triangles.len();
+        let nc = 3 * nt;
+        let extended = self.opts.method == Method::Extended;
+        let mut blue = 0;
+        for c in 0..nc {
+            let Some(o) = self.table.opposite(CornerId(c as u32)) else {
+                continue;
+            };
+            if o.index() < c || self.s.cflags[c] & C_RED != 0 {
+                continue;
+            }
+            let (a, b) = (self.cv(next(c)), self.cv(prev(c)));
+            let is_blue = if extended {
+                crate::extended::is_chamfer_edge(self, a, b)
+            } else {
+                self.s.vflags[a as usize] & V_RED != 0 && self.s.vflags[b as usize] & V_RED != 0
+            };
+            if is_blue && !self.split_blocked(c) && !self.split_blocked(o.index()) {
+                self.s.cflags[c] |= C_BLUE;
+                self.s.cflags[o.index()] |= C_BLUE;
+                blue += 1;
+            }
+        }
+        self.report.chamfer_edges = blue;
+        let mut green = 0;
+        for t in 0..nt {
+            let f = &self.s.cflags[3 * t..3 * t + 3];
+            let corner = f.iter().all(|&x| x & C_BLUE != 0)
+                || (extended
+                    && self.s.tflags[t] & T_RED == 0
+                    && crate::extended::is_corner_triangle(self, self.mesh.triangles[t]));
+            if corner {
+                self.s.tflags[t] |= T_GREEN;
+                green += 1;
+            }
+        }
+        self.report.corner_triangles = green;
+    }
+
+    /// True when the edge opposite corner `c` is a long edge of an input sliver (a triangle
+    /// with an angle under the sliver threshold): splitting it would leave a piece holding the
+    /// sliver's short edge and a new apex, thin again and fixable only by undoing the split.
+    fn split_blocked(&self, c: usize) -> bool {
+        let t = c / 3;
+        let p = self.mesh.triangle_positions(t);
+        if min_angle(&p) >= self.opts.min_angle_degrees.to_radians() {
+            return false;
+        }
+        // Edge k of the triangle is opposite corner k.
+        let len = |k: usize| p[(k + 1) % 3].distance_squared(p[(k + 2) % 3]);
+        let k = c % 3;
+        (0..3).any(|j| j != k && len(j) < len(k))
+    }
+
+    /// Extended method: a chamfer edge whose new vertex could not move, or would move by under
+    /// [`IDLE_SPLIT`] of the edge length, changes no geometry; it is dropped so that already
+    /// sharp creases keep their triangulation. So is the centre of a corner triangle that could
+    /// not move, unless the triangle keeps three chamfer edges (which need a centre).
+    fn drop_idle_splits(&mut self) {
+        let nt = self.mesh.triangles.len();
+        let mut blue = 0;
+        for c in 0..3 * nt {
+            if self.s.cflags[c] & C_BLUE == 0 {
+                continue;
+            }
+            let Some(o) = self.table.opposite(CornerId(c as u32)) else {
+                continue;
+            };
+            if o.index() < c {
+                continue;
+            }
+            let (a, b) = (self.cv(next(c)), self.cv(prev(c)));
+            let (pa, pb) = (self.positions[a as usize], self.positions[b as usize]);
+            let mid = (pa + pb) * 0.5;
+            let snapped = self.edge_snap(a, b, mid);
+            let idle = match &snapped {
+                Ok((p, _)) => p.distance(mid) <= IDLE_SPLIT * pa.distance(pb),
+                Err(_) => true,
+            };
+            if !idle {
+                self.snap_cache.insert(c as u32, snapped);
+            }
+            if idle {
+                self.s.cflags[c] &= !C_BLUE;
+                self.s.cflags[o.index()] &= !C_BLUE;
+            } else {
+                blue += 1;
+            }
+        }
+        self.report.chamfer_edges = blue;
+        let mut green = 0;
+        for t in 0..nt {
+            if self.s.tflags[t] & T_GREEN == 0 {
+                continue;
+            }
+            let tri = self.mesh.triangles[t];
+            let three = (3 * t..3 * t + 3).all(|c| self.s.cflags[c] & C_BLUE != 0);
+            let anchor = tri
+                .iter()
+                .map(|&v| self.positions[v as usize])
+                .sum::<DVec3>()
+                / 3.0;
+            if three || self.corner_snap(tri, anchor).is_ok() {
+                green += 1;
+            } else {
+                self.s.tflags[t] &= !T_GREEN;
+            }
+        }
+        self.report.corner_triangles = green;
+    }
+
+    /// Inserts one vertex per blue edge and green triangle, computes the planes at the ends of
+    /// the chamfer edges and snaps.
+    fn insert_vertices(&mut self) {
+        let mesh = self.mesh;
+        let nt = mesh.triangles.len();
+        let nc = 3 * nt;
+        let nv = mesh.positions.len();
+        reset(&mut self.s.edge_vertex, nc, NONE);
+        self.s.new_vertices.clear();
+        self.s.touched.clear();
+        if self.opts.method == Method::Papers {
+            // Which vertices need a plane: the ends of blue edges (corner-triangle vertices
+            // are ends of blue edges too).
+            for c in 0..nc {
+                if self.s.cflags[c] & C_BLUE != 0 {
+                    let (a, b) = (self.cv(next(c)) as usize, self.cv(prev(c)) as usize);
+                    self.s.vflags[a] |= V_PLANE;
+                    self.s.vflags[b] |= V_PLANE;
+                }
+            }
+            self.compute_planes();
+        }
+        for c in 0..nc {
+            if self.s.cflags[c] & C_BLUE == 0 {
+                continue;
+            }
+            let Some(o) = self.table.opposite(CornerId(c as u32)) else {
+                continue;
+            };
+            if o.index() < c {
+                continue;
+            }
+            let (a, b) = (self.cv(next(c)), self.cv(prev(c)));
+            let rest = (self.positions[a as usize] + self.positions[b as usize]) * 0.5;
+            let id = (nv + self.s.new_vertices.len()) as u32;
+            self.s.edge_vertex[c] = id;
+            self.s.edge_vertex[o.index()] = id;
+            let snapped = match self.snap_cache.remove(&(c as u32)) {
+                Some(s) => s,
+                None => self.edge_snap(a, b, rest),
+            };
+            let (pos, status, planes) = match snapped {
+                Ok((p, planes)) => (p, SNAPPED, planes),
+                Err(r) => (rest, 1 + r.index() as u8, Planes::default()),
+            };
+            self.s.new_vertices.push(NewVertex {
+                kind: Kind::Edge(c as u32),
+                rest,
+                status,
+                planes,
+            });
+            self.positions.push(pos);
+        }
+        reset(&mut self.s.center, 0, NONE);
+        if self.report.corner_triangles > 0 {
+            reset(&mut self.s.center, nt, NONE);
+        }
+        for t in 0..nt {
+            let f = self.s.tflags[t];
+            if f & T_GREEN != 0 {
+                let tri = mesh.triangles[t];
+                let rest = (self.positions[tri[0] as usize]
+                    + self.positions[tri[1] as usize]
+                    + self.positions[tri[2] as usize])
+                    / 3.0;
+                let id = (nv + self.s.new_vertices.len()) as u32;
+                self.s.center[t] = id;
+                let (pos, status, planes) = match self.corner_snap(tri, rest) {
+                    Ok((p, planes)) => (p, SNAPPED, planes),
+                    Err(r) => (rest, 1 + r.index() as u8, Planes::default()),
+                };
+                self.s.new_vertices.push(NewVertex {
+                    kind: Kind::Center(t as u32),
+                    rest,
+                    status,
+                    planes,
+                });
+                self.positions.push(pos);
+            }
+            if self.s.cflags[3 * t..3 * t + 3]
+                .iter()
+                .any(|&x| x & C_BLUE != 0)
+                || f & (T_TOUCHED | T_GREEN) != 0
+            {
+                self.s.tflags[t] |= T_TOUCHED;
+                self.s.touched.push(t as u32);
+            }
+        }
+        self.report.inserted_vertices = self.s.new_vertices.len();
+    }
+
+    /// Angle-weighted normal of the red triangles around each vertex flagged `V_PLANE`
+    /// (seed 000 section 3: weights are the triangles' angles at the vertex).
+    fn compute_planes(&mut self) {
+        let mesh = self.mesh;
+        reset(&mut self.s.plane_of, mesh.positions.len(), NONE);
+        self.s.planes.clear();
+        for v in 0..mesh.positions.len() {
+            if self.s.vflags[v] & V_PLANE == 0 {
+                continue;
+            }
+            let mut n = DVec3::ZERO;
+            for c in self.table.vertex_corners(VertexId(v as u32)) {
+                let t = c.index() / 3;
+                if self.s.tflags[t] & T_RED == 0 {
+                    continue;
+                }
+                n += self.s.normals[t] * self.corner_angle(c.index());
+            }
+            self.s.plane_of[v] = self.s.planes.len() as u32;
+            self.s.planes.push(Plane {
+                point: mesh.positions[v],
+                normal: n.normalize_or_zero(),
+            });
+        }
+    }
+
+    /// Interior angle of the input triangle at corner `c` (to 2e-5 rad: a weight).
+    #[inline]
+    pub(crate) fn corner_angle(&self, c: usize) -> f64 {
+        let p = self.mesh.positions[self.cv(c) as usize];
+        let a = self.mesh.positions[self.cv(next(c)) as usize];
+        let b = self.mesh.positions[self.cv(prev(c)) as usize];
+        fast_angle(a - p, b - p)
+    }
+
+    /// The plane of vertex `v` (which has one).
+    #[inline]
+    fn plane(&self, v: u32) -> Plane {
+        let i = self.s.plane_of[v as usize];
+        match self.s.planes.get(i as usize) {
+            Some(p) => *p,
+            // Every end of a blue edge got a plane in compute_planes; a zero normal is
+            // rejected by the snapping rules as parallel or dependent.
+            None => Plane {
+                point: self.mesh.positions[v as usize],
+                normal: DVec3::ZERO,
+            },
+        }
+    }
+
+    fn edge_snap(&self, a: u32, b: u32, anchor: DVec3) -> Result<(DVec3, Planes), UnmovedReason> {
+        if self.opts.method == Method::Extended {
+            return crate::extended::edge_snap(self, a, b, anchor);
+        }
+        let (pa, pb) = (self.plane(a), self.plane(b));
+        if pa.normal == DVec3::ZERO || pb.normal == DVec3::ZERO {
+            return Err(UnmovedReason::Parallel);
+        }
+        snap::edge_point(&pa, &pb, anchor, &self.limits).map(|p| (p, Planes::two(pa, pb)))
+    }
+
+    fn corner_snap(&self, tri: [u32; 3], anchor: DVec3) -> Result<(DVec3, Planes), UnmovedReason> {
+        if self.opts.method == Method::Extended {
+            return crate::extended::corner_snap(self, tri, anchor);
+        }
+        let p = tri.map(|v| self.plane(v));
+        if p.iter().any(|x| x.normal == DVec3::ZERO) {
+            return Err(UnmovedReason::Dependent);
+        }
+        snap::corner_point(&p[0], &p[1], &p[2], anchor, &self.limits)
+            .map(|q| (q, Planes::three(p[0], p[1], p[2])))
+    }
+
+    /// Calls `f` on every plane vertex `v` is known to lie on: for an input vertex its plane
+    /// (papers) or label planes (extended), for a snapped new vertex the planes it was snapped
+    /// onto.
+    fn for_each_plane(&self, v: u32, mut f: impl FnMut(&Plane)) {
+        let nv = self.mesh.positions.len();
+        if (v as usize) < nv {
+            match self.opts.method {
+                Method::Papers => {
+                    if self.s.vflags[v as usize] & V_PLANE != 0 {
+                        f(&self.plane(v));
+                    }
+                }
+                _ => {
+                    for lp in crate::extended::planes_of(self, v) {
+                        f(&lp.plane);
+                    }
+                }
+            }
+        } else {
+            let n = &self.s.new_vertices[v as usize - nv];
+            if n.status == SNAPPED {
+                for p in n.planes.p.iter().flatten() {
+                    f(p);
+                }
+            }
+        }
+    }
+
+    /// The orientation the new triangle `tri` (cut from input triangle `parent`) must keep.
+    /// Every piece of a subdivision holds an input vertex, and lies on that vertex's side of
+    /// the crease: the expected normal is the normal of the plane of its input vertices that
+    /// the triangle lies on best (papers: the plane of the vertex's red triangles; extended: its
+    /// label planes). A triangle without such a plane (collapses can leave only new vertices)
+    /// uses its new vertices' planes, and failing those [`Run::reference_normal`]. A triangle
+    /// pointing against it is *reversed*: folded over against the surface it approximates.
+    pub(crate) fn expected_normal(&self, tri: &[u32; 3], parent: usize) -> DVec3 {
+        let nv = self.mesh.positions.len() as u32;
+        let p = tri.map(|v| self.positions[v as usize]);
+        let mut best = (f64::INFINITY, DVec3::ZERO);
+        for pass in [true, false] {
+            for &v in tri {
+                if (v < nv) != pass {
+                    continue;
+                }
+                self.for_each_plane(v, |pl| {
+                    if pl.normal == DVec3::ZERO {
+                        return;
+                    }
+                    let d = p
+                        .iter()
+                        .map(|q| (*q - pl.point).dot(pl.normal).abs())
+                        .fold(0.0f64, f64::max);
+                    if d < best.0 {
+                        best = (d, pl.normal);
+                    }
+                });
+            }
+            if best.0.is_finite() {
+                return best.1;
+            }
+        }
+        self.reference_normal(parent)
+    }
+
+    /// True when the triangle `tri` at positions `p`, cut from input triangle `parent`, is
+    /// reversed (see [`Run::expected_normal`]). A triangle whose vertices are the parent's
+    /// corners and its new vertices at rest lies in the parent's plane: reversed only if it
+    /// points against the parent.
+    pub(crate) fn is_reversed(&self, tri: &[u32; 3], parent: usize, p: &[DVec3; 3]) -> bool {
+        let area = (p[1] - p[0]).cross(p[2] - p[0]);
+        if self.at_rest_in(tri, parent) {
+            return area.dot(self.s.normals[parent]) <= 0.0
+                && self.s.normals[parent] != DVec3::ZERO;
+        }
+        let n = self.expected_normal(tri, parent);
+        n != DVec3::ZERO && area.dot(n) <= 0.0
+    }
+
+    /// True when every vertex of `tri` is a corner of input triangle `t` (unmoved) or a new
+    /// vertex of `t`'s subdivision at its rest position.
+    fn at_rest_in(&self, tri: &[u32; 3], t: usize) -> bool {
+        let nv = self.mesh.positions.len();
+        let corners = self.mesh.triangles[t];
+        tri.iter().all(|&v| {
+            if (v as usize) < nv {
+                corners.contains(&v) && self.s.vflags[v as usize] & V_MOVED == 0
+            } else {
+                let n = &self.s.new_vertices[v as usize - nv];
+                n.status != SNAPPED && self.triangles_of_new(v).contains(&(t as u32))
+            }
+        })
+    }
+
+    /// The orientation a new triangle cut from input triangle `t` must keep ("the area it
+    /// replaces"): the normalised sum of the area vectors of every input triangle around the
+    /// three corners of `t`. A single chamfer triangle can lean towards either face, so on an
+    /// acute crease a correct piece may turn by more than 90 degrees from it; the two-ring
+    /// around it is centred on the crease. Zero when that area cancels, in which case nothing is
+    /// checked.
+    pub(crate) fn reference_normal(&self, t: usize) -> DVec3 {
+        if let Some(n) = self.ref_normals.get(&(t as u32)) {
+            return *n;
+        }
+        self.compute_reference_normal(t)
+    }
+
+    fn compute_reference_normal(&self, t: usize) -> DVec3 {
+        let mut n = DVec3::ZERO;
+        for &v in &self.mesh.triangles[t] {
+            for c in self.table.vertex_corners(VertexId(v)) {
+                n += self.mesh.face_cross(c.index() / 3);
+            }
+        }
+        n.normalize_or_zero()
+    }
+
+    /// Caches the reference normals of the touched triangles.
+    fn cache_reference_normals(&mut self) {
+        self.ref_normals.clear();
+        for i in 0..self.s.touched.len() {
+            let t = self.s.touched[i];
+            let n = self.compute_reference_normal(t as usize);
+            self.ref_normals.insert(t, n);
+        }
+    }
+
+    /// The triangles of the subdivision of input triangle `t`, with the current diagonal
+    /// choice. Returns the pieces and their number.
+    ///
+    /// ```text
+    /// corner triangle (centre w): a fan around w over the boundary cycle
+    ///   v0 [m2] v1 [m0] v2 [m1]   (m_i on the edge opposite v_i, when it is split)
+    /// otherwise, by the number of split edges (seed 001 Figure 5):
+    ///   0: the triangle; 1: two triangles from the opposite corner to m;
+    ///   2: the corner triangle (v0, a, b) and the quad (a, v1, v2, b) cut by a diagonal
+    /// ```
+    pub(crate) fn pieces(&self, t: usize) -> ([[u32; 3]; 6], usize) {
+        let tri = self.mesh.triangles[t];
+        let m = [
+            self.s.edge_vertex[3 * t],
+            self.s.edge_vertex[3 * t + 1],
+            self.s.edge_vertex[3 * t + 2],
+        ];
+        let mut out = [[0u32; 3]; 6];
+        let w = self.s.center.get(t).copied().unwrap_or(NONE);
+        if w != NONE {
+            let mut cycle = [0u32; 6];
+            let mut n = 0;
+            for (v, split) in [(tri[0], m[2]), (tri[1], m[0]), (tri[2], m[1])] {
+                cycle[n] = v;
+                n += 1;
+                if split != NONE {
+                    cycle[n] = split;
+                    n += 1;
+                }
+            }
+            for k in 0..n {
+                out[k] = [cycle[k], cycle[(k + 1) % n], w];
+            }
+            return (out, n);
+        }
+        let split = m.iter().filter(|&&x| x != NONE).count();
+        match split {
+            1 => {
+                let i = m.iter().position(|&x| x != NONE).unwrap_or(0);
+                let (v0, v1, v2) = (tri[i], tri[(i + 1) % 3], tri[(i + 2) % 3]);
+                out[0] = [v0, v1, m[i]];
+                out[1] = [v0, m[i], v2];
+                (out, 2)
+            }
+            2 => {
+                let i = m.iter().position(|&x| x == NONE).unwrap_or(0);
+                let (v0, v1, v2) = (tri[i], tri[(i + 1) % 3], tri[(i + 2) % 3]);
+                let a = m[(i + 2) % 3]; // on v0-v1
+                let b = m[(i + 1) % 3]; // on v2-v0
+                out[0] = [v0, a, b];
+                if self.s.tflags[t] & T_DIAG == 0 {
+                    out[1] = [a, v1, v2];
+                    out[2] = [a, v2, b];
+                } else {
+                    out[1] = [a, v1, b];
+                    out[2] = [b, v1, v2];
+                }
+                (out, 3)
+            }
+            // No split, or (impossible: three split edges always make a corner triangle) three
+            // without a centre: the triangle itself.
+            _ => {
+                out[0] = tri;
+                (out, 1)
+            }
+        }
+    }
+
+    /// True when `v` (an output index) is displaced from where it would change nothing: a
+    /// snapped new vertex, or an input chamfer vertex the extended method moved.
+    #[inline]
+    pub(crate) fn is_snapped(&self, v: u32) -> bool {
+        let nv = self.mesh.positions.len();
+        if (v as usize) < nv {
+            self.s.vflags[v as usize] & V_MOVED != 0
+        } else {
+            self.s.new_vertices[v as usize - nv].status == SNAPPED
+        }
+    }
+
+    /// Where `v` goes when unsnapped: the rest position of a new vertex, the input position of
+    /// an input vertex.
+    fn rest_of(&self, v: u32) -> DVec3 {
+        let nv = self.mesh.positions.len();
+        if (v as usize) < nv {
+            self.mesh.positions[v as usize]
+        } else {
+            self.s.new_vertices[v as usize - nv].rest
+        }
+    }
+
+    /// Puts `v` back at its rest position (a new vertex, for `reason`) or at its input position
+    /// (a moved input vertex).
+    pub(crate) fn unsnap(&mut self, v: u32, reason: UnmovedReason) {
+        let nv = self.mesh.positions.len();
+        if (v as usize) < nv {
+            if self.s.vflags[v as usize] & V_MOVED != 0 {
+                self.s.vflags[v as usize] &= !V_MOVED;
+                self.positions[v as usize] = self.mesh.positions[v as usize];
+            }
+            return;
+        }
+        let k = v as usize - nv;
+        let nvx = &mut self.s.new_vertices[k];
+        if nvx.status == SNAPPED {
+            nvx.status = 1 + reason.index() as u8;
+            self.positions[v as usize] = nvx.rest;
+        }
+    }
+
+    /// The input vertices new vertex `v` was inserted between: the ends of its edge, or the
+    /// corners of its triangle.
+    pub(crate) fn origin_vertices(&self, v: u32) -> Vec<u32> {
+        let k = v as usize - self.mesh.positions.len();
+        match self.s.new_vertices[k].kind {
+            Kind::Edge(c) => vec![self.cv(next(c as usize)), self.cv(prev(c as usize))],
+            Kind::Center(t) => self.mesh.triangles[t as usize].to_vec(),
+        }
+    }
+
+    /// Input triangles whose subdivision uses `v` (for an input vertex: those around it).
+    pub(crate) fn triangles_of(&self, v: u32) -> Vec<u32> {
+        if (v as usize) < self.mesh.positions.len() {
+            self.table
+                .vertex_corners(VertexId(v))
+                .map(|c| c.0 / 3)
+                .collect()
+        } else {
+            self.triangles_of_new(v)
+                .into_iter()
+                .filter(|&t| t != NONE)
+                .collect()
+        }
+    }
+
+    /// Input triangles whose subdivision uses new vertex `v`.
+    pub(crate) fn triangles_of_new(&self, v: u32) -> [u32; 2] {
+        let k = v as usize - self.mesh.positions.len();
+        match self.s.new_vertices[k].kind {
+            Kind::Edge(c) => {
+                let o = self.table.opposite(CornerId(c)).map_or(NONE, |o| o.0 / 3);
+                [c / 3, o]
+            }
+            Kind::Center(t) => [t, NONE],
+        }
+    }
+
+    /// Chooses diagonals and unsnaps vertices until no piece reverses its input triangle or
+    /// has an edge with a snapped end longer than the longest input edge.
+    fn settle_positions(&mut self) {
+        let limit = self.max_edge * self.edge_limit_factor();
+        let max2 = limit * limit;
+        let mut stack = std::mem::take(&mut self.s.stack);
+        stack.clear();
+        stack.extend_from_slice(&self.s.touched);
+        while let Some(t) = stack.pop() {
+            let t = t as usize;
+            self.choose_diagonal(t);
+            let (pieces, n) = self.pieces(t);
+            let mut victim: Option<(u32, UnmovedReason)> = None;
+            'pieces: for piece in &pieces[..n] {
+                let p = piece.map(|v| self.positions[v as usize]);
+                // A thin piece's normal means little; the sliver pass removes it (and checks
+                // the orientation of what replaces it).
+                if min_angle(&p) >= SETTLE_MIN_ANGLE.to_radians() && self.is_reversed(piece, t, &p)
+                {
+                    victim = self
+                        .worst_snapped(piece.iter().copied())
+                        .map(|v| (v, UnmovedReason::Flipped));
+                    if victim.is_some() {
+                        break 'pieces;
+                    }
+                }
+                for k in 0..3 {
+                    let (a, b) = (piece[k], piece[(k + 1) % 3]);
+                    if (self.is_snapped(a) || self.is_snapped(b))
+                        && p[k].distance_squared(p[(k + 1) % 3]) > max2
+                    {
+                        victim = self
+                            .worst_snapped([a, b].into_iter())
+                            .map(|v| (v, UnmovedReason::TooLong));
+                        break 'pieces;
+                    }
+                }
+            }
+            if let Some((v, reason)) = victim {
+                self.unsnap(v, reason);
+                for u in self.triangles_of(v) {
+                    if self.s.tflags[u as usize] & T_TOUCHED != 0 {
+                        stack.push(u);
+                    }
+                }
+            }
+        }
+        self.s.stack = stack;
+    }
+
+    /// New edges may be this many times the longest input edge: 1 in the papers; 2 in the
+    /// extended method, whose corner vertices on marching-cubes meshes sit up to sqrt(3) cells
+    /// from the cut-off corner's vertices (docs/sharpen.md).
+    fn edge_limit_factor(&self) -> f64 {
+        match self.opts.method {
+            Method::Papers => 1.0,
+            _ => 2.0,
+        }
+    }
+
+    /// The snapped new vertex among `vs` that moved farthest from its rest position.
+    fn worst_snapped(&self, vs: impl Iterator<Item = u32>) -> Option<u32> {
+        vs.filter(|&v| self.is_snapped(v))
+            .map(|v| {
+                (
+                    v,
+                    self.positions[v as usize].distance_squared(self.rest_of(v)),
+                )
+            })
+            .max_by(|x, y| x.1.total_cmp(&y.1))
+            .map(|(v, _)| v)
+    }
+
+    /// For a triangle with two chamfer edges, picks the quad diagonal whose two triangles have
+    /// the larger smallest angle, preferring one that reverses nothing.
+    fn choose_diagonal(&mut self, t: usize) {
+        let m = &self.s.edge_vertex[3 * t..3 * t + 3];
+        if m.iter().filter(|&&x| x != NONE).count() != 2 {
+            return;
+        }
+        let mut best = (false, f64::NEG_INFINITY, 0u8);
+        for diag in [0u8, T_DIAG] {
+            self.s.tflags[t] = (self.s.tflags[t] & !T_DIAG) | diag;
+            let (pieces, _) = self.pieces(t);
+            let mut ok = true;
+            let mut worst = f64::INFINITY;
+            for piece in &pieces[1..3] {
+                let p = piece.map(|v| self.positions[v as usize]);
+                if self.is_reversed(piece, t, &p) {
+                    ok = false;
+                }
+                worst = worst.min(min_angle(&p));
+            }
+            if (ok, worst) > (best.0, best.1) {
+                best = (ok, worst, diag);
+            }
+        }
+        self.s.tflags[t] = (self.s.tflags[t] & !T_DIAG) | best.2;
+    }
+
+    /// Tagged vertices (3bis plus the surviving new vertices) and the edges between them.
+    fn tags(&mut self, mesh: &Mesh) -> SharpTags {
+        let nv = self.mesh.positions.len();
+        let mut flags = vec![false; mesh.positions.len()];
+        for (v, f) in flags.iter_mut().enumerate() {
+            *f = if v < nv {
+                self.s.vflags[v] & V_TAG != 0
+            } else {
+                true
+            };
+        }
+        let tags = SharpTags::from_vertex_flags(mesh, &flags);
+        self.report.tagged_vertices = tags.vertices.len();
+        self.report.sharp_edges = tags.edges.len();
+        tags
+    }
+
+    fn extend_detection(&mut self) {
+        crate::extended::classify(self);
+    }
+}
+
+/// Labels the smooth regions: the connected components of red triangles through smooth
+/// edges (what filter 3's flood connects), numbered 0.. in order of their lowest triangle.
+/// Union-find in one pass over the triangles (neighbours are mostly close in index order,
+/// which keeps it cache friendly), then one pass to number the roots.
+fn label_regions(s: &mut Scratch, table: &CornerTable, nt: usize) {
+    let region = &mut s.region;
+    region.clear();
+    region.extend(0..nt as u32);
+    fn find(p: &mut [u32], mut x: u32) -> u32 {
+        while p[x as usize] != x {
+            let g = p[p[x as usize] as usize];
+            p[x as usize] = g;
+            x = g;
+        }
+        x
+    }
+    for t in 0..nt {
+        if s.tflags[t] & T_RED == 0 {
+            continue;
+        }
+        for c in 3 * t..3 * t + 3 {
+            if s.cflags[c] & C_BROWN == 0 {
+                continue;
+            }
+            if let Some(o) = table.opposite(CornerId(c as u32)) {
+                let u = o.index() / 3;
+                if u < t && s.tflags[u] & T_RED != 0 {
+                    let (a, b) = (find(region, t as u32), find(region, u as u32));
+                    if a != b {
+                        // The smaller root wins: roots are then the lowest triangle of each set.
+                        let (lo, hi) = if a < b { (a, b) } else { (b, a) };
+                        region[hi as usize] = lo;
+                    }
+                }
+            }
+        }
+    }
+    // Number the roots in order; every non-root points to a smaller index, so one forward
+    // pass resolves them.
+    let mut next_label = 0u32;
+    for t in 0..nt {
+        if s.tflags[t] & T_RED == 0 {
+            region[t] = NONE;
+            continue;
+        }
+        let p = region[t] as usize;
+        if p == t {
+            region[t] = next_label;
+            next_label += 1;
+        } else {
+            // p < t: already renumbered (roots are labels now, non-roots their root's label).
+            region[t] = region[p];
+        }
+    }
+}
+
+/// Angle between two unit vectors. Most edges of a sampled surface are nearly flat, so the
+/// chord `c = |a - b|` is small and `2 asin(c / 2) = c + c^3/24 + 3c^5/640 + 5c^7/7168 + ...`
+/// converges fast: under c = 0.5 (29 degrees) the omitted terms are below 3e-7 rad, far under
+/// anything the smooth test can resolve, at a fraction of the cost of `atan2`; above it
+/// [`fast_angle`] (2e-5 rad). Both use only IEEE arithmetic and `sqrt`, so the smooth test gives
+/// the same answer on every platform (libm's `atan2` need not).
+#[inline]
+fn normal_angle(a: DVec3, b: DVec3) -> f64 {
+    let c2 = a.distance_squared(b);
+    if c2 < 0.25 {
+        let c = c2.sqrt();
+        c * (1.0 + c2 * (1.0 / 24.0 + c2 * (3.0 / 640.0 + c2 * (5.0 / 7168.0))))
+    } else {
+        fast_angle(a, b)
+    }
+}
+
+/// Smallest interior angle of a triangle, in radians (0 when two corners coincide): the angle
+/// opposite the shortest side (law of sines), by [`fast_angle`] (2e-5 rad, 0.001 degree: far
+/// below anything the 1-degree sliver test or a quality comparison resolves).
+#[inline]
+pub(crate) fn min_angle(p: &[DVec3; 3]) -> f64 {
+    let l = [
+        p[1].distance_squared(p[2]),
+        p[2].distance_squared(p[0]),
+        p[0].distance_squared(p[1]),
+    ];
+    let k = if l[0] <= l[1] && l[0] <= l[2] {
+        0
+    } else if l[1] <= l[2] {
+        1
+    } else {
+        2
+    };
+    let e1 = p[(k + 1) % 3] - p[k];
+    let e2 = p[(k + 2) % 3] - p[k];
+    if e1 == DVec3::ZERO || e2 == DVec3::ZERO {
+        return 0.0;
+    }
+    fast_angle(e1, e2)
+}
+
+/// Angle between two vectors with an absolute error under 2e-5 rad: `atan2` by a minimax
+/// polynomial of atan on [0, 1] (Abramowitz & Stegun 4.4.49 style, degree 9). For weights,
+/// where the papers' own choice of weight matters far more than this error.
+#[inline]
+pub(crate) fn fast_angle(a: DVec3, b: DVec3) -> f64 {
+    let y = a.cross(b).length();
+    let x = a.dot(b);
+    if y == 0.0 && x == 0.0 {
+        return 0.0;
+    }
+    let (ax, ay) = (x.abs(), y);
+    let (t, swap) = if ay > ax {
+        (ax / ay, true)
+    } else {
+        (ay / ax, false)
+    };
+    let t2 = t * t;
+    let mut r = t
+        * (0.999_866_0
+            + t2 * (-0.330_299_5 + t2 * (0.180_141_0 + t2 * (-0.085_133_0 + t2 * 0.020_835_1))));
+    if swap {
+        r = std::f64::consts::FRAC_PI_2 - r;
+    }
+    if x < 0.0 {
+        r = std::f64::consts::PI - r;
+    }
+    r
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use whet_mesh::angle_between;
+
+    #[test]
+    fn fast_angle_is_accurate_to_2e_5() {
+        // Deterministic directions all over the sphere, including near-parallel and opposite.
+        let mut worst: f64 = 0.0;
+        let mut seed = 0x9E37_79B9_7F4A_7C15u64;
+        let mut rnd = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        for i in 0..20_000 {
+            let a = DVec3::new(rnd(), rnd(), rnd());
+            let mut b = DVec3::new(rnd(), rnd(), rnd());
+            if i % 4 == 0 {
+                b = a + b * 1e-4;
+            } else if i % 4 == 1 {
+                b = -a + b * 1e-4;
+            }
+            worst = worst.max((fast_angle(a, b) - angle_between(a, b)).abs());
+        }
+        assert!(worst < 2e-5, "{worst}");
+        assert_eq!(fast_angle(DVec3::ZERO, DVec3::X), 0.0);
+    }
+
+    #[test]
+    fn normal_angle_matches_atan2() {
+        let a = DVec3::new(0.3, -0.2, 0.9).normalize();
+        for t in [1e-9, 1e-4, 0.01, 0.1, 0.3, 0.49, 0.6, 1.5, 3.0] {
+            let b = (a + DVec3::new(0.2, 0.7, -0.1).normalize() * t).normalize();
+            let tol = if t < 0.4 { 1e-6 } else { 2e-5 };
+            assert!(
+                (normal_angle(a, b) - angle_between(a, b)).abs() < tol,
+                "{t}"
+            );
+        }
+    }
+
+    #[test]
+    fn min_angle_is_the_angle_opposite_the_shortest_side() {
+        let p = [
+            DVec3::ZERO,
+            DVec3::new(4.0, 0.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+        ];
+        assert!((min_angle(&p) - (0.25f64).atan()).abs() < 2e-5);
+        assert_eq!(min_angle(&[DVec3::ZERO, DVec3::ZERO, DVec3::X]), 0.0);
+    }
+}

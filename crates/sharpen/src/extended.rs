@@ -1,0 +1,863 @@
+//! The extended chamfer detection of [`Method::Extended`](crate::Method::Extended)
+//! (docs/sharpen.md, "What we extend", has the reasons and the measurements).
+//!
+//! The papers split an edge only when both of its ends lie on the border of a smooth (red)
+//! region. On marching-cubes and other irregular samplings many chamfer triangles have a
+//! vertex that lies in no red triangle at all (a *gray* vertex, too close to the crease for any
+//! of its triangles to be smooth), so they are never split and the chamfer survives, with the
+//! largest errors at corners. We extend the detection with *labels*, one per smooth surface:
+//!
+//! 1. regions: the connected components of filter 3's flood (labelled in `filters`); thin
+//!    corridors whose vertices lie on their neighbours' planes are demoted (`demote_corridors`);
+//! 2. label planes: one per region around each region-border vertex (`border_planes`);
+//! 3. each gray vertex takes the label plane of a neighbour that it lies on (`gray_vertices`);
+//! 4. vertices on two surfaces get both labels; gray ones move onto their crease
+//!    (`crease_vertices`, `snap_chamfer_vertices`); the nearest gray vertex of a corner point
+//!    moves onto it (`corner_vertices`);
+//! 5. chamfer edges join vertices that share no surface (`is_chamfer_edge`), corner triangles
+//!    are those whose vertices span three surfaces (`is_corner_triangle`; by Sperner's lemma
+//!    every corner of three labelled faces has one), and new vertices snap onto the planes of
+//!    the best pair or triple when the point is consistent with the neighbours' planes and
+//!    supported by the input surface (`edge_snap`, `corner_snap`).
+//!
+//! Red vertices never move; gray ones only within their chamfer.
+
+use glam::DVec3;
+use whet_mesh::{CornerId, VertexId};
+
+use crate::edge_sharpener::{
+    next, Planes, Run, C_RED, NONE, T_RED, T_TOUCHED, V_CHAMFER, V_CORE, V_MOVED, V_RED, V_USED,
+};
+use crate::report::UnmovedReason;
+use crate::snap::{self, Plane};
+
+/// A gray vertex joins a neighbouring plane when it lies within this fraction of its mean
+/// edge length from it. Measured on marching cubes of cube, pyramid and fandisk at 64 and 128:
+/// 85-90 % of gray vertices lie within 0.25 edge lengths of the nearest neighbouring plane, the
+/// rest are vertices the interpolation put inside the chamfer. Tuned on the synth table
+/// (docs/results.md): 0.5 gains a little RMS at 64-128 but mislabels vertices of fandisk at 32
+/// (one case then gets worse), 0.3 loses RMS everywhere.
+pub(crate) const GRAY_TOLERANCE: f64 = 0.4;
+
+/// Labelling passes over the gray vertices (each reaches one ring further into a chamfer).
+/// One: measured on the stand-in retilings (docs/results.md), a second and third pass reach
+/// into blends a few samples wide (cad_cyl_fillet's fillet, cad_box_hole's hole), whose two
+/// sides then meet and get sharpened into a crease, making those cases worse; on the synth
+/// samplings they gain nothing.
+pub(crate) const GRAY_PASSES: usize = 1;
+
+/// A labelled gray (chamfer) vertex also takes a neighbour's non-parallel label plane when it
+/// lies within this fraction of its mean edge length from it: it is next to the crease, and
+/// moves onto it ([`snap_chamfer_vertices`]); if it cannot move it keeps one label.
+pub(crate) const CREASE_TOLERANCE: f64 = 0.3;
+
+/// The same for a red vertex, which never moves: only one practically on the crease takes a
+/// second label. Without it, an error of the crease estimate larger than the vertex's distance
+/// to the crease would fold the small piece it anchors.
+pub(crate) const RED_CREASE_TOLERANCE: f64 = 0.05;
+
+/// One region's plane at a vertex.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LabelPlane {
+    pub label: u32,
+    pub plane: Plane,
+}
+
+/// Labels regions and border vertices, then classifies the gray vertices.
+pub(crate) fn classify(run: &mut Run) {
+    demote_corridors(run);
+    border_planes(run);
+    gray_vertices(run);
+    crease_vertices(run);
+    snap_chamfer_vertices(run);
+}
+
+/// A chamfer vertex moves onto its crease or corner only when that is within this fraction of
+/// its mean edge length (it lies within [`CREASE_TOLERANCE`] of its second plane, so farther
+/// targets mean inconsistent planes).
+pub(crate) const MOVE_LIMIT: f64 = 0.5;
+
+/// Moves each labelled gray (chamfer) vertex that lies on two or more surfaces onto their
+/// intersection: the point of the crease line nearest to it, or the (least-squares) corner
+/// point. Only gray vertices move, never the vertices of smooth (red) triangles.
+fn snap_chamfer_vertices(run: &mut Run) {
+    let nv = run.mesh.positions.len();
+    let mut moves: Vec<(u32, DVec3)> = Vec::new();
+    let mut stay: Vec<u32> = Vec::new();
+    for v in 0..nv as u32 {
+        if run.s.vflags[v as usize] & V_CHAMFER == 0 {
+            continue;
+        }
+        if run.s.lp_len[v as usize] > 1 {
+            // Assume it stays; a successful move below removes it from the list.
+            stay.push(v);
+        }
+        let mut kept: Vec<LabelPlane> = Vec::new();
+        for lp in planes_of(run, v) {
+            if kept.iter().all(|k| !same_surface(run, k, lp)) {
+                kept.push(*lp);
+            }
+        }
+        let surfaces: Vec<Plane> = kept.iter().map(|k| k.plane).collect();
+        if surfaces.len() < 2 || !well_separated(run, &surfaces) {
+            continue;
+        }
+        let p = run.mesh.positions[v as usize];
+        let target = if surfaces.len() == 2 {
+            snap::line_point(&surfaces[0], &surfaces[1], p)
+        } else {
+            snap::planes_point(&surfaces, p)
+        };
+        let Some(target) = target else { continue };
+        let mut len = 0.0;
+        let mut k = 0usize;
+        for c in run.table.vertex_corners(VertexId(v)) {
+            len += (run.mesh.positions[run.cv(next(c.index())) as usize] - p).length();
+            k += 1;
+        }
+        if k == 0 || target.distance(p) > MOVE_LIMIT * len / k as f64 {
+            continue;
+        }
+        // The fan around the vertex must stay unfolded and free of thin triangles.
+        let thin = run.opts.min_angle_degrees.to_radians();
+        let fan_ok = run.table.vertex_corners(VertexId(v)).all(|c| {
+            let t = c.index() / 3;
+            let tri = run.mesh.triangles[t];
+            let q = tri.map(|x| {
+                if x == v {
+                    target
+                } else {
+                    run.mesh.positions[x as usize]
+                }
+            });
+            let area = (q[1] - q[0]).cross(q[2] - q[0]);
+            area.dot(run.mesh.face_cross(t)) > 0.0 && crate::edge_sharpener::min_angle(&q) >= thin
+        });
+        if fan_ok {
+            moves.push((v, target));
+            stay.pop();
+        }
+    }
+    // A chamfer vertex that cannot reach its crease is on one surface only.
+    for v in stay {
+        run.s.lp_len[v as usize] = 1;
+    }
+    for (v, target) in moves {
+        run.positions[v as usize] = target;
+        run.s.vflags[v as usize] |= V_MOVED;
+        for c in run.table.vertex_corners(VertexId(v)) {
+            run.s.tflags[c.index() / 3] |= T_TOUCHED;
+        }
+    }
+}
+
+/// A corridor region is a chamfer when at most this fraction of its vertices is off the
+/// neighbours' planes. Measured on marching cubes of cube and fandisk at 32-64 with two
+/// rotations: chamfer strips that passed the smooth test have 3-10 % of their vertices off
+/// (interpolation puts a few samples inside a chamfer), fandisk's real narrow bands 75-85 %.
+pub(crate) const CORRIDOR_OFF_FRACTION: f64 = 0.25;
+
+/// A vertex of a corridor region is *on a neighbour* when it lies within this fraction of its
+/// mean edge length from a neighbouring region's plane (see [`demote_corridors`]).
+pub(crate) const CORRIDOR_ON_PLANE: f64 = 0.1;
+
+/// Demotes *chamfer corridors*: smooth regions too thin to have a vertex whose whole two-ring
+/// lies in them (the papers' "thin corridors of smoothly connected triangles, which although
+/// smooth, may correspond to the actual chamfers", seed 001 section 3.1) and almost all of
+/// whose vertices lie on the planes of neighbouring regions. Their triangles stop being red, so their
+/// vertices are classified like any chamfer vertex. This reaches what the papers' core test
+/// (filter 1) misses on coarse samplings.
+fn demote_corridors(run: &mut Run) {
+    let nv = run.mesh.positions.len();
+    let nt = run.mesh.triangles.len();
+    let nregions = run
+        .s
+        .region
+        .iter()
+        .filter(|&&r| r != NONE)
+        .max()
+        .map_or(0, |&m| m as usize + 1);
+    if nregions == 0 {
+        return;
+    }
+    // A region is thick when it has a *deep* vertex: a core vertex (filter 1: all its edges
+    // smooth, so its whole fan lies in one region) whose neighbours are all core too. One pass
+    // over the corners.
+    let core = |v: usize| run.s.vflags[v] & V_CORE != 0;
+    let mut deep: Vec<bool> = (0..nv).map(core).collect();
+    let mut of: Vec<u32> = vec![NONE; nv];
+    for (t, tri) in run.mesh.triangles.iter().enumerate() {
+        for k in 0..3 {
+            let v = tri[k] as usize;
+            if deep[v] {
+                of[v] = run.s.region[t];
+                if !core(tri[(k + 1) % 3] as usize) {
+                    deep[v] = false;
+                }
+            }
+        }
+    }
+    let mut thick = vec![false; nregions];
+    for v in 0..nv {
+        if deep[v] && of[v] != NONE {
+            thick[of[v] as usize] = true;
+        }
+    }
+    if thick.iter().all(|&t| t) {
+        return;
+    }
+    // A thin region is a chamfer when every one of its vertices lies on a neighbouring
+    // region's plane: marching cubes, scanners and retilers put their samples on the true
+    // surface, so a chamfer strip has no vertex of its own, while a real narrow face has (its
+    // core vertex at least is on none of its neighbours).
+    let mut off = vec![0usize; nregions];
+    let mut count = vec![0usize; nregions];
+    let mut seen = vec![false; nv];
+    for t in 0..nt {
+        let r = run.s.region[t];
+        if r == NONE || thick[r as usize] {
+            continue;
+        }
+        for &v in &run.mesh.triangles[t] {
+            if seen[v as usize] {
+                continue;
+            }
+            seen[v as usize] = true;
+            count[r as usize] += 1;
+            if neighbour_plane_distance(run, v, r) > CORRIDOR_ON_PLANE {
+                off[r as usize] += 1;
+            }
+        }
+    }
+    let mut demoted: Vec<bool> = (0..nregions)
+        .map(|r| (off[r] as f64) <= CORRIDOR_OFF_FRACTION * count[r] as f64)
+        .collect();
+    let mut any = false;
+    for r in 0..nregions {
+        if thick[r] {
+            demoted[r] = false;
+        }
+        any |= demoted[r];
+    }
+    if !any {
+        return;
+    }
+    for t in 0..nt {
+        let r = run.s.region[t];
+        if r != NONE && demoted[r as usize] {
+            run.s.region[t] = NONE;
+            run.s.tflags[t] &= !T_RED;
+        }
+    }
+    // Filter 4 again for the red triangles that remain.
+    for f in run.s.vflags.iter_mut() {
+        *f &= !V_RED;
+    }
+    for f in run.s.cflags.iter_mut() {
+        *f &= !C_RED;
+    }
+    for t in 0..nt {
+        if run.s.tflags[t] & T_RED == 0 {
+            continue;
+        }
+        for c in 3 * t..3 * t + 3 {
+            run.s.cflags[c] |= C_RED;
+            if let Some(o) = run.table.opposite(CornerId(c as u32)) {
+                run.s.cflags[o.index()] |= C_RED;
+            }
+            let v = run.cv(c) as usize;
+            run.s.vflags[v] |= V_RED;
+        }
+    }
+}
+
+/// Distance of vertex `v` from the nearest plane of a red triangle of another region than `r`
+/// around it or around a neighbour, in units of its mean edge length.
+fn neighbour_plane_distance(run: &Run, v: u32, r: u32) -> f64 {
+    let p = run.mesh.positions[v as usize];
+    let mut len = 0.0;
+    let mut k = 0usize;
+    let mut best = f64::INFINITY;
+    for c in run.table.vertex_corners(VertexId(v)) {
+        let u = run.cv(next(c.index()));
+        len += (run.mesh.positions[u as usize] - p).length();
+        k += 1;
+        for x in [v, u] {
+            for cc in run.table.vertex_corners(VertexId(x)) {
+                let t = cc.index() / 3;
+                let rt = run.s.region[t];
+                if rt == NONE || rt == r {
+                    continue;
+                }
+                let n = run.s.normals[t];
+                let q = run.mesh.positions[run.mesh.triangles[t][0] as usize];
+                best = best.min((p - q).dot(n).abs());
+            }
+        }
+    }
+    best / (len / k.max(1) as f64)
+}
+
+/// Label planes of the red vertices that touch a non-red triangle or two regions.
+fn border_planes(run: &mut Run) {
+    let nv = run.mesh.positions.len();
+    run.s.lp_start.clear();
+    run.s.lp_start.resize(nv, NONE);
+    run.s.lp_len.clear();
+    run.s.lp_len.resize(nv, 0);
+    run.s.lps.clear();
+    // Border vertices in one pass over the corners: a red vertex with a non-red triangle or
+    // triangles of two regions.
+    let mut first: Vec<u32> = vec![NONE; nv];
+    let mut border: Vec<bool> = vec![false; nv];
+    for (t, tri) in run.mesh.triangles.iter().enumerate() {
+        let t_region = run.s.region[t];
+        for &v in tri {
+            let v = v as usize;
+            if run.s.vflags[v] & V_RED == 0 {
+                continue;
+            }
+            if t_region == NONE {
+                border[v] = true;
+            } else if first[v] == NONE {
+                first[v] = t_region;
+            } else if first[v] != t_region {
+                border[v] = true;
+            }
+        }
+    }
+    drop(first);
+    let mut acc: Vec<(u32, DVec3)> = Vec::new();
+    for v in 0..nv {
+        if !border[v] {
+            continue;
+        }
+        acc.clear();
+        for c in run.table.vertex_corners(VertexId(v as u32)) {
+            let t = c.index() / 3;
+            let r = run.s.region[t];
+            if r == NONE {
+                continue;
+            }
+            let w = run.s.normals[t] * run.corner_angle(c.index());
+            match acc.iter_mut().find(|(l, _)| *l == r) {
+                Some((_, n)) => *n += w,
+                None => acc.push((r, w)),
+            }
+        }
+        run.s.lp_start[v] = run.s.lps.len() as u32;
+        let point = run.mesh.positions[v];
+        for &(label, n) in acc.iter().take(u8::MAX as usize) {
+            let normal = n.normalize_or_zero();
+            if normal != DVec3::ZERO {
+                run.s.lps.push(LabelPlane {
+                    label,
+                    plane: Plane { point, normal },
+                });
+                run.s.lp_len[v] += 1;
+            }
+        }
+    }
+}
+
+/// The label planes of vertex `v`.
+#[inline]
+pub(crate) fn planes_of<'a>(run: &'a Run, v: u32) -> &'a [LabelPlane] {
+    let start = run.s.lp_start[v as usize];
+    if start == NONE {
+        return &[];
+    }
+    let len = run.s.lp_len[v as usize] as usize;
+    &run.s.lps[start as usize..start as usize + len]
+}
+
+/// Gives each gray vertex the nearest label plane of a neighbour when it lies on it.
+fn gray_vertices(run: &mut Run) {
+    let nv = run.mesh.positions.len();
+    let mut gray: Vec<u32> = (0..nv as u32)
+        .filter(|&v| {
+            let f = run.s.vflags[v as usize];
+            f & V_USED != 0 && f & V_RED == 0 && !run.table.is_boundary_vertex(VertexId(v))
+        })
+        .collect();
+    let mut found: Vec<(u32, LabelPlane)> = Vec::new();
+    for _ in 0..GRAY_PASSES {
+        found.clear();
+        for &g in &gray {
+            let p = run.mesh.positions[g as usize];
+            let mut len = 0.0;
+            let mut k = 0usize;
+            let mut best: Option<(f64, LabelPlane)> = None;
+            for c in run.table.vertex_corners(VertexId(g)) {
+                let u = run.cv(next(c.index()));
+                len += (run.mesh.positions[u as usize] - p).length();
+                k += 1;
+                for lp in planes_of(run, u) {
+                    let d = (p - lp.plane.point).dot(lp.plane.normal).abs();
+                    let better = match &best {
+                        None => true,
+                        Some((bd, b)) => d < *bd || (d == *bd && lp.label < b.label),
+                    };
+                    if better {
+                        best = Some((d, *lp));
+                    }
+                }
+            }
+            if let Some((d, lp)) = best {
+                if k > 0 && d <= GRAY_TOLERANCE * len / k as f64 {
+                    found.push((g, lp));
+                }
+            }
+        }
+        if found.is_empty() {
+            break;
+        }
+        // Apply after the pass, so the result does not depend on the vertex order.
+        for &(g, lp) in &found {
+            run.s.lp_start[g as usize] = run.s.lps.len() as u32;
+            run.s.lp_len[g as usize] = 1;
+            run.s.lps.push(lp);
+            run.s.vflags[g as usize] |= V_CHAMFER;
+        }
+        gray.retain(|&g| run.s.vflags[g as usize] & V_CHAMFER == 0);
+    }
+    run.report.chamfer_vertices = run.s.vflags.iter().filter(|&&f| f & V_CHAMFER != 0).count();
+}
+
+/// Gives labelled vertices that lie on a neighbour's other, non-parallel plane that label too.
+fn crease_vertices(run: &mut Run) {
+    let nv = run.mesh.positions.len();
+    let mut extra: Vec<(u32, LabelPlane)> = Vec::new();
+    for v in 0..nv as u32 {
+        let own = planes_of(run, v);
+        if own.is_empty() || run.table.is_boundary_vertex(VertexId(v)) {
+            continue;
+        }
+        let p = run.mesh.positions[v as usize];
+        let mut len = 0.0;
+        let mut k = 0usize;
+        let mut found: Vec<LabelPlane> = Vec::new();
+        for c in run.table.vertex_corners(VertexId(v)) {
+            let u = run.cv(next(c.index()));
+            len += (run.mesh.positions[u as usize] - p).length();
+            k += 1;
+            for lp in planes_of(run, u) {
+                let new_surface = own
+                    .iter()
+                    .chain(found.iter())
+                    .all(|o| !same_surface(run, o, lp));
+                if new_surface {
+                    found.push(*lp);
+                }
+            }
+        }
+        if k == 0 {
+            continue;
+        }
+        let factor = if run.s.vflags[v as usize] & V_CHAMFER != 0 {
+            CREASE_TOLERANCE
+        } else {
+            RED_CREASE_TOLERANCE
+        };
+        let tol = factor * len / k as f64;
+        for lp in found {
+            if (p - lp.plane.point).dot(lp.plane.normal).abs() <= tol {
+                extra.push((v, lp));
+            }
+        }
+    }
+    // Rebuild the lists with the additions (applied after the scan: order independent).
+    if extra.is_empty() {
+        return;
+    }
+    extra.sort_by_key(|(v, lp)| (*v, lp.label));
+    let mut lps = Vec::with_capacity(run.s.lps.len() + extra.len());
+    let mut i = 0;
+    for v in 0..nv {
+        let own: Vec<LabelPlane> = planes_of(run, v as u32).to_vec();
+        let start = lps.len() as u32;
+        lps.extend_from_slice(&own);
+        while i < extra.len() && extra[i].0 as usize == v {
+            if lps.len() - (start as usize) < u8::MAX as usize {
+                lps.push(extra[i].1);
+            }
+            i += 1;
+        }
+        let len = lps.len() - start as usize;
+        run.s.lp_start[v] = if len == 0 { NONE } else { start };
+        run.s.lp_len[v] = len as u8;
+    }
+    run.s.lps = lps;
+}
+
+/// Planes a vertex may be moved onto must meet at angles of at least twice the smooth
+/// threshold (and, for three, with a triple product of at least [`MIN_CORNER_DET`]): the
+/// intersection of nearly parallel planes moves by the planes' error divided by the sine of
+/// their angle, and a moved input vertex, unlike a new one, changes triangles that would
+/// otherwise be left alone.
+fn well_separated(run: &Run, planes: &[Plane]) -> bool {
+    let limit = (2.0 * run.limits.threshold).min(60f64.to_radians()).cos();
+    for i in 0..planes.len() {
+        for j in i + 1..planes.len() {
+            if planes[i].normal.dot(planes[j].normal).abs() > limit {
+                return false;
+            }
+        }
+    }
+    planes.len() != 3
+        || planes[0]
+            .normal
+            .dot(planes[1].normal.cross(planes[2].normal))
+            .abs()
+            >= MIN_CORNER_DET
+}
+
+/// Smallest triple product of the unit normals of three planes whose point a vertex moves to
+/// (0.1: the planes' error is amplified at most tenfold; a cube corner has 1, the synth
+/// pyramid's base corners 0.7 and its apex triples 0.5).
+pub(crate) const MIN_CORNER_DET: f64 = 0.1;
+
+/// Number of distinct surfaces among `planes` (greedy, in order; see [`same_surface`]).
+fn surfaces(run: &Run, planes: &[LabelPlane]) -> usize {
+    let mut kept: Vec<&LabelPlane> = Vec::new();
+    for lp in planes {
+        if kept.iter().all(|k| !same_surface(run, k, lp)) {
+            kept.push(lp);
+        }
+    }
+    kept.len()
+}
+
+/// Two label planes belong to the same surface when they come from the same smooth region
+/// (whose planes turn along a curved surface: a cylinder's planes two edges apart may differ by
+/// more than the smooth threshold) or are parallel (different regions of one plane).
+#[inline]
+fn same_surface(run: &Run, a: &LabelPlane, b: &LabelPlane) -> bool {
+    a.label == b.label || parallel(run, &a.plane, &b.plane)
+}
+
+#[inline]
+fn parallel(run: &Run, a: &Plane, b: &Plane) -> bool {
+    let c = a.normal.dot(b.normal);
+    c >= run.limits.parallel_cos || c <= -run.limits.parallel_cos
+}
+
+/// Filter 6, extended: a triangle (not red) is a corner triangle when its three vertices have
+/// label planes, no surface holds all three, and one plane per vertex can be chosen so that
+/// the three are pairwise non-parallel: the corner where those surfaces meet is inside it,
+/// whether or not its edges are chamfer edges (its vertices may lie on the creases around the
+/// corner).
+pub(crate) fn is_corner_triangle(run: &Run, tri: [u32; 3]) -> bool {
+    let p = tri.map(|v| planes_of(run, v));
+    if p.iter().any(|x| x.is_empty()) {
+        return false;
+    }
+    // A vertex already on three surfaces is the corner (a corner vertex moved there).
+    if p.iter().any(|x| surfaces(run, x) >= 3) {
+        return false;
+    }
+    let mut common = false;
+    let mut spread = false;
+    for x in p[0] {
+        for y in p[1] {
+            for z in p[2] {
+                let (xy, yz, zx) = (
+                    same_surface(run, x, y),
+                    same_surface(run, y, z),
+                    same_surface(run, z, x),
+                );
+                common |= xy && yz && zx;
+                spread |= !xy && !yz && !zx;
+            }
+        }
+    }
+    spread && !common
+}
+
+/// Filter 5, extended: the non-red edge `a`-`b` is a chamfer edge when both ends have label
+/// planes and they share no surface: every pair of their planes is non-parallel.
+pub(crate) fn is_chamfer_edge(run: &Run, a: u32, b: u32) -> bool {
+    let (pa, pb) = (planes_of(run, a), planes_of(run, b));
+    !pa.is_empty()
+        && !pb.is_empty()
+        && pa
+            .iter()
+            .all(|x| pb.iter().all(|y| !same_surface(run, x, y)))
+}
+
+/// Snaps the new vertex of chamfer edge `a`-`b`: the plane pair whose line point is closest
+/// to the midpoint.
+pub(crate) fn edge_snap(
+    run: &Run,
+    a: u32,
+    b: u32,
+    anchor: DVec3,
+) -> Result<(DVec3, Planes), UnmovedReason> {
+    let mut best: Option<(f64, DVec3, Planes)> = None;
+    let mut reason = UnmovedReason::Parallel;
+    let scale = run.positions[a as usize].distance(run.positions[b as usize]);
+    for x in planes_of(run, a) {
+        for y in planes_of(run, b) {
+            match snap::edge_point(&x.plane, &y.plane, anchor, &run.limits) {
+                Ok(p) => {
+                    if !consistent(run, p, &[(a, x.label), (b, y.label)], scale)
+                        || !supported(run, p, &[a, b])
+                    {
+                        reason = UnmovedReason::Curved;
+                        continue;
+                    }
+                    let d = p.distance_squared(anchor);
+                    if better(best.as_ref().map(|b| b.0), d) {
+                        best = Some((d, p, Planes::two(x.plane, y.plane)));
+                    }
+                }
+                Err(r) => {
+                    if r != UnmovedReason::Parallel {
+                        reason = r;
+                    }
+                }
+            }
+        }
+    }
+    best.map(|(_, p, planes)| (p, planes)).ok_or(reason)
+}
+
+/// A snapped or moved-to point must lie within this many mean edge lengths of the input
+/// surface around it (see [`supported`]).
+pub(crate) const SUPPORT: f64 = 1.5;
+
+/// Whether point `p` lies within [`SUPPORT`] mean edge lengths of the input triangles around
+/// the vertices `around`. The crease of a sampled sharp edge is within about a cell of the
+/// chamfer that cut it (deeper only at acute creases and corners); the planes of the faces
+/// around a blend meet far above the blend (0.4 times its radius for a right angle), so a
+/// blend wider than a few samples, which the smooth test may still call a chamfer, is left
+/// alone.
+fn supported(run: &Run, p: DVec3, around: &[u32]) -> bool {
+    let mut len = 0.0;
+    let mut k = 0usize;
+    for &v in around {
+        let pv = run.mesh.positions[v as usize];
+        for c in run.table.vertex_corners(VertexId(v)) {
+            len += (run.mesh.positions[run.cv(next(c.index())) as usize] - pv).length();
+            k += 1;
+        }
+    }
+    if k == 0 {
+        return false;
+    }
+    let limit = SUPPORT * len / k as f64;
+    around.iter().any(|&v| {
+        run.table.vertex_corners(VertexId(v)).any(|c| {
+            let [a, b, q] = run.mesh.triangle_positions(c.index() / 3);
+            snap::point_triangle_distance(p, a, b, q) <= limit
+        })
+    })
+}
+
+/// Points farther than this fraction of the chamfer edge from a same-label plane of a
+/// neighbour are not trusted (see [`consistent`]). Tuned on the synth table: 0.2 costs RMS on
+/// the planar pyramid (region planes near a chamfer carry some noise), 0.4 lets coarse
+/// fandisk samplings snap onto badly extrapolated cylinder planes.
+pub(crate) const CURVED_TOLERANCE: f64 = 0.3;
+
+/// Whether point `p`, computed from the planes of `(vertex, label)` pairs, also lies within
+/// [`CURVED_TOLERANCE`] times `scale` of the planes of the same labels at those vertices'
+/// neighbours. Where the surfaces are flat at the scale of the sampling every such plane holds
+/// the point; on a surface curved at that scale (a coarse sampling of a cylinder or cone) the
+/// extrapolated point is off the surface by about the disagreement.
+fn consistent(run: &Run, p: DVec3, sources: &[(u32, u32)], scale: f64) -> bool {
+    let tol = CURVED_TOLERANCE * scale;
+    for &(v, label) in sources {
+        for c in run.table.vertex_corners(VertexId(v)) {
+            let u = run.cv(next(c.index()));
+            for lp in planes_of(run, u) {
+                if lp.label == label && (p - lp.plane.point).dot(lp.plane.normal).abs() > tol {
+                    return false;
+                }
+            }
+        }
+    }
+    true
+}
+
+/// Snaps the new vertex of a corner triangle: the three-plane point of the best combination of
+/// its vertices' planes, else the best line point of two of them.
+pub(crate) fn corner_snap(
+    run: &Run,
+    tri: [u32; 3],
+    anchor: DVec3,
+) -> Result<(DVec3, Planes), UnmovedReason> {
+    let p = tri.map(|v| planes_of(run, v));
+    let mut best: Option<(f64, DVec3, Planes)> = None;
+    let mut reason = UnmovedReason::Dependent;
+    for x in p[0] {
+        for y in p[1] {
+            for z in p[2] {
+                match snap::corner_point(&x.plane, &y.plane, &z.plane, anchor, &run.limits) {
+                    Ok(q) => {
+                        let scale = tri
+                            .iter()
+                            .map(|&v| run.positions[v as usize].distance(anchor))
+                            .fold(0.0f64, f64::max);
+                        if !consistent(
+                            run,
+                            q,
+                            &[(tri[0], x.label), (tri[1], y.label), (tri[2], z.label)],
+                            2.0 * scale,
+                        ) || !supported(run, q, &tri)
+                        {
+                            reason = UnmovedReason::Curved;
+                            continue;
+                        }
+                        let d = q.distance_squared(anchor);
+                        if better(best.as_ref().map(|b| b.0), d) {
+                            best = Some((d, q, Planes::three(x.plane, y.plane, z.plane)));
+                        }
+                    }
+                    Err(r) => {
+                        if r == UnmovedReason::MixedConvexity && reason != UnmovedReason::Curved {
+                            reason = r;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    if let Some((_, q, planes)) = best {
+        return Ok((q, planes));
+    }
+    // No three independent planes (a corner triangle inside a straight chamfer): the crease
+    // line of the best pair.
+    for (i, j) in [(0, 1), (1, 2), (2, 0)] {
+        for x in p[i] {
+            for y in p[j] {
+                if let Ok(q) = snap::edge_point(&x.plane, &y.plane, anchor, &run.limits) {
+                    let scale =
+                        run.positions[tri[i] as usize].distance(run.positions[tri[j] as usize]);
+                    if !consistent(run, q, &[(tri[i], x.label), (tri[j], y.label)], scale)
+                        || !supported(run, q, &tri)
+                    {
+                        continue;
+                    }
+                    let d = q.distance_squared(anchor);
+                    if better(best.as_ref().map(|b| b.0), d) {
+                        best = Some((d, q, Planes::two(x.plane, y.plane)));
+                    }
+                }
+            }
+        }
+    }
+    best.map(|(_, q, planes)| (q, planes)).ok_or(reason)
+}
+
+/// A chamfer vertex moves onto a corner point only when it is within this fraction of its
+/// mean edge length (marching cubes cuts a corner off by up to sqrt(3) cells).
+pub(crate) const CORNER_MOVE_LIMIT: f64 = 1.5;
+
+/// Corner vertices: for each corner triangle whose three planes meet in a point, the nearest
+/// chamfer vertex (of the triangle or around it) moves onto that point and takes the three
+/// planes as labels. Returns how many moved; the caller then recomputes the chamfer edges.
+pub(crate) fn corner_vertices(run: &mut Run) -> usize {
+    let nt = run.mesh.triangles.len();
+    let mut placed: Vec<DVec3> = Vec::new();
+    let mut moved = 0;
+    for t in 0..nt {
+        if run.s.tflags[t] & crate::edge_sharpener::T_GREEN == 0 {
+            continue;
+        }
+        let tri = run.mesh.triangles[t];
+        let anchor = tri
+            .iter()
+            .map(|&v| run.positions[v as usize])
+            .sum::<DVec3>()
+            / 3.0;
+        let Ok((w, planes)) = corner_snap(run, tri, anchor) else {
+            continue;
+        };
+        let [Some(a), Some(b), Some(c)] = planes.p else {
+            continue;
+        };
+        if !well_separated(run, &[a, b, c]) {
+            continue;
+        }
+        // Candidates: chamfer vertices of the triangle and of its neighbours.
+        let mut best: Option<(f64, u32)> = None;
+        for &v0 in &tri {
+            for cc in run.table.vertex_corners(VertexId(v0)) {
+                for v in [v0, run.cv(next(cc.index()))] {
+                    if run.s.vflags[v as usize] & V_CHAMFER == 0 {
+                        continue;
+                    }
+                    let d = run.positions[v as usize].distance(w);
+                    if better(best.map(|b| b.0), d)
+                        || best.is_some_and(|(bd, bv)| d == bd && v < bv)
+                    {
+                        best = Some((d, v));
+                    }
+                }
+            }
+        }
+        let Some((d, v)) = best else { continue };
+        let p = run.mesh.positions[v as usize];
+        let mut len = 0.0;
+        let mut k = 0usize;
+        for cc in run.table.vertex_corners(VertexId(v)) {
+            len += (run.mesh.positions[run.cv(next(cc.index())) as usize] - p).length();
+            k += 1;
+        }
+        let mean = len / k.max(1) as f64;
+        if d > CORNER_MOVE_LIMIT * mean || placed.iter().any(|q| q.distance(w) < 0.5 * mean) {
+            continue;
+        }
+        let thin = run.opts.min_angle_degrees.to_radians();
+        let fan_ok = run.table.vertex_corners(VertexId(v)).all(|cc| {
+            let u = cc.index() / 3;
+            let q =
+                run.mesh.triangles[u].map(|x| if x == v { w } else { run.positions[x as usize] });
+            let area = (q[1] - q[0]).cross(q[2] - q[0]);
+            area.dot(run.mesh.face_cross(u)) > 0.0 && crate::edge_sharpener::min_angle(&q) >= thin
+        });
+        if !fan_ok {
+            continue;
+        }
+        run.positions[v as usize] = w;
+        run.s.vflags[v as usize] |= V_MOVED;
+        for cc in run.table.vertex_corners(VertexId(v)) {
+            run.s.tflags[cc.index() / 3] |= T_TOUCHED;
+        }
+        // The corner vertex lies on the three surfaces: it takes their label planes (found
+        // again among the triangle's vertices by their normals).
+        let labels: Vec<u32> = [a, b, c]
+            .iter()
+            .map(|pl| {
+                tri.iter()
+                    .flat_map(|&x| planes_of(run, x))
+                    .find(|lp| lp.plane.normal == pl.normal)
+                    .map_or(NONE, |lp| lp.label)
+            })
+            .collect();
+        run.s.lp_start[v as usize] = run.s.lps.len() as u32;
+        run.s.lp_len[v as usize] = 3;
+        for (i, pl) in [a, b, c].into_iter().enumerate() {
+            run.s.lps.push(LabelPlane {
+                label: labels[i],
+                plane: Plane {
+                    point: w,
+                    normal: pl.normal,
+                },
+            });
+        }
+        placed.push(w);
+        moved += 1;
+    }
+    moved
+}
+
+/// True when distance `d` beats the best so far (none yet counts as beaten).
+#[inline]
+fn better(best: Option<f64>, d: f64) -> bool {
+    match best {
+        None => true,
+        Some(b) => d < b,
+    }
+}

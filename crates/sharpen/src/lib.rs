@@ -1,0 +1,98 @@
+//! whet-sharpen owns EdgeSharpener (Attene et al., SGP 2003 and ACM TOG 2005): it finds the
+//! chamfers that feature-insensitive sampling (marching cubes, scanners, the SwingWrapper
+//! retiler) cuts through sharp edges and corners, subdivides them, and snaps the new vertices
+//! onto the intersections of planes extending the smooth surfaces around them, then tags the
+//! sharp edges for Bender. [`sharpen`] takes an oriented manifold [`Mesh`] and returns the
+//! sharpened mesh, the [`SharpTags`] and a [`SharpenReport`]; input vertices keep their indices
+//! and, outside the chamfers, their exact coordinates. [`Method::Papers`] is the papers'
+//! algorithm alone, [`Method::Extended`] (the default) adds whet's extended chamfer detection.
+//! See `docs/sharpen.md` for the rules and the degenerate cases.
+//!
+//! ```
+//! use whet_sharpen::{sharpen, SharpenOptions};
+//! use whet_synth::{marching_cubes, Shape, ShapeKind, ShapeParams};
+//!
+//! // A marching-cubes cube has chamfered edges and corners.
+//! let cube = Shape::new(ShapeKind::Cube, &ShapeParams::default()).unwrap();
+//! let chamfered = marching_cubes(&cube, 16).unwrap();
+//! let out = sharpen(&chamfered, &SharpenOptions::DEFAULT).unwrap();
+//! assert!(out.report.chamfer_edges > 0 && out.report.new_vertices > 0);
+//! // Input vertices come first, at their input indices.
+//! assert_eq!(out.mesh.positions.len(), chamfered.positions.len() + out.report.new_vertices);
+//! let report = out.mesh.topology_report();
+//! assert!(report.manifold && report.oriented && report.boundary_edges == 0);
+//! assert!(out.report.to_json().contains("\"chamfer_edges\":"));
+//! ```
+#![forbid(unsafe_code)]
+
+mod edge_sharpener;
+mod extended;
+mod options;
+mod report;
+mod slivers;
+mod snap;
+mod tags;
+
+pub use edge_sharpener::EdgeSharpener;
+
+pub use options::{Method, SharpenOptions};
+pub use report::{SharpenReport, UnmovedReason};
+pub use tags::SharpTags;
+
+use whet_mesh::{FaceId, Mesh, MeshError};
+
+/// The result of [`sharpen`].
+#[derive(Clone, Debug)]
+#[non_exhaustive]
+pub struct Sharpened {
+    /// The sharpened mesh: the input vertices at their input indices, then the new vertices.
+    pub mesh: Mesh,
+    /// For each triangle of `mesh`, the input triangle it was cut from (or is): lets callers
+    /// carry per-face attributes over, and is what the orientation guarantee refers to.
+    pub parents: Vec<FaceId>,
+    /// Sharp vertices and edges of `mesh`, for Bender (seed 001 section 4.1).
+    pub tags: SharpTags,
+    /// Counts and time of the run.
+    pub report: SharpenReport,
+}
+
+/// Why sharpening or reading tags failed.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// The mesh is not an oriented manifold with valid indices and finite coordinates. The
+    /// error names the first offender; run `Mesh::make_manifold` first to accept any input.
+    #[error("the mesh cannot be sharpened: {0} (run make_manifold first)")]
+    InvalidInput(MeshError),
+    /// An option out of range (API misuse).
+    #[error("bad sharpen option: {0}")]
+    Parameter(String),
+    /// Reading or writing a tag file failed.
+    #[error("tag file I/O: {0}")]
+    Io(#[from] std::io::Error),
+    /// A tag file that does not follow the format or does not fit the mesh.
+    #[error("tag file line {line}: {message}")]
+    Format {
+        /// 1-based line number.
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+impl Error {
+    pub(crate) fn format(line: usize, message: String) -> Error {
+        Error::Format { line, message }
+    }
+}
+
+/// Sharpens `mesh` with `options`: detects the chamfers, subdivides them, snaps the new
+/// vertices onto the extrapolated planes and removes the slivers this leaves (see the crate
+/// docs and `docs/sharpen.md`).
+///
+/// Fails with [`Error::InvalidInput`] when the mesh is not an oriented manifold (non-manifold
+/// edges or vertices, inconsistent orientation, bad indices) or has a non-finite coordinate,
+/// and with [`Error::Parameter`] for options out of range. Never panics.
+pub fn sharpen(mesh: &Mesh, options: &SharpenOptions) -> Result<Sharpened, Error> {
+    EdgeSharpener::new(*options).sharpen(mesh)
+}

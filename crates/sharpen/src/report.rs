@@ -1,0 +1,218 @@
+//! What a sharpening run did: the counts of `whet sharpen --json`.
+
+use std::fmt::Write as _;
+use std::time::Duration;
+
+use crate::options::Method;
+
+/// Why a new vertex stayed at the midpoint of its chamfer edge or the centroid of its corner
+/// triangle instead of moving onto the extrapolated planes (docs/sharpen.md, "Degenerate
+/// cases").
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum UnmovedReason {
+    /// The two planes of a chamfer edge are parallel (closer than the smooth threshold).
+    Parallel,
+    /// The three planes of a corner triangle have coplanar normals.
+    Dependent,
+    /// The strip is convex at one end of the edge and concave at the other.
+    MixedConvexity,
+    /// The snapped position would make an edge longer than the longest input edge.
+    TooLong,
+    /// The snapped position would reverse a triangle against the input triangle it replaces.
+    Flipped,
+    /// Unsnapped by the sliver pass, which could remove a small angle no other way.
+    Sliver,
+    /// Extended method: the planes of the neighbouring vertices of the same surfaces disagree
+    /// with the snapped point (the surface is curved at the scale of the sampling).
+    Curved,
+}
+
+impl UnmovedReason {
+    /// Every reason, in declaration order.
+    pub const ALL: [UnmovedReason; 7] = [
+        UnmovedReason::Parallel,
+        UnmovedReason::Dependent,
+        UnmovedReason::MixedConvexity,
+        UnmovedReason::TooLong,
+        UnmovedReason::Flipped,
+        UnmovedReason::Sliver,
+        UnmovedReason::Curved,
+    ];
+
+    /// The snake_case name used in JSON.
+    pub const fn name(self) -> &'static str {
+        match self {
+            UnmovedReason::Parallel => "parallel",
+            UnmovedReason::Dependent => "dependent",
+            UnmovedReason::MixedConvexity => "mixed_convexity",
+            UnmovedReason::TooLong => "too_long",
+            UnmovedReason::Flipped => "flipped",
+            UnmovedReason::Sliver => "sliver",
+            UnmovedReason::Curved => "curved",
+        }
+    }
+
+    pub(crate) const fn index(self) -> usize {
+        self as usize
+    }
+}
+
+/// Counts and timing of one run. Vertex counts refer to the output mesh unless named
+/// otherwise: `snapped_vertices` plus the sum of `unmoved` is `new_vertices`.
+#[derive(Clone, Debug, Default, PartialEq)]
+#[non_exhaustive]
+pub struct SharpenReport {
+    /// The method that ran.
+    pub method: Method,
+    /// The smooth factor used.
+    pub smooth_factor: f64,
+    /// Mean angle between the normals of adjacent triangles over the interior edges, in
+    /// degrees (the papers' epsilon).
+    pub mean_angle_degrees: f64,
+    /// `smooth_factor` times the mean: edges under it are smooth.
+    pub smooth_threshold_degrees: f64,
+    /// Vertices of the input.
+    pub input_vertices: usize,
+    /// Triangles of the input.
+    pub input_triangles: usize,
+    /// Vertices of the output.
+    pub output_vertices: usize,
+    /// Triangles of the output.
+    pub output_triangles: usize,
+    /// Smooth (brown) edges.
+    pub smooth_edges: usize,
+    /// Chamfer (blue) edges: each got a new vertex.
+    pub chamfer_edges: usize,
+    /// Corner (green) triangles: each got a new vertex.
+    pub corner_triangles: usize,
+    /// Input vertices classified as chamfer vertices by the extended detection (0 in papers
+    /// mode).
+    pub chamfer_vertices: usize,
+    /// New vertices inserted before the sliver pass.
+    pub inserted_vertices: usize,
+    /// New vertices in the output (inserted minus those the sliver pass removed).
+    pub new_vertices: usize,
+    /// New vertices of the output that sit on their extrapolated planes.
+    pub snapped_vertices: usize,
+    /// New vertices of the output left at their midpoint or centroid, by reason (indexed like
+    /// [`UnmovedReason::ALL`]; see [`SharpenReport::unmoved`]).
+    pub unmoved_by_reason: [usize; 7],
+    /// Input vertices moved (extended mode only; always chamfer vertices).
+    pub moved_input_vertices: usize,
+    /// Triangles removed by the sliver pass's edge collapses.
+    pub collapsed_triangles: usize,
+    /// Subdivided triangles the sliver pass restored to their input triangles (docs/sharpen.md,
+    /// "The sliver pass").
+    pub restored_triangles: usize,
+    /// Vertices tagged sharp (filter 3bis plus the new vertices).
+    pub tagged_vertices: usize,
+    /// Edges tagged sharp.
+    pub sharp_edges: usize,
+    /// Wall time of the run.
+    pub time: Duration,
+}
+
+impl SharpenReport {
+    /// New vertices of the output left unmoved for `reason`.
+    pub fn unmoved(&self, reason: UnmovedReason) -> usize {
+        self.unmoved_by_reason[reason.index()]
+    }
+
+    /// All unmoved new vertices of the output.
+    pub fn unmoved_total(&self) -> usize {
+        self.unmoved_by_reason.iter().sum()
+    }
+
+    /// The report as one JSON object (no whitespace), for `whet sharpen --json`: `method`,
+    /// `smooth_factor`, `mean_angle_degrees`, `smooth_threshold_degrees`, the input and output
+    /// counts, `smooth_edges`, `chamfer_edges`, `corner_triangles`, `chamfer_vertices`,
+    /// `inserted_vertices`, `new_vertices`, `snapped_vertices`, `unmoved` (an object with one
+    /// count per [`UnmovedReason`] name), `moved_input_vertices`, `collapsed_triangles`,
+    /// `restored_triangles`, `tagged_vertices`, `sharp_edges` and `time_ms`.
+    pub fn to_json(&self) -> String {
+        let mut s = String::with_capacity(768);
+        // Writing to a String cannot fail.
+        let _ = write!(
+            s,
+            "{{\"method\":\"{}\",\"smooth_factor\":{},\"mean_angle_degrees\":{},\
+             \"smooth_threshold_degrees\":{},\"input_vertices\":{},\"input_triangles\":{},\
+             \"output_vertices\":{},\"output_triangles\":{},\"smooth_edges\":{},\
+             \"chamfer_edges\":{},\"corner_triangles\":{},\"chamfer_vertices\":{},\
+             \"inserted_vertices\":{},\"new_vertices\":{},\"snapped_vertices\":{},\"unmoved\":{{",
+            self.method.name(),
+            json_num(self.smooth_factor),
+            json_num(self.mean_angle_degrees),
+            json_num(self.smooth_threshold_degrees),
+            self.input_vertices,
+            self.input_triangles,
+            self.output_vertices,
+            self.output_triangles,
+            self.smooth_edges,
+            self.chamfer_edges,
+            self.corner_triangles,
+            self.chamfer_vertices,
+            self.inserted_vertices,
+            self.new_vertices,
+            self.snapped_vertices,
+        );
+        for (i, r) in UnmovedReason::ALL.iter().enumerate() {
+            if i > 0 {
+                s.push(',');
+            }
+            let _ = write!(s, "\"{}\":{}", r.name(), self.unmoved_by_reason[i]);
+        }
+        let _ = write!(
+            s,
+            "}},\"moved_input_vertices\":{},\"collapsed_triangles\":{},\"restored_triangles\":{},\
+             \"tagged_vertices\":{},\"sharp_edges\":{},\"time_ms\":{}}}",
+            self.moved_input_vertices,
+            self.collapsed_triangles,
+            self.restored_triangles,
+            self.tagged_vertices,
+            self.sharp_edges,
+            json_num(self.time.as_secs_f64() * 1e3),
+        );
+        s
+    }
+}
+
+/// A finite number in JSON (non-finite values, which the report never holds, become null).
+fn json_num(x: f64) -> String {
+    if x.is_finite() {
+        format!("{x}")
+    } else {
+        "null".to_string()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn json_has_every_field_once() {
+        let mut r = SharpenReport {
+            smooth_factor: 2.0,
+            ..SharpenReport::default()
+        };
+        r.unmoved_by_reason[UnmovedReason::TooLong.index()] = 3;
+        let j = r.to_json();
+        for key in [
+            "method",
+            "smooth_factor",
+            "chamfer_edges",
+            "corner_triangles",
+            "new_vertices",
+            "unmoved",
+            "too_long",
+            "collapsed_triangles",
+            "time_ms",
+        ] {
+            assert_eq!(j.matches(&format!("\"{key}\":")).count(), 1, "{key} in {j}");
+        }
+        assert!(j.contains("\"too_long\":3"));
+        assert!(j.starts_with("{\"method\":\"extended\"") && j.ends_with('}'));
+        assert_eq!(r.unmoved_total(), 3);
+    }
+}

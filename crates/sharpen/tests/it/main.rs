@@ -1,0 +1,17 @@
+//! Integration tests of whet-sharpen: one binary, one module per topic.
+//!
+//! - `ridge`: a hand-built chamfered ridge with exact expectations;
+//! - `outputs`: the issue's output guarantees on marching-cubes samplings of the synth shapes;
+//! - `inputs`: refused input, boundaries, components, already-sharp meshes, tags, options;
+//! - `issue6`: the figures of issue 6 at test-suite scale (regression bounds) and noise;
+//! - `robustness`: random noise, holes and options never break the output's guarantees.
+#![allow(clippy::unwrap_used)] // a panic is a test failure
+
+#[path = "../../examples/support/mod.rs"]
+mod support;
+
+mod inputs;
+mod issue6;
+mod outputs;
+mod ridge;
+mod robustness;

@@ -1,0 +1,136 @@
+//! Measurement: cost of the swing indices under several context schemes.
+#![allow(clippy::unwrap_used)]
+use whet_bits::{BitSink, BitTree, CostCounter};
+use whet_codec::{SwingParams, VertexSource};
+use whet_edgebreaker::{traverse, Clers, Step};
+use whet_swing::{retile, RetileTuning};
+
+fn zz(q: i32) -> u32 {
+    ((q << 1) ^ (q >> 31)) as u32
+}
+fn bl(z: u32) -> usize {
+    (32 - z.leading_zeros()) as usize
+}
+
+fn main() {
+    let a: Vec<String> = std::env::args().skip(1).collect();
+    let bits: u32 = a[1].parse().unwrap();
+    let f: f64 = a[2].parse().unwrap();
+    for name in a[3..].iter() {
+        let mesh = whet_io::read_path(&whet_testkit::shared_fixture(name), None).unwrap();
+        let params = SwingParams::new(f * mesh.diagonal(), bits, &mesh.bounding_box(), 20).unwrap();
+        let r = retile(&mesh, &params, &RetileTuning::DEFAULT).unwrap();
+        let enc = whet_edgebreaker::encode_connectivity(&r.mesh.triangles, r.mesh.positions.len())
+            .unwrap();
+        let conn = &enc.connectivity;
+        let t = &conn.table;
+        // Per traversal C: (q, parent q or None, prev label, prev q, grandparent q)
+        let mut tri_q = vec![None; t.triangle_count()];
+        let mut tri_parent = vec![usize::MAX; t.triangle_count()];
+        let mut rows = Vec::new();
+        let mut preds: Vec<i32> = Vec::new();
+        let mut acc = vec![whet_mesh::DVec3::ZERO; t.vertex_count()];
+        let pos = &r.mesh.positions;
+        let add_tri = |acc: &mut Vec<whet_mesh::DVec3>, c: whet_mesh::CornerId| {
+            let vs = [t.vertex(c), t.vertex(t.next(c)), t.vertex(t.prev(c))];
+            let [p0, p1, p2] = vs.map(|v| pos[v.index()]);
+            let n = (p1 - p0).cross(p2 - p0);
+            for v in vs {
+                acc[v.index()] += n;
+            }
+        };
+        let mut prev_label = Clers::C;
+        let mut last_q = 0i32;
+        traverse(t, Some(&conn.starts), |s| {
+            if let Step::Start { corner } = s {
+                add_tri(&mut acc, corner);
+            }
+            if let Step::Triangle { tip, label, .. } = s {
+                let o = t.opposite(tip).unwrap();
+                let pt = o.face().index();
+                tri_parent[tip.face().index()] = pt;
+                if label == Clers::C {
+                    let v = t.vertex(tip);
+                    let VertexSource::Swing(q) = r.mesh.sources[v.index()] else {
+                        panic!()
+                    };
+                    let gp = tri_parent[pt];
+                    let gq = if gp != usize::MAX { tri_q[gp] } else { None };
+                    rows.push((q, tri_q[pt], prev_label, last_q, gq));
+                    let (a, b, c) = (t.vertex(t.next(tip)), t.vertex(t.prev(tip)), t.vertex(o));
+                    let fr = params
+                        .frame(pos[a.index()], pos[b.index()], pos[c.index()])
+                        .unwrap();
+                    let nn = (acc[a.index()] + acc[b.index()]).normalize();
+                    let th = (-(fr.e1.dot(nn))).atan2(fr.e2.dot(nn));
+                    // two solutions th and th+pi: take the one nearer 0
+                    let th = if th.abs() > std::f64::consts::FRAC_PI_2 {
+                        if th > 0.0 {
+                            th - std::f64::consts::PI
+                        } else {
+                            th + std::f64::consts::PI
+                        }
+                    } else {
+                        th
+                    };
+                    preds.push(params.angles.quantize(th));
+                    tri_q[tip.face().index()] = Some(q);
+                    last_q = q;
+                }
+                prev_label = label;
+                add_tri(&mut acc, tip);
+            }
+        })
+        .unwrap();
+        let n = rows.len() as f64;
+        for (i, r) in rows.iter_mut().enumerate() {
+            r.3 = preds[i];
+        }
+        let run = |ctx: &dyn Fn(&(i32, Option<i32>, Clers, i32, Option<i32>)) -> (usize, i32),
+                   nctx: usize| {
+            let mut trees: Vec<BitTree> = (0..nctx).map(|_| BitTree::new(bits)).collect();
+            let mut c = CostCounter::new();
+            let mask = (1u32 << bits) - 1;
+            for row in &rows {
+                let (k, pred) = ctx(row);
+                let d = row.0 - pred;
+                // wrap into range
+                let half = 1i32 << (bits - 1);
+                let d = ((d + half).rem_euclid(1 << bits)) - half;
+                c.encode_tree(&mut trees[k], zz(d) & mask);
+            }
+            c.bits() / n
+        };
+        let o0 = run(&|_| (0, 0), 1);
+        let pbucket = run(&|r| (r.1.map_or(0, |p| 1 + bl(zz(p)).min(7)), 0), 9);
+        let pres = run(&|r| (r.1.map_or(0, |_| 1), r.1.unwrap_or(0)), 2);
+        let pres_b = run(
+            &|r| (r.1.map_or(0, |p| 1 + bl(zz(p)).min(7)), r.1.unwrap_or(0)),
+            9,
+        );
+        let lastq = run(&|r| (1 + bl(zz(r.3)).min(7), 0), 9);
+        let lastres = run(&|r| (0, r.3), 1);
+        let normpred_b = run(&|r| (1 + bl(zz(r.3)).min(7), r.3), 9);
+        let avg = run(
+            &|r| {
+                let p = match (r.1, r.4) {
+                    (Some(a), Some(b)) => (a + b) / 2,
+                    (Some(a), None) => a,
+                    _ => r.3,
+                };
+                (r.1.map_or(0, |_| 1), p)
+            },
+            2,
+        );
+        let pb_label = run(
+            &|r| {
+                (
+                    r.1.map_or(0, |p| 1 + bl(zz(p)).min(7)) * 5 + r.2 as usize,
+                    0,
+                )
+            },
+            45,
+        );
+        println!("{name} B={bits} f={f}: n={} order0 {o0:.3} parent-bucket {pbucket:.3} parent-resid {pres:.3} parent-resid+bucket {pres_b:.3} last-bucket {lastq:.3} NORMAL-PRED {lastres:.3} normpred+bucket {normpred_b:.3} avg-pred {avg:.3} pbucket+label {pb_label:.3}", rows.len());
+    }
+}

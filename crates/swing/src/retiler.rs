@@ -1,0 +1,1387 @@
+//! The SwingWrapper retiler (Attene, Falcidieno, Spagnuolo, Rossignac 2003;
+//! `../shared/docs/algorithms.md` 1.4-1.7): grows the retiled mesh `M'` over the original `M`
+//! one triangle at a time, in exactly the order in which `whet_edgebreaker::traverse` will
+//! later visit `M'`, so that the Edgebreaker encoder reproduces the retiler's labels and
+//! vertex order and every new vertex can be sent as one swing index.
+//!
+//! State (what the Edgebreaker compressor would hold while traversing the final `M'`): the
+//! built triangles; the **loops** bounding the built region, as doubly linked lists of loop
+//! nodes (one vertex may have several nodes), oriented so the unbuilt region lies to the
+//! left of each directed loop edge; the current gate `A -> A.next`; a stack of deferred gates.
+//!
+//! ```text
+//!            a⁻ ----- a ===gate==> b ----- b⁺        new triangle (tip, a, b), CCW
+//!                      \         /                   right edge b -> tip, left edge tip -> a
+//!             unbuilt   \  tip  /   (left of the loop)
+//!
+//!   C  tip new, between a and b          next gate tip -> b      (go right)
+//!   R  tip = b⁺, node b closes           next gate a -> b⁺       (go left)
+//!   L  tip = a⁻, node a closes           next gate a⁻ -> b       (go right)
+//!   E  loop of 3 closes                  pop a deferred gate
+//!   S  tip = another loop node w         push a -> w, go on with w -> b (a split, or a
+//!                                        merge of two loops when w is on another one)
+//! ```
+//!
+//! Labels are computed with the traversal's own rule on this state (tip new; right
+//! neighbour built = directed edge `tip -> b` built; left = `a -> tip` built), and popped
+//! gates whose edge is already used are skipped, exactly as the traversal skips visited
+//! triangles. Each component starts with its seed `[x0, x1, x2]` (quantized positions) and
+//! the traversal's first gate `x0 -> x2`.
+//!
+//! Decision rules at a gate (tunable, [`RetileTuning`]): close a small wedge with R/L/E;
+//! else swing (smallest `|θ|` hit of the circle with `M`, quantized); snap the tip to a live
+//! loop vertex within `snap · L`; else C; fallbacks close with the best valid loop vertex.
+//! Validity keeps `M'` an oriented manifold: combinatorial rules (no repeated directed edge,
+//! no new edge duplicating an existing one) and geometric ones (the new triangle must fit
+//! in the open wedge of each of its three vertices, fold less than `max_fold` against its
+//! built neighbours, face outwards; a tip must not land on the built part: the cheap
+//! triangloid coverage test of `algorithms.md` 1.5).
+//!
+//! Not handled: retiling features narrower than about `L` faithfully (thin parts are
+//! wrapped as well as the rules allow, never by more than a bounded number of triangles);
+//! sharp edges are chamfered by design (EdgeSharpener restores them after decoding).
+
+use crate::grid::{Cells, FastMap, PointGrid};
+use crate::surface::{Hit, Surface};
+use crate::Error;
+use std::f64::consts::{PI, TAU};
+use whet_codec::{RetiledMesh, SwingFrame, SwingParams, VertexSource};
+use whet_edgebreaker::Clers;
+use whet_mesh::DVec3;
+
+/// Tunable constants of the retiler (`algorithms.md` 1.4; defaults as prototyped there,
+/// adjusted on the fixtures).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct RetileTuning {
+    /// Close a wedge (R, L, E) whose open angle is below this (radians).
+    pub close_angle: f64,
+    /// Snap a swing tip to a live loop vertex closer than this fraction of `L`.
+    pub snap: f64,
+    /// Largest admissible `|θ|` of a swing hit (radians).
+    pub theta_max: f64,
+    /// Slack of the wedge-containment tests (radians; vertex normals are estimates).
+    pub wedge_slack: f64,
+    /// Largest fold between a new triangle and a built neighbour (radians between their
+    /// normals).
+    pub max_fold: f64,
+    /// A hit within this fraction of `L` of a built triangle's plane, over the triangle,
+    /// counts as covered.
+    pub cover_thickness: f64,
+    /// A tip closer than this fraction of `L` to a closed (interior) retiled vertex is
+    /// refused.
+    pub interior_clearance: f64,
+    /// Work bound: at most this many times the expected triangle count per component.
+    pub budget_factor: f64,
+    /// Longest new edge (fraction of `L`) the regular rules may create: a gate of `2L`
+    /// or more has no swing circle.
+    pub max_edge: f64,
+}
+
+impl RetileTuning {
+    /// The defaults.
+    pub const DEFAULT: RetileTuning = RetileTuning {
+        close_angle: 80.0 * PI / 180.0,
+        snap: 0.55,
+        theta_max: 170.0 * PI / 180.0,
+        wedge_slack: 12.0 * PI / 180.0,
+        max_fold: 170.0 * PI / 180.0,
+        cover_thickness: 0.3,
+        interior_clearance: 0.45,
+        budget_factor: 12.0,
+        max_edge: 1.7,
+    };
+}
+
+impl Default for RetileTuning {
+    fn default() -> Self {
+        Self::DEFAULT
+    }
+}
+
+/// What the retiler did, beyond the mesh.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct RetileStats {
+    /// Components retiled normally.
+    pub components: usize,
+    /// Components smaller than about `L`, coded as a flat two-triangle pillow.
+    pub tiny_components: usize,
+    /// Gates where the smallest-angle swing hit fell on the built part.
+    pub covered_hits: usize,
+    /// Gates closed by the fallback rule (no swing possible or valid).
+    pub fallbacks: usize,
+    /// Fallbacks that had to drop the geometric checks.
+    pub forced: usize,
+    /// Gates declared boundary edges of `M'` (open originals).
+    pub boundary_edges: usize,
+}
+
+/// The result of [`retile`].
+#[derive(Clone, Debug)]
+pub struct Retiled {
+    /// The retiled mesh, ready for `whet_codec::encode_retiled`.
+    pub mesh: RetiledMesh,
+    /// What happened.
+    pub stats: RetileStats,
+}
+
+const NONE: u32 = u32::MAX;
+
+#[derive(Clone, Copy, Debug)]
+struct Node {
+    v: u32,
+    prev: u32,
+    next: u32,
+    /// Next node of the same vertex (a per-vertex list).
+    same: u32,
+    alive: bool,
+}
+
+/// A swing tip the regular rules refused, kept for the fallback with a penalty for why.
+struct Spare {
+    pos: DVec3,
+    normal: DVec3,
+    q: i32,
+    penalty: f64,
+}
+
+enum Tip {
+    New { pos: DVec3, normal: DVec3, q: i32 },
+    Existing(u32),
+}
+
+#[inline]
+fn ekey(a: u32, b: u32) -> u64 {
+    ((a as u64) << 32) | b as u64
+}
+
+/// Counter-clockwise angle about `n` from `d1` to `d2` after projecting both on the plane
+/// normal to `n`, in `[0, 2π)`.
+#[inline]
+fn ccw(n: DVec3, d1: DVec3, d2: DVec3) -> f64 {
+    let p1 = d1 - n * d1.dot(n);
+    let p2 = d2 - n * d2.dot(n);
+    let a = n.dot(p1.cross(p2)).atan2(p1.dot(p2));
+    if a < 0.0 {
+        a + TAU
+    } else {
+        a
+    }
+}
+
+/// The angle between two vectors (0 for a zero vector).
+#[inline]
+fn angle3(a: DVec3, b: DVec3) -> f64 {
+    a.cross(b).length().atan2(a.dot(b))
+}
+
+struct Retiler<'s, 'm> {
+    surf: &'s mut Surface<'m>,
+    params: &'s SwingParams,
+    tune: RetileTuning,
+    l: f64,
+    pos: Vec<DVec3>,
+    nrm: Vec<DVec3>,
+    src: Vec<VertexSource>,
+    tris: Vec<[u32; 3]>,
+    tri_normal: Vec<DVec3>,
+    labels: Vec<Clers>,
+    /// Incident triangles per vertex: head corner, then `corner_next`.
+    vcorner: Vec<u32>,
+    corner_next: Vec<u32>,
+    /// Loop nodes per vertex (head of the `same` list) and how many are alive.
+    vnode: Vec<u32>,
+    vlive: Vec<u32>,
+    nodes: Vec<Node>,
+    edges: FastMap<u64, u32>,
+    boundary: FastMap<u64, ()>,
+    vgrid: PointGrid,
+    stack: Vec<(u32, u32, u32)>,
+    hits: Vec<Hit>,
+    tri_stamp: Vec<u32>,
+    query: u32,
+    comp: u32,
+    stats: RetileStats,
+}
+
+/// Retiles `mesh` with the edge length and grids of `params` (see the module docs).
+pub fn retile(
+    mesh: &whet_mesh::Mesh,
+    params: &SwingParams,
+    tune: &RetileTuning,
+) -> Result<Retiled, Error> {
+    let l = params.edge_length;
+    let mut surf = Surface::new(mesh, l);
+    let bbox = mesh.bounding_box();
+    let mut r = Retiler {
+        params,
+        tune: *tune,
+        l,
+        pos: Vec::new(),
+        nrm: Vec::new(),
+        src: Vec::new(),
+        tris: Vec::new(),
+        tri_normal: Vec::new(),
+        labels: Vec::new(),
+        vcorner: Vec::new(),
+        corner_next: Vec::new(),
+        vnode: Vec::new(),
+        vlive: Vec::new(),
+        nodes: Vec::new(),
+        edges: FastMap::default(),
+        boundary: FastMap::default(),
+        vgrid: PointGrid::new(Cells::new(bbox.min, l)),
+        stack: Vec::new(),
+        hits: Vec::new(),
+        tri_stamp: Vec::new(),
+        query: 0,
+        comp: 0,
+        stats: RetileStats::default(),
+        surf: &mut surf,
+    };
+    let comps = r.surf.component_count;
+    // Per component: its first triangle, area and box.
+    let mut first = vec![u32::MAX; comps];
+    let mut area = vec![0.0f64; comps];
+    let mut boxes = vec![whet_mesh::Aabb::EMPTY; comps];
+    for (t, &c) in r.surf.component.iter().enumerate() {
+        let c = c as usize;
+        if first[c] == u32::MAX {
+            first[c] = t as u32;
+        }
+        area[c] += mesh.face_area(t);
+        for p in mesh.triangle_positions(t) {
+            boxes[c].include(p);
+        }
+    }
+    for c in 0..comps {
+        r.comp = c as u32;
+        let tiny = boxes[c].diagonal() < 1.5 * l || area[c] < 0.75 * l * l;
+        if tiny {
+            r.pillow(first[c])?;
+            r.stats.tiny_components += 1;
+            continue;
+        }
+        // Expected triangles: 2.4 · area / L² (algorithms.md 1.9).
+        let budget = (tune.budget_factor * 2.4 * area[c] / (l * l)) as usize + 1000;
+        r.component(first[c], budget)?;
+        r.stats.components += 1;
+    }
+    let open = !r.boundary.is_empty();
+    Ok(Retiled {
+        mesh: RetiledMesh {
+            positions: r.pos,
+            triangles: r.tris,
+            sources: r.src,
+            labels: r.labels,
+            components: comps,
+            open,
+        },
+        stats: r.stats,
+    })
+}
+
+impl Retiler<'_, '_> {
+    // --- Construction -------------------------------------------------------------------
+
+    fn add_vertex(&mut self, p: DVec3, n: DVec3, s: VertexSource) -> u32 {
+        let v = self.pos.len() as u32;
+        self.pos.push(p);
+        self.nrm.push(n);
+        self.src.push(s);
+        self.vcorner.push(NONE);
+        self.vnode.push(NONE);
+        self.vlive.push(0);
+        self.vgrid.insert(v, p);
+        v
+    }
+
+    fn add_node(&mut self, v: u32) -> u32 {
+        let id = self.nodes.len() as u32;
+        self.nodes.push(Node {
+            v,
+            prev: NONE,
+            next: NONE,
+            same: self.vnode[v as usize],
+            alive: true,
+        });
+        self.vnode[v as usize] = id;
+        self.vlive[v as usize] += 1;
+        id
+    }
+
+    fn kill_node(&mut self, n: u32) {
+        let node = &mut self.nodes[n as usize];
+        if node.alive {
+            node.alive = false;
+            self.vlive[node.v as usize] -= 1;
+        }
+    }
+
+    fn add_triangle(&mut self, t: [u32; 3]) {
+        let id = self.tris.len() as u32;
+        let [w, a, b] = t;
+        for (k, &v) in t.iter().enumerate() {
+            let c = 3 * id + k as u32;
+            self.corner_next.push(self.vcorner[v as usize]);
+            self.vcorner[v as usize] = c;
+        }
+        self.edges.insert(ekey(w, a), id);
+        self.edges.insert(ekey(a, b), id);
+        self.edges.insert(ekey(b, w), id);
+        let [pw, pa, pb] = t.map(|v| self.pos[v as usize]);
+        self.tri_normal
+            .push((pa - pw).cross(pb - pw).normalize_or_zero());
+        self.tris.push(t);
+    }
+
+    #[inline]
+    fn built(&self, a: u32, b: u32) -> bool {
+        self.edges.contains_key(&ekey(a, b))
+    }
+
+    /// The third vertex of the built triangle holding directed edge `b -> a`.
+    fn parent_vertex(&self, a: u32, b: u32) -> Option<u32> {
+        let t = *self.edges.get(&ekey(b, a))?;
+        self.tris[t as usize]
+            .iter()
+            .copied()
+            .find(|&v| v != a && v != b)
+    }
+
+    // --- Components ---------------------------------------------------------------------
+
+    /// A component smaller than about `L`: its three most spread-out vertices as a seed and
+    /// the seed's back face (label E), a flat closed pillow.
+    fn pillow(&mut self, first_tri: u32) -> Result<(), Error> {
+        let mesh = self.surf.mesh;
+        let comp = self.comp;
+        let verts: Vec<u32> = {
+            let mut vs: Vec<u32> = self
+                .surf
+                .component
+                .iter()
+                .enumerate()
+                .filter(|(_, &c)| c == comp)
+                .flat_map(|(t, _)| mesh.triangles[t])
+                .collect();
+            vs.sort_unstable();
+            vs.dedup();
+            vs
+        };
+        let p = |v: u32| mesh.positions[v as usize];
+        let v0 = mesh.triangles[first_tri as usize][0];
+        let v1 = *verts
+            .iter()
+            .max_by(|&&x, &&y| {
+                (p(x) - p(v0))
+                    .length_squared()
+                    .total_cmp(&(p(y) - p(v0)).length_squared())
+            })
+            .unwrap_or(&v0);
+        let axis = p(v1) - p(v0);
+        let v2 = *verts
+            .iter()
+            .max_by(|&&x, &&y| {
+                axis.cross(p(x) - p(v0))
+                    .length_squared()
+                    .total_cmp(&axis.cross(p(y) - p(v0)).length_squared())
+            })
+            .unwrap_or(&v0);
+        let ids: Vec<u32> = [v0, v1, v2]
+            .iter()
+            .map(|&v| {
+                let (g, q) = self.params.snap_seed(p(v));
+                let n = self.surf.vertex_normal[v as usize];
+                self.add_vertex(q, n, VertexSource::Seed(g))
+            })
+            .collect();
+        let (x0, x1, x2) = (ids[0], ids[1], ids[2]);
+        self.add_triangle([x0, x1, x2]);
+        self.add_triangle([x1, x0, x2]);
+        self.labels.push(Clers::E);
+        Ok(())
+    }
+
+    /// Seeds and retiles one component.
+    fn component(&mut self, first_tri: u32, budget: usize) -> Result<(), Error> {
+        let start = self.tris.len();
+        let mut gate = self.seed(first_tri)?;
+        loop {
+            if self.tris.len() - start > budget {
+                return Err(Error::Stuck(format!(
+                    "component {} needed more than {budget} triangles (the retiler is \
+                     wrapping the surface more than once)",
+                    self.comp
+                )));
+            }
+            if let Some(at) = std::env::var_os("WHET_SWING_DUMP_AT") {
+                if at.to_str().and_then(|x| x.parse::<usize>().ok()) == Some(self.tris.len()) {
+                    self.dump(std::path::Path::new("/tmp/dump_at.off"), gate);
+                }
+            }
+            let stepped = self.step(gate);
+            if let (Err(_), Some(path)) = (&stepped, std::env::var_os("WHET_SWING_DUMP")) {
+                self.dump(std::path::Path::new(&path), gate);
+            }
+            match stepped? {
+                Some(next) => gate = next,
+                None => match self.pop() {
+                    Some(g) => gate = g,
+                    None => break,
+                },
+            }
+        }
+        Ok(())
+    }
+
+    /// Debugging aid: writes the partial retiled mesh as OFF and the stuck gate's vertices.
+    fn dump(&self, path: &std::path::Path, gate: u32) {
+        use std::fmt::Write as _;
+        let mut s = format!("OFF\n{} {} 0\n", self.pos.len(), self.tris.len());
+        for p in &self.pos {
+            let _ = writeln!(s, "{} {} {}", p.x, p.y, p.z);
+        }
+        for t in &self.tris {
+            let _ = writeln!(s, "3 {} {} {}", t[0], t[1], t[2]);
+        }
+        let _ = std::fs::write(path, s);
+        let a = self.nodes[gate as usize].v;
+        let b = self.nodes[self.nodes[gate as usize].next as usize].v;
+        eprintln!(
+            "stuck gate {a} -> {b}: {:?} -> {:?}, normal {:?}",
+            self.pos[a as usize].to_array(),
+            self.pos[b as usize].to_array(),
+            self.nrm[a as usize].to_array()
+        );
+    }
+
+    /// The deferred gate to continue with, skipping those whose edge was used meanwhile.
+    fn pop(&mut self) -> Option<u32> {
+        while let Some((n, a, w)) = self.stack.pop() {
+            if self.built(a, w) {
+                continue;
+            }
+            let node = self.nodes[n as usize];
+            if node.alive && node.v == a && self.nodes[node.next as usize].v == w {
+                return Some(n);
+            }
+            // Not reachable: an unused loop edge keeps its node. Search a's nodes anyway.
+            let mut m = self.vnode[a as usize];
+            while m != NONE {
+                let nm = self.nodes[m as usize];
+                if nm.alive && self.nodes[nm.next as usize].v == w {
+                    return Some(m);
+                }
+                m = nm.same;
+            }
+        }
+        None
+    }
+
+    /// Places the seed triangle `[x0, x1, x2]` of the current component on the surface and
+    /// returns the first gate `x0 -> x2`.
+    fn seed(&mut self, first_tri: u32) -> Result<u32, Error> {
+        let mesh = self.surf.mesh;
+        let l = self.l;
+        let comp = self.comp;
+        // Candidates spread over the component, flattest first: a seed on a crease or a
+        // corner starts the spiral badly.
+        let tris: Vec<usize> = self
+            .surf
+            .component
+            .iter()
+            .enumerate()
+            .skip(first_tri as usize)
+            .filter(|(_, &c)| c == comp)
+            .map(|(t, _)| t)
+            .collect();
+        let stride = (tris.len() / 96).max(1);
+        // Candidate points are triangle centroids: on coarse CAD meshes the vertices all
+        // sit on creases and corners.
+        let mut candidates: Vec<(f64, usize, DVec3)> = Vec::new();
+        for &t in tris.iter().step_by(stride) {
+            let [p0, p1, p2] = mesh.triangle_positions(t);
+            let (n, flat) = self
+                .surf
+                .normal_coherence((p0 + p1 + p2) / 3.0, 1.5 * l, comp);
+            if n != DVec3::ZERO {
+                candidates.push((flat, t, n));
+            }
+        }
+        candidates.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
+        for &(_, t0, n0) in candidates.iter().take(32) {
+            let [p0, p1, p2] = mesh.triangle_positions(t0);
+            let x0 = (p0 + p1 + p2) / 3.0;
+            let t = n0.any_orthonormal_vector();
+            let s = n0.cross(t);
+            let Some((x1, t1)) = self.surf.closest_in_component(x0 + t * l, comp, l) else {
+                continue;
+            };
+            let target2 = x0 + (t * 0.5 + s * (0.75f64).sqrt()) * l;
+            let Some((x2, t2)) = self.surf.closest_in_component(target2, comp, l) else {
+                continue;
+            };
+            let (g0, q0) = self.params.snap_seed(x0);
+            let (g1, q1) = self.params.snap_seed(x1);
+            let (g2, q2) = self.params.snap_seed(x2);
+            let nrm = (q1 - q0).cross(q2 - q0);
+            let edges_ok = [(q0, q1), (q1, q2), (q2, q0)].iter().all(|(a, b)| {
+                let d = (*a - *b).length();
+                d > 0.3 * l && d < 1.8 * l
+            });
+            if !(nrm.dot(n0) > 0.0) || !edges_ok {
+                continue;
+            }
+            let n1 = self.surf.normal_at(t1, x1);
+            let n1 = self.surf.smooth_normal(x1, 0.5 * l, comp, n1);
+            let n2 = self.surf.normal_at(t2, x2);
+            let n2 = self.surf.smooth_normal(x2, 0.5 * l, comp, n2);
+            let a = self.add_vertex(q0, n0, VertexSource::Seed(g0));
+            let b = self.add_vertex(q1, n1, VertexSource::Seed(g1));
+            let c = self.add_vertex(q2, n2, VertexSource::Seed(g2));
+            self.add_triangle([a, b, c]);
+            // Loop x0 -> x2 -> x1 -> x0 (the seed's edges reversed).
+            let n_a = self.add_node(a);
+            let n_c = self.add_node(c);
+            let n_b = self.add_node(b);
+            self.link(n_a, n_c);
+            self.link(n_c, n_b);
+            self.link(n_b, n_a);
+            return Ok(n_a);
+        }
+        Err(Error::Stuck(format!(
+            "no seed triangle of edge length {l} fits on component {comp}"
+        )))
+    }
+
+    #[inline]
+    fn link(&mut self, a: u32, b: u32) {
+        self.nodes[a as usize].next = b;
+        self.nodes[b as usize].prev = a;
+    }
+
+    // --- Geometry of the front ----------------------------------------------------------
+
+    /// The open angle of node `n`: `2π` minus the angles of the built triangles of its
+    /// sector (walked around the vertex from the loop edge to its next node to the one from
+    /// its previous node), projected on the plane normal to the sum of their normals and
+    /// `extra` (the normal of a triangle about to be added). Unlike the angle between the two
+    /// loop edges it does not wrap: a sector whose triangles overlap gives a negative open
+    /// angle, a nearly closed one a small positive angle. Measuring in the plane of the
+    /// retiled fan itself, not along the original's normal, keeps it meaningful at creases
+    /// and thin edges where the original's normals point anywhere. Returns the open angle
+    /// and the projection normal.
+    fn wedge_in(&self, n: u32, extra: DVec3) -> (f64, DVec3) {
+        let node = self.nodes[n as usize];
+        let v = node.v;
+        let p = self.pos[v as usize];
+        let xv = self.nodes[node.next as usize].v;
+        let pv = self.nodes[node.prev as usize].v;
+        let mut fan = [0u32; 66];
+        let mut len = 1;
+        fan[0] = xv;
+        let mut sum = extra;
+        let mut from = xv;
+        // At most the vertex's valence; a guard against a corrupt fan.
+        while len < fan.len() {
+            let Some(&t) = self.edges.get(&ekey(from, v)) else {
+                break;
+            };
+            sum += self.tri_normal[t as usize];
+            let y = self.tris[t as usize]
+                .iter()
+                .copied()
+                .find(|&u| u != from && u != v)
+                .unwrap_or(from);
+            fan[len] = y;
+            len += 1;
+            if y == pv {
+                break;
+            }
+            from = y;
+        }
+        let mut nn = sum.normalize_or_zero();
+        if nn == DVec3::ZERO {
+            nn = self.nrm[v as usize];
+        }
+        let mut used = 0.0;
+        for k in 1..len {
+            let mut ang = ccw(
+                nn,
+                self.pos[fan[k] as usize] - p,
+                self.pos[fan[k - 1] as usize] - p,
+            );
+            if ang > PI {
+                ang -= TAU;
+            }
+            used += ang;
+        }
+        (TAU - used, nn)
+    }
+
+    /// The open angle of node `n` (see [`Self::wedge_in`]).
+    #[inline]
+    fn wedge(&self, n: u32) -> f64 {
+        self.wedge_in(n, DVec3::ZERO).0
+    }
+
+    /// Does the triangle corner at node `n`, spanning counter-clockwise from the ray towards
+    /// `first` to the ray towards `second`, fit inside the node's open wedge?
+    #[inline]
+    fn fits_wedge(&self, n: u32, first: DVec3, second: DVec3) -> bool {
+        self.wedge_violation(n, first, second) == 0.0
+    }
+
+    /// How far (radians beyond the slack) the corner at node `n` spanning from `first` to
+    /// `second` leaves the node's open wedge; 0 when it fits.
+    fn wedge_violation(&self, n: u32, first: DVec3, second: DVec3) -> f64 {
+        let node = self.nodes[n as usize];
+        let p = self.pos[node.v as usize];
+        let tri_n = (first - p).cross(second - p).normalize_or_zero();
+        let (open, nn) = self.wedge_in(n, tri_n);
+        let r = self.pos[self.nodes[node.next as usize].v as usize] - p;
+        let slack = self.tune.wedge_slack;
+        // Directions in the built arc (open..2π) count as clockwise of the reference ray
+        // when they are nearer to its start than to the open wedge's end.
+        let split = open.max(0.0) + (TAU - open.max(0.0)) * 0.5;
+        let norm = |a: f64| if a > split { a - TAU } else { a };
+        let af = norm(ccw(nn, r, first - p));
+        let as_ = norm(ccw(nn, r, second - p));
+        let projected =
+            (af - as_ - slack).max(0.0) + (as_ - open - slack).max(0.0) + (-af - slack).max(0.0);
+        if projected == 0.0 {
+            return 0.0;
+        }
+        // Intrinsically (3D corner angles, as if the fan were unfolded): exact across a
+        // crease, where the projection distorts the steep side. Either view may accept.
+        let corner = angle3(first - p, second - p);
+        let intrinsic = (corner - self.intrinsic_open(n) - slack).max(0.0);
+        projected.min(intrinsic)
+    }
+
+    /// `2π` minus the 3D corner angles of the sector of node `n`.
+    fn intrinsic_open(&self, n: u32) -> f64 {
+        let node = self.nodes[n as usize];
+        let v = node.v;
+        let p = self.pos[v as usize];
+        let pv = self.nodes[node.prev as usize].v;
+        let mut from = self.nodes[node.next as usize].v;
+        let mut used = 0.0;
+        for _ in 0..64 {
+            let Some(&t) = self.edges.get(&ekey(from, v)) else {
+                break;
+            };
+            let y = self.tris[t as usize]
+                .iter()
+                .copied()
+                .find(|&u| u != from && u != v)
+                .unwrap_or(from);
+            used += angle3(self.pos[y as usize] - p, self.pos[from as usize] - p);
+            if y == pv {
+                break;
+            }
+            from = y;
+        }
+        TAU - used
+    }
+
+    /// Combinatorial (and, with `geometric`, geometric) validity of existing node `w_node`
+    /// as the tip of gate `A -> B`.
+    fn valid_existing(&self, an: u32, bn: u32, wn: u32, geometric: bool) -> bool {
+        let a = self.nodes[an as usize].v;
+        let b = self.nodes[bn as usize].v;
+        let w = self.nodes[wn as usize].v;
+        if !self.nodes[wn as usize].alive || w == a || w == b {
+            return false;
+        }
+        let xn = self.nodes[bn as usize].next;
+        let pn = self.nodes[an as usize].prev;
+        if self.built(b, w) || self.built(w, a) {
+            return false;
+        }
+        if wn != xn && self.built(w, b) {
+            return false;
+        }
+        if wn != pn && self.built(a, w) {
+            return false;
+        }
+        // Boundary edges of M' stay open.
+        if wn == xn && self.boundary.contains_key(&ekey(b, w)) {
+            return false;
+        }
+        if wn == pn && self.boundary.contains_key(&ekey(w, a)) {
+            return false;
+        }
+        if !geometric {
+            return true;
+        }
+        let (pa, pb, pw) = (
+            self.pos[a as usize],
+            self.pos[b as usize],
+            self.pos[w as usize],
+        );
+        // Edges longer than about 2L would leave gates no swing can cross.
+        let max_edge = self.tune.max_edge * self.l;
+        if (pw - pa).length() > max_edge || (pw - pb).length() > max_edge {
+            return false;
+        }
+        if !self.triangle_ok(a, b, pw, self.nrm[w as usize]) {
+            return false;
+        }
+        // Folds against the neighbours it will be glued to.
+        let nt = (pa - pw).cross(pb - pw).normalize_or_zero();
+        let cos_fold = self.tune.max_fold.cos();
+        for (x, y) in [(w, b), (a, w)] {
+            if let Some(&t) = self.edges.get(&ekey(x, y)) {
+                if nt.dot(self.tri_normal[t as usize]) < cos_fold {
+                    return false;
+                }
+            }
+        }
+        self.existing_wedges(an, bn, wn) == 0.0
+    }
+
+    /// Wedge violations of the corners of triangle `(w, a, b)`. A corner that fills its
+    /// node's whole wedge (b for R, a for L, both for E) closes that wedge whatever its
+    /// size: it is exactly what an over-full wedge needs, so it is not measured.
+    fn existing_wedges(&self, an: u32, bn: u32, wn: u32) -> f64 {
+        let xn = self.nodes[bn as usize].next;
+        let pn = self.nodes[an as usize].prev;
+        let (pa, pb, pw) = (
+            self.pos[self.nodes[an as usize].v as usize],
+            self.pos[self.nodes[bn as usize].v as usize],
+            self.pos[self.nodes[wn as usize].v as usize],
+        );
+        let mut v = self.wedge_violation(wn, pa, pb);
+        if wn != xn {
+            v += self.wedge_violation(bn, pw, pa);
+        }
+        if wn != pn {
+            v += self.wedge_violation(an, pb, pw);
+        }
+        v
+    }
+
+    /// Shape checks shared by new and existing tips: non-degenerate, facing outwards, folding
+    /// less than `max_fold` against the parent.
+    fn triangle_ok(&self, a: u32, b: u32, pw: DVec3, nw: DVec3) -> bool {
+        let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
+        let n = (pa - pw).cross(pb - pw);
+        let len = n.length();
+        if !(len > 1e-9 * self.l * self.l) {
+            return false;
+        }
+        let nt = n / len;
+        if !self.faces_out(
+            nt,
+            pa,
+            pb,
+            pw,
+            self.nrm[a as usize] + self.nrm[b as usize] + nw,
+        ) {
+            return false;
+        }
+        match self.edges.get(&ekey(b, a)) {
+            Some(&t) => nt.dot(self.tri_normal[t as usize]) >= self.tune.max_fold.cos(),
+            None => true,
+        }
+    }
+
+    /// Does a triangle with unit normal `nt` and corners `pa, pb, pw` face outwards? Judged
+    /// against the original's face nearest to its centroid (smoothed vertex normals,
+    /// `vertex_sum`, mislead across creases and thin edges; they are the fallback when no
+    /// face is near).
+    fn faces_out(&self, nt: DVec3, pa: DVec3, pb: DVec3, pw: DVec3, vertex_sum: DVec3) -> bool {
+        // Clearly outwards by the vertex normals: no query needed.
+        if nt.dot(vertex_sum) > 0.5 * vertex_sum.length() {
+            return true;
+        }
+        let c = (pa + pb + pw) / 3.0;
+        match self.surf.closest_face_normal(c, self.comp, 0.75 * self.l) {
+            Some(n) => nt.dot(n) > -0.3,
+            None => nt.dot(vertex_sum) > 0.0,
+        }
+    }
+
+    /// Is `h` (surface normal `nh`) over a built triangle facing the same way (within
+    /// `cover_thickness · L` of its plane)? A triangle facing away is the other side of a
+    /// thin part, which the front may still have to wrap.
+    fn covered(&mut self, h: DVec3, nh: DVec3) -> bool {
+        let l = self.l;
+        let thick = self.tune.cover_thickness * l;
+        self.query = self.query.wrapping_add(1);
+        if self.query == 0 {
+            self.tri_stamp.iter_mut().for_each(|s| *s = 0);
+            self.query = 1;
+        }
+        if self.tri_stamp.len() < self.tris.len() {
+            self.tri_stamp.resize(self.tris.len() + 1024, 0);
+        }
+        let q = self.query;
+        let mut hit = false;
+        let mut near = Vec::new();
+        self.vgrid.near(h, 1.2 * l, |v| near.push(v));
+        'outer: for v in near {
+            let mut c = self.vcorner[v as usize];
+            while c != NONE {
+                let t = (c / 3) as usize;
+                c = self.corner_next[c as usize];
+                if self.tri_stamp[t] == q {
+                    continue;
+                }
+                self.tri_stamp[t] = q;
+                let n = self.tri_normal[t];
+                if n.dot(nh) < 0.0 {
+                    continue;
+                }
+                let [p0, p1, p2] = self.tris[t].map(|x| self.pos[x as usize]);
+                let d = (h - p0).dot(n);
+                if d.abs() > thick {
+                    continue;
+                }
+                let x = h - n * d;
+                // Inside, and at least `margin` from every edge: a hit on the border of the
+                // built part is the front itself (rule 4's business), not a covered spot.
+                let margin = 0.1 * l;
+                let inside = [(p0, p1), (p1, p2), (p2, p0)].iter().all(|&(s, e)| {
+                    let edge = e - s;
+                    let len = edge.length();
+                    len > 0.0 && edge.cross(x - s).dot(n) >= margin * len
+                });
+                if inside {
+                    hit = true;
+                    if std::env::var_os("WHET_SWING_TRACE2").is_some() {
+                        eprintln!(
+                            "   covered by tri {t} {:?} d {:.3}L at h {:?} tri pts {:?}",
+                            self.tris[t],
+                            d / l,
+                            h.to_array(),
+                            [p0, p1, p2].map(|p| p.to_array())
+                        );
+                    }
+                    break 'outer;
+                }
+            }
+        }
+        hit
+    }
+
+    /// The live loop vertex nearest to `p` (surface normal `np`) within `radius`, other
+    /// than `a` and `b`; and whether a closed (interior) vertex lies within `clearance`.
+    /// Vertices whose normal opposes `np` are on the other side of a thin part and ignored.
+    fn nearest_live(
+        &self,
+        p: DVec3,
+        np: DVec3,
+        radius: f64,
+        clearance: f64,
+        a: u32,
+        b: u32,
+    ) -> (Option<u32>, bool) {
+        let mut best: Option<(f64, u32)> = None;
+        let mut blocked = false;
+        let r2 = radius * radius;
+        let c2 = clearance * clearance;
+        self.vgrid.near(p, radius.max(clearance), |v| {
+            if v == a || v == b {
+                return;
+            }
+            if self.nrm[v as usize].dot(np) < -0.2 {
+                return;
+            }
+            let d2 = (self.pos[v as usize] - p).length_squared();
+            if self.vlive[v as usize] == 0 {
+                if d2 < c2 {
+                    blocked = true;
+                }
+                return;
+            }
+            if d2 <= r2 && best.map_or(true, |(bd, _)| d2 < bd) {
+                best = Some((d2, v));
+            }
+        });
+        (best.map(|(_, v)| v), blocked)
+    }
+
+    /// The live nodes of vertex `v`, preferring the gate's neighbours `x` and `p` nodes.
+    fn nodes_of(&self, v: u32, xn: u32, pn: u32) -> Vec<u32> {
+        if self.nodes[xn as usize].v == v {
+            return vec![xn];
+        }
+        if self.nodes[pn as usize].v == v {
+            return vec![pn];
+        }
+        let mut out = Vec::new();
+        let mut m = self.vnode[v as usize];
+        while m != NONE {
+            if self.nodes[m as usize].alive {
+                out.push(m);
+            }
+            m = self.nodes[m as usize].same;
+        }
+        out
+    }
+
+    // --- One step -----------------------------------------------------------------------
+
+    /// Builds the triangle at gate node `an`; returns the next gate, or `None` after an E.
+    fn step(&mut self, mut an: u32) -> Result<Option<u32>, Error> {
+        // A gate declared boundary stays open: move along the loop to one that is not;
+        // a loop made only of boundary edges is finished (a hole of M').
+        if !self.boundary.is_empty() {
+            let start = an;
+            let mut guard = 0usize;
+            loop {
+                let b = self.nodes[self.nodes[an as usize].next as usize].v;
+                if !self
+                    .boundary
+                    .contains_key(&ekey(self.nodes[an as usize].v, b))
+                {
+                    break;
+                }
+                an = self.nodes[an as usize].next;
+                guard += 1;
+                if an == start || guard > self.nodes.len() {
+                    return Ok(None);
+                }
+            }
+        }
+        let bn = self.nodes[an as usize].next;
+        let xn = self.nodes[bn as usize].next;
+        let pn = self.nodes[an as usize].prev;
+        let a = self.nodes[an as usize].v;
+        let b = self.nodes[bn as usize].v;
+        let three = xn == pn;
+        let open_b = self.wedge(bn);
+        let open_a = self.wedge(an);
+        let close = self.tune.close_angle;
+
+        // Rule 2: a small loop of three closes.
+        if three && (open_a < close || open_b < close) && self.valid_existing(an, bn, xn, true) {
+            return self.apply(an, Tip::Existing(xn));
+        }
+        // Rule 3: close a small wedge.
+        if !three {
+            let mut cands = [(open_b, xn), (open_a, pn)];
+            if open_a < open_b {
+                cands.swap(0, 1);
+            }
+            for (angle, n) in cands {
+                if angle < close && self.valid_existing(an, bn, n, true) {
+                    return self.apply(an, Tip::Existing(n));
+                }
+            }
+        }
+        // Rules 4 and 5: swing.
+        let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
+        let mut spare: Option<Spare> = None;
+        if let Some(c) = self.parent_vertex(a, b) {
+            if let Some(frame) = self.params.frame(pa, pb, self.pos[c as usize]) {
+                let mut hits = std::mem::take(&mut self.hits);
+                self.surf.circle_hits(&frame, self.comp, &mut hits);
+                let tmax = self.tune.theta_max;
+                let best = hits
+                    .iter()
+                    .filter(|h| h.theta.abs() <= tmax)
+                    .min_by(|x, y| x.theta.abs().total_cmp(&y.theta.abs()))
+                    .copied();
+                self.hits = hits;
+                if let Some(h) = best {
+                    let q = self.params.angles.quantize(h.theta);
+                    let v = frame.tip(&self.params.angles, q);
+                    let rough = self.surf.normal_at(h.triangle, h.point);
+                    let normal = self
+                        .surf
+                        .smooth_normal(h.point, 0.5 * self.l, self.comp, rough);
+                    let (near, blocked) = self.nearest_live(
+                        v,
+                        normal,
+                        self.tune.snap * self.l,
+                        self.tune.interior_clearance * self.l,
+                        a,
+                        b,
+                    );
+                    let mut penalty = 0.0;
+                    if let Some(w) = near {
+                        // Rule 4: the tip falls on the front: connect to it.
+                        for wn in self.nodes_of(w, xn, pn) {
+                            if self.valid_existing(an, bn, wn, true) {
+                                return self.apply(an, Tip::Existing(wn));
+                            }
+                        }
+                        penalty += 1.0;
+                    }
+                    if blocked {
+                        self.stats.covered_hits += 1;
+                        penalty += 2.0;
+                    } else if near.is_none() && self.covered(h.point, normal) {
+                        self.stats.covered_hits += 1;
+                        penalty += 2.0;
+                    }
+                    if penalty == 0.0
+                        && self.triangle_ok(a, b, v, normal)
+                        && self.fits_wedge(bn, v, pa)
+                        && self.fits_wedge(an, pb, v)
+                    {
+                        // Rule 5: a new vertex.
+                        return self.apply(an, Tip::New { pos: v, normal, q });
+                    }
+                    if std::env::var_os("WHET_SWING_TRACE").is_some() {
+                        eprintln!(
+                            "C refused at tri {}: theta {:.0} penalty {penalty} tri_ok {} fits b {} ({:.0}) fits a {} ({:.0}), viol b {:.2} a {:.2}",
+                            self.tris.len(),
+                            h.theta.to_degrees(),
+                            self.triangle_ok(a, b, v, normal),
+                            self.fits_wedge(bn, v, pa),
+                            open_b.to_degrees(),
+                            self.fits_wedge(an, pb, v),
+                            open_a.to_degrees(),
+                            self.wedge_violation(bn, v, pa),
+                            self.wedge_violation(an, pb, v),
+                        );
+                    }
+                    spare = Some(Spare {
+                        pos: v,
+                        normal,
+                        q,
+                        penalty,
+                    });
+                } else if self.surf.open && self.near_boundary_of_m(pa, pb) {
+                    return Ok(Some(self.declare_boundary(an)));
+                }
+                // No clean hit: the point of the circle nearest to the surface, off the
+                // built part (the wrapper then bridges gaps narrower than L, as a shrink
+                // wrap would).
+                if spare.as_ref().map_or(true, |sp| sp.penalty > 0.0) {
+                    if let Some(sp) = self.nearest_on_circle(&frame, a, b) {
+                        if spare.as_ref().map_or(true, |s| sp.penalty < s.penalty) {
+                            spare = Some(sp);
+                        }
+                    }
+                }
+            }
+        }
+        self.fallback(an, spare)
+    }
+
+    /// The admissible swing tip nearest to the surface among those not over the built
+    /// part and not near a closed vertex; its penalty grows with its distance to `M`.
+    fn nearest_on_circle(&mut self, frame: &SwingFrame, a: u32, b: u32) -> Option<Spare> {
+        let l = self.l;
+        let tmax = self.tune.theta_max;
+        let angles = &self.params.angles;
+        let qmax = angles.quantize(tmax).abs().min(angles.max_index());
+        let stride = ((10.0f64.to_radians() / angles.step()).round() as i32).max(1);
+        let mut best: Option<(f64, i32, DVec3, DVec3)> = None;
+        let eval = |r: &mut Self, q: i32, best: &mut Option<(f64, i32, DVec3, DVec3)>| {
+            let p = frame.tip(&r.params.angles, q);
+            let Some((x, t)) = r.surf.closest_in_component(p, r.comp, l) else {
+                return;
+            };
+            let d = (x - p).length();
+            if best.map_or(false, |(bd, ..)| d >= bd) {
+                return;
+            }
+            let rough = r.surf.normal_at(t, x);
+            let n = r.surf.smooth_normal(x, 0.5 * l, r.comp, rough);
+            let (near, blocked) =
+                r.nearest_live(p, n, r.tune.snap * l, r.tune.interior_clearance * l, a, b);
+            if near.is_some() || blocked || r.covered(x, n) {
+                return;
+            }
+            *best = Some((d, q, p, n));
+        };
+        let mut q = -qmax;
+        while q <= qmax {
+            eval(self, q, &mut best);
+            q += stride;
+        }
+        let (_, q0, ..) = best?;
+        for q in (q0 - stride + 1)..(q0 + stride) {
+            if q != q0 && (-qmax..=qmax).contains(&q) {
+                eval(self, q, &mut best);
+            }
+        }
+        best.map(|(d, q, pos, normal)| Spare {
+            pos,
+            normal,
+            q,
+            penalty: 0.5 + 2.0 * d / l,
+        })
+    }
+
+    /// Rule 6: no regular move fits. Every combinatorially valid move (the loop
+    /// neighbours, any front vertex near the gate, the spare swing tip) gets a cost for how
+    /// much it violates the geometric checks and how long its edges are, and the cheapest is
+    /// taken: the mesh stays a valid manifold and degrades gracefully where the surface is
+    /// hard (thin parts, sharp creases, pockets of the front).
+    fn fallback(&mut self, an: u32, spare: Option<Spare>) -> Result<Option<u32>, Error> {
+        self.stats.fallbacks += 1;
+        let bn = self.nodes[an as usize].next;
+        let xn = self.nodes[bn as usize].next;
+        let pn = self.nodes[an as usize].prev;
+        let a = self.nodes[an as usize].v;
+        let b = self.nodes[bn as usize].v;
+        let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
+        let mut nodes = vec![xn, pn];
+        let mid = (pa + pb) * 0.5;
+        let radius = 2.5 * self.l + (pa - pb).length();
+        let mut near = Vec::new();
+        self.vgrid.near(mid, radius, |v| {
+            if v != a && v != b && self.vlive[v as usize] > 0 {
+                near.push(v);
+            }
+        });
+        for v in near {
+            for wn in self.nodes_of(v, xn, pn) {
+                if !nodes.contains(&wn) {
+                    nodes.push(wn);
+                }
+            }
+        }
+        let mut best: Option<(f64, Option<u32>)> = None;
+        for wn in nodes {
+            if self.valid_existing(an, bn, wn, false) {
+                let c = self.existing_cost(an, bn, wn);
+                if best.map_or(true, |(bc, _)| c < bc) {
+                    best = Some((c, Some(wn)));
+                }
+            }
+        }
+        if let Some(sp) = &spare {
+            let c = 0.5 + sp.penalty + self.new_cost(an, bn, sp.pos, sp.normal);
+            if best.map_or(true, |(bc, _)| c < bc) {
+                best = Some((c, None));
+            }
+        }
+        if std::env::var_os("WHET_SWING_TRACE").is_some() {
+            let x = self.nodes[xn as usize].v;
+            let px = self.pos[x as usize];
+            eprintln!(
+                "   R parts: shape {:.2} viol b {:.2} a {:.2} x {:.2}",
+                self.shape_cost(a, b, px, self.nrm[x as usize]),
+                self.wedge_violation(bn, px, pa),
+                self.wedge_violation(an, pb, px),
+                self.wedge_violation(xn, pa, pb)
+            );
+            eprintln!(
+                "fallback at tri {}: gate {a}->{b} len {:.3}L, spare {:?}, best {:?}; R: valid {} cost {:.2} len {:.2}L built(x,a) {} built(a,x) {}",
+                self.tris.len(),
+                (pa - pb).length() / self.l,
+                spare.as_ref().map(|s| s.penalty),
+                best,
+                self.valid_existing(an, bn, xn, false),
+                self.existing_cost(an, bn, xn),
+                (self.pos[x as usize] - pa).length() / self.l,
+                self.built(x, a),
+                self.built(a, x),
+            );
+        }
+        match best {
+            Some((c, choice)) => {
+                if c > 1.0 {
+                    self.stats.forced += 1;
+                }
+                match (choice, spare) {
+                    (Some(wn), _) => self.apply(an, Tip::Existing(wn)),
+                    (None, Some(sp)) => self.apply(
+                        an,
+                        Tip::New {
+                            pos: sp.pos,
+                            normal: sp.normal,
+                            q: sp.q,
+                        },
+                    ),
+                    (None, None) => Err(Error::Internal("fallback chose nothing".into())),
+                }
+            }
+            None => Err(Error::Stuck(format!(
+                "no valid triangle closes the gate between retiled vertices {a} and {b}"
+            ))),
+        }
+    }
+
+    /// Cost of closing gate `an -> bn` with existing node `wn` (0 when every check passes).
+    fn existing_cost(&self, an: u32, bn: u32, wn: u32) -> f64 {
+        let a = self.nodes[an as usize].v;
+        let b = self.nodes[bn as usize].v;
+        let w = self.nodes[wn as usize].v;
+        let (pa, pb, pw) = (
+            self.pos[a as usize],
+            self.pos[b as usize],
+            self.pos[w as usize],
+        );
+        let mut c = self.shape_cost(a, b, pw, self.nrm[w as usize]);
+        let nt = (pa - pw).cross(pb - pw).normalize_or_zero();
+        for (x, y) in [(w, b), (a, w)] {
+            if let Some(&t) = self.edges.get(&ekey(x, y)) {
+                let fold = nt.dot(self.tri_normal[t as usize]).clamp(-1.0, 1.0).acos();
+                c += 2.0 * (fold - self.tune.max_fold).max(0.0);
+            }
+        }
+        c + 2.0 * self.existing_wedges(an, bn, wn)
+    }
+
+    /// Cost of a new tip at `pv` for gate `an -> bn`.
+    fn new_cost(&self, an: u32, bn: u32, pv: DVec3, nv: DVec3) -> f64 {
+        let a = self.nodes[an as usize].v;
+        let b = self.nodes[bn as usize].v;
+        let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
+        self.shape_cost(a, b, pv, nv)
+            + 2.0 * (self.wedge_violation(bn, pv, pa) + self.wedge_violation(an, pb, pv))
+    }
+
+    /// Penalties of triangle `(w, a, b)`: long edges, degeneracy, facing inwards, folding
+    /// against the parent.
+    fn shape_cost(&self, a: u32, b: u32, pw: DVec3, nw: DVec3) -> f64 {
+        let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
+        let l = self.l;
+        let longest = (pw - pa).length().max((pw - pb).length()) / l;
+        // Edges of 2L or more leave gates without a swing circle: the front can then only
+        // zip itself shut with ever longer edges. Avoid them at almost any price.
+        let mut c = 3.0 * (longest - 1.2).max(0.0) + 20.0 * (longest - 1.9).max(0.0);
+        let n = (pa - pw).cross(pb - pw);
+        let len = n.length();
+        if !(len > 1e-9 * l * l) {
+            return c + 10.0;
+        }
+        let nt = n / len;
+        if !self.faces_out(
+            nt,
+            pa,
+            pb,
+            pw,
+            self.nrm[a as usize] + self.nrm[b as usize] + nw,
+        ) {
+            c += 3.0;
+        }
+        if let Some(&t) = self.edges.get(&ekey(b, a)) {
+            let fold = nt.dot(self.tri_normal[t as usize]).clamp(-1.0, 1.0).acos();
+            c += 2.0 * (fold - self.tune.max_fold).max(0.0);
+        }
+        c
+    }
+
+    /// Is the gate `pa -> pb` at a boundary of the (open) original?
+    fn near_boundary_of_m(&self, _pa: DVec3, _pb: DVec3) -> bool {
+        // Open originals: a gate whose circle misses M entirely lies at M's border.
+        true
+    }
+
+    /// Marks the gate edge as a boundary edge of `M'` and moves on along the loop; returns
+    /// the next gate to work on.
+    fn declare_boundary(&mut self, an: u32) -> u32 {
+        let bn = self.nodes[an as usize].next;
+        let a = self.nodes[an as usize].v;
+        let b = self.nodes[bn as usize].v;
+        self.boundary.insert(ekey(a, b), ());
+        self.stats.boundary_edges += 1;
+        bn
+    }
+
+    /// Adds the triangle of gate `an` with `tip`, updates the loops and returns the next gate.
+    fn apply(&mut self, an: u32, tip: Tip) -> Result<Option<u32>, Error> {
+        let bn = self.nodes[an as usize].next;
+        let xn = self.nodes[bn as usize].next;
+        let pn = self.nodes[an as usize].prev;
+        let a = self.nodes[an as usize].v;
+        let b = self.nodes[bn as usize].v;
+        match tip {
+            Tip::New { pos, normal, q } => {
+                let v = self.add_vertex(pos, normal, VertexSource::Swing(q));
+                self.add_triangle([v, a, b]);
+                self.labels.push(Clers::C);
+                let vn = self.add_node(v);
+                self.link(an, vn);
+                self.link(vn, bn);
+                Ok(Some(vn))
+            }
+            Tip::Existing(wn) => {
+                let w = self.nodes[wn as usize].v;
+                // The traversal's rule: right neighbour built <=> w -> b built, left <=> a -> w.
+                let right = self.built(w, b);
+                let left = self.built(a, w);
+                self.add_triangle([w, a, b]);
+                let label = match (right, left) {
+                    (true, true) => Clers::E,
+                    (true, false) => Clers::R,
+                    (false, true) => Clers::L,
+                    (false, false) => Clers::S,
+                };
+                self.labels.push(label);
+                if std::env::var_os("WHET_SWING_TRACE").is_some() {
+                    let (pa, pb, pw) = (
+                        self.pos[a as usize],
+                        self.pos[b as usize],
+                        self.pos[w as usize],
+                    );
+                    let m = (pw - pa).length().max((pw - pb).length()) / self.l;
+                    if m > 1.6 {
+                        eprintln!(
+                            "long edge {m:.2}L by {} at tri {} (gate {:.2}L)",
+                            label.letter(),
+                            self.tris.len(),
+                            (pa - pb).length() / self.l
+                        );
+                    }
+                }
+                let consistent = match label {
+                    Clers::E => wn == xn && wn == pn,
+                    Clers::R => wn == xn,
+                    Clers::L => wn == pn,
+                    _ => wn != xn && wn != pn,
+                };
+                if !consistent {
+                    return Err(Error::Internal(format!(
+                        "label {} does not match the loop at gate {a} -> {b}",
+                        label.letter()
+                    )));
+                }
+                match label {
+                    Clers::R => {
+                        self.kill_node(bn);
+                        self.link(an, xn);
+                        Ok(Some(an))
+                    }
+                    Clers::L => {
+                        self.kill_node(an);
+                        self.link(pn, bn);
+                        Ok(Some(pn))
+                    }
+                    Clers::E => {
+                        self.kill_node(an);
+                        self.kill_node(bn);
+                        self.kill_node(xn);
+                        Ok(None)
+                    }
+                    _ => {
+                        // S: W keeps its predecessor and gets successor b; a new node W2
+                        // for w gets W's old successor and predecessor a.
+                        let wnext = self.nodes[wn as usize].next;
+                        let w2 = self.add_node(w);
+                        self.link(an, w2);
+                        self.link(w2, wnext);
+                        self.link(wn, bn);
+                        self.stack.push((an, a, w));
+                        Ok(Some(wn))
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ccw_measures_counter_clockwise() {
+        let n = DVec3::Z;
+        assert!((ccw(n, DVec3::X, DVec3::Y) - PI / 2.0).abs() < 1e-12);
+        assert!((ccw(n, DVec3::Y, DVec3::X) - 1.5 * PI).abs() < 1e-12);
+        assert!((ccw(n, DVec3::X, -DVec3::X) - PI).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,159 @@
+//! `whet sharpen` (EdgeSharpener) and `whet bend` (Bender), and the helpers `whet decode`
+//! uses to run them after decoding.
+
+use super::{print_json, read_mesh, write_mesh, CliResult, Failure};
+use clap::Args;
+use std::path::PathBuf;
+use whet::Mesh;
+use whet_sharpen::{sharpen, Method, SharpTags, SharpenOptions, Sharpened};
+
+#[derive(Args, Debug)]
+pub struct SharpenArgs {
+    /// Input mesh (e.g. a decoded retiled mesh).
+    input: PathBuf,
+    /// Output mesh.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// An edge is smooth when its normal angle is under this factor times the mesh average.
+    #[arg(long, default_value_t = 2.0)]
+    smooth_factor: f64,
+    /// `extended` (default: whet's extended chamfer detection) or `papers` (the papers'
+    /// six filters only).
+    #[arg(long, default_value = "extended")]
+    method: String,
+    /// Write the sharp-edge tags (for `whet bend --tags`) to this file.
+    #[arg(long)]
+    tags: Option<PathBuf>,
+    /// Print the report as one JSON object.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Options from the command line's words.
+pub fn sharpen_options(method: &str, smooth_factor: f64) -> Result<SharpenOptions, Failure> {
+    let method: Method = method.parse().map_err(Failure::input)?;
+    let opts = SharpenOptions::DEFAULT
+        .with_method(method)
+        .with_smooth_factor(smooth_factor);
+    opts.validate().map_err(Failure::input)?;
+    Ok(opts)
+}
+
+/// Sharpens, cutting non-manifold input first (and saying so).
+pub fn run_sharpen(mesh: &Mesh, opts: &SharpenOptions) -> CliResult<Sharpened> {
+    match sharpen(mesh, opts) {
+        Ok(s) => Ok(s),
+        Err(whet_sharpen::Error::InvalidInput(e)) => {
+            let mut m = mesh.clone();
+            let rep = m.make_manifold();
+            eprintln!("whet: the mesh is not an oriented manifold ({e}); make_manifold {rep}");
+            sharpen(&m, opts).map_err(Failure::input)
+        }
+        Err(e) => Err(Failure::input(e)),
+    }
+}
+
+pub fn run(args: &SharpenArgs) -> CliResult {
+    let mesh = read_mesh(&args.input, None)?;
+    let opts = sharpen_options(&args.method, args.smooth_factor)?;
+    let out = run_sharpen(&mesh, &opts)?;
+    write_mesh(
+        &args.output,
+        &out.mesh,
+        None,
+        &whet::io::WriteOptions::DEFAULT,
+    )?;
+    if let Some(t) = &args.tags {
+        out.tags.write_path(t, &out.mesh).map_err(|e| {
+            Failure::other(anyhow::Error::new(e).context(format!("cannot write {}", t.display())))
+        })?;
+    }
+    if args.json {
+        let v: serde_json::Value = serde_json::from_str(&out.report.to_json())
+            .map_err(|e| Failure::other(anyhow::Error::new(e)))?;
+        print_json(&v);
+    } else {
+        eprintln!(
+            "{} -> {}: {} vertices, {} triangles",
+            args.input.display(),
+            args.output.display(),
+            out.mesh.positions.len(),
+            out.mesh.triangles.len()
+        );
+    }
+    Ok(())
+}
+
+#[derive(Args, Debug)]
+pub struct BendArgs {
+    /// Input mesh (e.g. a sharpened one).
+    input: PathBuf,
+    /// Output mesh.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Subdivision levels.
+    #[arg(long, default_value_t = 1)]
+    levels: u32,
+    /// Sharp-edge tags written by `whet sharpen --tags`; without it the edges are tagged by
+    /// EdgeSharpener's filter 3bis rule on the input.
+    #[arg(long)]
+    tags: Option<PathBuf>,
+}
+
+/// Sharp edges of `tags` as plain pairs.
+pub fn tag_edges(tags: &SharpTags) -> Vec<[u32; 2]> {
+    tags.edges.iter().map(|e| [e[0].0, e[1].0]).collect()
+}
+
+/// Tags for a mesh that came without them: EdgeSharpener's filter 3bis on the mesh, keeping
+/// the sharp edges that are edges of the mesh itself.
+pub fn fallback_tags(mesh: &Mesh) -> CliResult<Vec<[u32; 2]>> {
+    let s = run_sharpen(mesh, &SharpenOptions::DEFAULT)?;
+    let n = mesh.positions.len() as u32;
+    let mut own: Vec<u64> = mesh
+        .undirected_edges()
+        .iter()
+        .map(|e| whet::edge_key(e[0], e[1]))
+        .collect();
+    own.sort_unstable();
+    Ok(tag_edges(&s.tags)
+        .into_iter()
+        .filter(|e| e[0] < n && e[1] < n && own.binary_search(&whet::edge_key(e[0], e[1])).is_ok())
+        .collect())
+}
+
+/// Bends `levels` times; errors are input errors.
+pub fn run_bend(mesh: &Mesh, sharp: &[[u32; 2]], levels: u32) -> CliResult<Mesh> {
+    whet_bend::bend_levels(mesh, sharp, levels)
+        .map(|b| b.mesh)
+        .map_err(Failure::input)
+}
+
+pub fn run_bend_cmd(args: &BendArgs) -> CliResult {
+    let mesh = read_mesh(&args.input, None)?;
+    if args.levels > 8 {
+        return Err(Failure::input(anyhow::anyhow!(
+            "--levels {} would multiply the triangles by 4^{}; at most 8",
+            args.levels,
+            args.levels
+        )));
+    }
+    let sharp = match &args.tags {
+        Some(t) => tag_edges(&SharpTags::read_path(t, &mesh).map_err(Failure::input)?),
+        None => {
+            eprintln!("whet bend: no --tags given; tagging sharp edges with EdgeSharpener's filter 3bis rule");
+            fallback_tags(&mesh)?
+        }
+    };
+    let out = run_bend(&mesh, &sharp, args.levels)?;
+    write_mesh(&args.output, &out, None, &whet::io::WriteOptions::DEFAULT)?;
+    eprintln!(
+        "{} -> {}: {} levels, {} sharp edges, {} triangles",
+        args.input.display(),
+        args.output.display(),
+        args.levels,
+        sharp.len(),
+        out.triangles.len()
+    );
+    Ok(())
+}
