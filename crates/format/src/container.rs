@@ -25,13 +25,19 @@ impl SectionKind {
     pub const GEOMETRY: SectionKind = SectionKind(4);
     /// Optional: per-vertex attributes.
     pub const ATTRIBUTES: SectionKind = SectionKind(5);
+    /// Required (subdiv mode): the control mesh, a complete exact-mode stream.
+    pub const CONTROL: SectionKind = SectionKind(6);
+    /// Required (subdiv mode): the quantized sharpness of every control edge.
+    pub const SHARPNESS: SectionKind = SectionKind(8);
 
     /// Every section kind of format 1.0, in tag order.
-    pub const KNOWN: [SectionKind; 4] = [
+    pub const KNOWN: [SectionKind; 6] = [
         SectionKind::METADATA,
         SectionKind::CONNECTIVITY,
         SectionKind::GEOMETRY,
         SectionKind::ATTRIBUTES,
+        SectionKind::CONTROL,
+        SectionKind::SHARPNESS,
     ];
 
     /// The kind with wire tag `tag`, known or not.
@@ -61,6 +67,8 @@ impl SectionKind {
             2 => Some("connectivity"),
             4 => Some("geometry"),
             5 => Some("attributes"),
+            6 => Some("control"),
+            8 => Some("sharpness"),
             _ => None,
         }
     }
@@ -260,7 +268,7 @@ mod tests {
             matches!(c.to_bytes(), Err(Error::Parameter(_))),
             "end marker"
         );
-        c.sections = vec![Section::new(SectionKind::new(8), vec![])];
+        c.sections = vec![Section::new(SectionKind::new(10), vec![])];
         assert!(
             matches!(c.to_bytes(), Err(Error::Parameter(_))),
             "unknown required"
@@ -279,7 +287,7 @@ mod tests {
         );
         let c = Container::new(header().with(crate::tag::QUANT_BITS, 1.5));
         assert!(matches!(c.to_bytes(), Err(Error::Parameter(_))));
-        let c = Container::new(header().with(12, 1u64));
+        let c = Container::new(header().with(14, 1u64));
         assert!(
             matches!(c.to_bytes(), Err(Error::Parameter(_))),
             "unknown required"

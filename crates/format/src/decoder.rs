@@ -445,7 +445,7 @@ impl StreamingDecoder {
         self.limits.check_section(len)?;
         // The payload and its CRC must leave room for the end marker before the declared end.
         let end = after.checked_add(len).and_then(|e| e.checked_add(4));
-        if end.map_or(true, |end| end >= self.declared_len) {
+        if end.is_none_or(|end| end >= self.declared_len) {
             return Err(FormatError::SectionOverrun {
                 tag: kind.tag(),
                 len,

@@ -142,15 +142,18 @@ pub mod tag {
     pub const EDGE_LENGTH: u64 = 8;
     /// u64: bits of a quantized swing angle (swing).
     pub const ANGLE_BITS: u64 = 10;
+    /// u64: subdivision levels the decoder applies to the control mesh (subdiv).
+    pub const SUBDIV_LEVELS: u64 = 12;
 
     /// Every tag this crate knows, with its name and value type.
-    pub const KNOWN: [(u64, &str, ValueType); 6] = [
+    pub const KNOWN: [(u64, &str, ValueType); 7] = [
         (ENCODER, "encoder", ValueType::Bytes),
         (COMPONENT_COUNT, "component_count", ValueType::U64),
         (QUANT_BITS, "quant_bits", ValueType::U64),
         (BBOX, "bbox", ValueType::Bytes),
         (EDGE_LENGTH, "edge_length", ValueType::F64),
         (ANGLE_BITS, "angle_bits", ValueType::U64),
+        (SUBDIV_LEVELS, "subdiv_levels", ValueType::U64),
     ];
 
     /// Name and type of a known tag.

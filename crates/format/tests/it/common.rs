@@ -24,6 +24,8 @@ pub fn sample() -> Container {
             (0..90u8).map(|i| i.wrapping_mul(37)).collect::<Vec<_>>(),
         )
         .with_section(SectionKind::ATTRIBUTES, vec![])
+        .with_section(SectionKind::CONTROL, b"control".to_vec())
+        .with_section(SectionKind::SHARPNESS, vec![3, 1, 4])
 }
 
 pub fn sample_bytes() -> Vec<u8> {

@@ -210,7 +210,7 @@ pub(crate) fn ear_clip(pts: &[DVec2]) -> Vec<[usize; 3]> {
                 continue;
             }
             let q = min_angle(a, b, c);
-            if best.map_or(true, |(_, bq)| q > bq) {
+            if best.is_none_or(|(_, bq)| q > bq) {
                 best = Some((k, q));
             }
         }
