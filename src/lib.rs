@@ -33,6 +33,92 @@ pub mod codec {
     pub use whet_codec::*;
 }
 
-pub use whet_codec::{
-    decode, encode, DecodeOptions, Decoder, EncodeOptions, Encoder, StreamingDecoder,
-};
+pub use whet_codec::{encode, DecodeOptions, Decoder, EncodeOptions, Encoder, StreamingDecoder};
+
+/// Why a stream could not be decoded (or a subdiv stream encoded).
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// The container, or an exact or swing stream, is bad.
+    #[error(transparent)]
+    Codec(#[from] whet_codec::Error),
+    /// A subdiv stream is bad.
+    #[error(transparent)]
+    Subdiv(#[from] whet_subdiv::Error),
+}
+
+impl Error {
+    /// True when the fault is in the bytes handed to a decoder.
+    pub fn is_input_error(&self) -> bool {
+        match self {
+            Error::Codec(e) => e.is_input_error(),
+            Error::Subdiv(e) => !matches!(e, whet_subdiv::Error::Parameter(_)),
+        }
+    }
+}
+
+/// Decodes a `.whet` stream of any mode: exact and swing through whet-codec, subdiv through
+/// whet-subdiv (its control mesh is subdivided `subdiv_levels` times, or `levels` when given;
+/// `Some(0)` returns the control mesh).
+pub fn decode_with_levels(
+    bytes: &[u8],
+    opts: &DecodeOptions,
+    levels: Option<u32>,
+) -> Result<Mesh, Error> {
+    let container = whet_format::parse(bytes, &opts.limits).map_err(whet_codec::Error::from)?;
+    let h = &container.header;
+    if h.mode != whet_format::Mode::Subdiv {
+        return Ok(whet_codec::decode_container(&container, opts)?);
+    }
+    let missing =
+        |what: &str| whet_subdiv::Error::Corrupt(format!("subdiv stream without its {what}"));
+    let stated = h
+        .get_u64(whet_format::tag::SUBDIV_LEVELS)
+        .ok_or_else(|| missing("subdiv_levels field"))?;
+    let control = container
+        .section(whet_format::SectionKind::CONTROL)
+        .ok_or_else(|| missing("control section"))?;
+    let sharpness = container
+        .section(whet_format::SectionKind::SHARPNESS)
+        .ok_or_else(|| missing("sharpness section"))?;
+    let levels = match levels {
+        Some(l) => l,
+        None => u32::try_from(stated).map_err(|_| missing("valid subdiv_levels"))?,
+    };
+    let mesh = whet_subdiv::decode_subdiv(control, sharpness, levels, opts)?;
+    if levels as u64 == stated
+        && (mesh.positions.len() as u64 != h.vertex_count
+            || mesh.triangles.len() as u64 != h.triangle_count)
+    {
+        return Err(
+            whet_subdiv::Error::Corrupt("decoded counts differ from the header's".into()).into(),
+        );
+    }
+    Ok(mesh)
+}
+
+/// Decodes a `.whet` stream of any mode (see [`decode_with_levels`]).
+pub fn decode(bytes: &[u8], opts: &DecodeOptions) -> Result<Mesh, Error> {
+    decode_with_levels(bytes, opts, None)
+}
+
+/// Encodes `mesh` in the subdiv mode: fits a control mesh with continuous edge sharpness and
+/// writes the container (header field `subdiv_levels`, sections `control` and `sharpness`).
+pub fn encode_subdiv(
+    mesh: &Mesh,
+    opts: &whet_subdiv::SubdivEncodeOptions,
+) -> Result<(Vec<u8>, whet_subdiv::SubdivReport), Error> {
+    let p = whet_subdiv::encode_subdiv(mesh, opts)?;
+    let header = whet_format::Header::new(
+        whet_format::Mode::Subdiv,
+        p.report.decoded_vertices,
+        p.report.decoded_triangles,
+    )
+    .with(whet_format::tag::SUBDIV_LEVELS, p.levels as u64);
+    let bytes = whet_format::Container::new(header)
+        .with_section(whet_format::SectionKind::CONTROL, p.control)
+        .with_section(whet_format::SectionKind::SHARPNESS, p.sharpness)
+        .to_bytes()
+        .map_err(whet_codec::Error::from)?;
+    Ok((bytes, p.report))
+}

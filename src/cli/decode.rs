@@ -3,7 +3,7 @@
 use super::{write_mesh, CliResult, Failure};
 use clap::Args;
 use std::path::PathBuf;
-use whet_codec::{decode, DecodeOptions};
+use whet_codec::DecodeOptions;
 
 #[derive(Args, Debug)]
 pub struct DecodeArgs {
@@ -28,6 +28,9 @@ pub struct DecodeArgs {
     /// EdgeSharpener's method: extended (default) or papers.
     #[arg(long, default_value = "extended")]
     method: String,
+    /// Subdiv streams: subdivision levels, overriding the header (0 gives the control mesh).
+    #[arg(long)]
+    levels: Option<u32>,
 }
 
 pub fn run(args: &DecodeArgs) -> CliResult {
@@ -36,15 +39,17 @@ pub fn run(args: &DecodeArgs) -> CliResult {
             anyhow::Error::new(e).context(format!("cannot read {}", args.input.display())),
         )
     })?;
-    let mesh = decode(&bytes, &DecodeOptions::DEFAULT).map_err(|e| {
-        let input = e.is_input_error();
-        let err = anyhow::Error::new(e).context(format!("cannot decode {}", args.input.display()));
-        if input {
-            Failure::input(err)
-        } else {
-            Failure::other(err)
-        }
-    })?;
+    let mesh =
+        whet::decode_with_levels(&bytes, &DecodeOptions::DEFAULT, args.levels).map_err(|e| {
+            let input = e.is_input_error();
+            let err =
+                anyhow::Error::new(e).context(format!("cannot decode {}", args.input.display()));
+            if input {
+                Failure::input(err)
+            } else {
+                Failure::other(err)
+            }
+        })?;
     let mesh = if args.sharpen {
         let opts = super::sharpen::sharpen_options(&args.method, args.smooth_factor)?;
         let s = super::sharpen::run_sharpen(&mesh, &opts)?;

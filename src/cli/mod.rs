@@ -23,6 +23,7 @@ mod convert;
 mod decode;
 mod demo;
 mod encode;
+mod encode_subdiv;
 mod info;
 mod metro;
 mod rd;

@@ -48,6 +48,9 @@ pub struct RdArgs {
         default_value = "8,9,10,11,12,13,14,15,16"
     )]
     exact_bits: Vec<f64>,
+    /// Control vertex counts of the subdiv mode's curve, comma separated.
+    #[arg(long, value_delimiter = ',', default_value = "100,200,400,800")]
+    subdiv_control: Vec<f64>,
     /// Codec modes to sweep.
     #[arg(long, value_delimiter = ',', default_value = "exact")]
     modes: Vec<String>,
@@ -74,6 +77,7 @@ pub struct Plan {
     pub modes: Vec<String>,
     pub rates: Option<Vec<f64>>,
     pub exact_bits: Vec<f64>,
+    pub subdiv_control: Vec<f64>,
     pub stages: Vec<String>,
     pub out: PathBuf,
     pub samples: usize,
@@ -81,11 +85,55 @@ pub struct Plan {
     pub draco: Option<PathBuf>,
 }
 
+/// The subdiv mode as an rd codec; the rate is the number of control vertices.
+struct SubdivCodec;
+
+impl Codec for SubdivCodec {
+    fn name(&self) -> String {
+        "subdiv".into()
+    }
+    fn encode(&self, mesh: &Mesh, rate: f64) -> Result<Vec<u8>, String> {
+        if rate.fract() != 0.0 || rate < 4.0 {
+            return Err(format!(
+                "subdiv rates are control vertex counts (>= 4), got {rate}"
+            ));
+        }
+        let opts = whet_subdiv::SubdivEncodeOptions::DEFAULT.with_control_vertices(rate as usize);
+        whet::encode_subdiv(mesh, &opts)
+            .map(|(b, _)| b)
+            .map_err(|e| e.to_string())
+    }
+    fn decode(&self, bytes: &[u8]) -> Result<Mesh, String> {
+        whet::decode(bytes, &whet_codec::DecodeOptions::DEFAULT).map_err(|e| e.to_string())
+    }
+}
+
+fn sharpened(mesh: &Mesh) -> Result<whet_sharpen::Sharpened, String> {
+    let run = |m: &Mesh| whet_sharpen::sharpen(m, &whet_sharpen::SharpenOptions::DEFAULT);
+    match run(mesh) {
+        Ok(s) => Ok(s),
+        Err(whet_sharpen::Error::InvalidInput(_)) => {
+            let mut m = mesh.clone();
+            m.make_manifold();
+            run(&m).map_err(|e| e.to_string())
+        }
+        Err(e) => Err(e.to_string()),
+    }
+}
+
 fn stage_by_name(name: &str) -> Result<Stage, Failure> {
     match name {
         "decoded" => Ok(Stage::decoded()),
+        "sharpened" => Ok(Stage::new("sharpened", |m| sharpened(m).map(|s| s.mesh))),
+        "bent" => Ok(Stage::new("bent", |m| {
+            let s = sharpened(m)?;
+            let tags = super::sharpen::tag_edges(&s.tags);
+            whet_bend::bend_levels(&s.mesh, &tags, 1)
+                .map(|b| b.mesh)
+                .map_err(|e| e.to_string())
+        })),
         other => Err(Failure::input(anyhow::anyhow!(
-            "unknown or unavailable stage {other:?} (available: decoded)"
+            "unknown stage {other:?} (available: decoded, sharpened, bent)"
         ))),
     }
 }
@@ -93,6 +141,7 @@ fn stage_by_name(name: &str) -> Result<Stage, Failure> {
 /// Runs a sweep and writes its files; returns the points.
 pub fn run_plan(meshes: Vec<(String, Mesh)>, plan: &Plan) -> CliResult<Vec<Point>> {
     let exact = ExactCodec;
+    let subdiv = SubdivCodec;
     let mut codecs: Vec<CodecSweep<'_>> = Vec::new();
     for m in &plan.modes {
         match m.as_str() {
@@ -100,9 +149,13 @@ pub fn run_plan(meshes: Vec<(String, Mesh)>, plan: &Plan) -> CliResult<Vec<Point
                 codec: &exact,
                 rates: plan.exact_bits.clone(),
             }),
+            "subdiv" => codecs.push(CodecSweep {
+                codec: &subdiv,
+                rates: plan.subdiv_control.clone(),
+            }),
             other => {
                 return Err(Failure::input(anyhow::anyhow!(
-                    "unknown or unavailable mode {other:?} (available: exact)"
+                    "unknown or unavailable mode {other:?} (available: exact, subdiv)"
                 )))
             }
         }
@@ -176,6 +229,7 @@ pub fn run(args: &RdArgs) -> CliResult {
         modes: args.modes.clone(),
         rates: args.rates.clone(),
         exact_bits: args.exact_bits.clone(),
+        subdiv_control: args.subdiv_control.clone(),
         stages: args.stages.clone(),
         out: args.out.clone(),
         samples: args.samples,
