@@ -1,20 +1,32 @@
 //! `whet encode`: a mesh file to a `.whet` stream.
 
-use super::{print_json, read_mesh, CliResult, Failure};
-use clap::{Args, ValueEnum};
+use super::{print_json, read_mesh, write_mesh, CliResult, Failure};
+use clap::{ArgGroup, Args, ValueEnum};
 use serde_json::json;
 use std::path::PathBuf;
 use whet_codec::{EncodeOptions, Encoder, Mode};
+use whet_swing::{Rate, SwingOptions};
 
 /// Codec modes selectable on the command line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum ModeArg {
+    /// SwingWrapper: retile into a nearly regular mesh with edges of about one length,
+    /// one quantized swing angle per vertex (lossy, the main codec).
+    Swing,
     /// Edgebreaker connectivity + quantized parallelogram-predicted positions (lossless
     /// connectivity).
     Exact,
+    /// A small control mesh with continuous edge sharpness fitted to the input; the decoder
+    /// subdivides it (semi-sharp Loop; seed 004).
+    Subdiv,
 }
 
+/// Swing mode's default edge length, as a fraction of the bounding-box diagonal, when no
+/// rate option is given.
+const DEFAULT_EDGE_LENGTH: f64 = 0.01;
+
 #[derive(Args, Debug)]
+#[command(group(ArgGroup::new("rate").args(["edge_length", "bpv", "target_bytes", "max_error"])))]
 pub struct EncodeArgs {
     /// Input mesh file.
     input: PathBuf,
@@ -22,11 +34,40 @@ pub struct EncodeArgs {
     #[arg(short, long)]
     output: PathBuf,
     /// Codec mode.
-    #[arg(long, value_enum, default_value_t = ModeArg::Exact)]
+    #[arg(long, value_enum, default_value_t = ModeArg::Swing)]
     mode: ModeArg,
-    /// Position quantization bits per coordinate (exact mode).
-    #[arg(long, default_value_t = 14, value_parser = clap::value_parser!(u32).range(1..=30))]
-    quant_bits: u32,
+    /// Position quantization bits per coordinate (exact mode: every vertex, default 14;
+    /// swing mode: the seed triangles, default 20).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=30))]
+    quant_bits: Option<u32>,
+    /// Swing: target edge length as a fraction of the bounding-box diagonal (default 0.01).
+    #[arg(long, value_name = "L")]
+    edge_length: Option<f64>,
+    /// Swing: bits per vertex of the ORIGINAL mesh; the edge length is searched to land
+    /// within 5 %.
+    #[arg(long, value_name = "R")]
+    bpv: Option<f64>,
+    /// Swing: stream size in bytes; the edge length is searched to land within 5 %.
+    #[arg(long, value_name = "N")]
+    target_bytes: Option<usize>,
+    /// Swing: largest RMS error in percent of the bounding-box diagonal (measured with
+    /// Metro against the input); the cheapest stream found that meets it.
+    #[arg(long, value_name = "E")]
+    max_error: Option<f64>,
+    /// Swing: bits of a quantized swing angle.
+    #[arg(long, value_name = "B", default_value_t = SwingOptions::DEFAULT_ANGLE_BITS,
+          value_parser = clap::value_parser!(u32).range(3..=14))]
+    angle_bits: u32,
+    /// Swing: also write the retiled mesh the stream encodes (byte-identical to what
+    /// `whet decode` writes in the same format).
+    #[arg(long, value_name = "PATH")]
+    emit_retiled: Option<PathBuf>,
+    /// Subdiv: control vertices to fit.
+    #[arg(long, default_value_t = 500)]
+    control_vertices: usize,
+    /// Subdiv: subdivision levels the decoder applies (default: the fitting levels).
+    #[arg(long)]
+    levels: Option<u32>,
     /// Input format, overriding the extension.
     #[arg(long)]
     format: Option<whet::io::Format>,
@@ -36,28 +77,41 @@ pub struct EncodeArgs {
 }
 
 pub fn run(args: &EncodeArgs) -> CliResult {
+    let rate_given = args.edge_length.is_some()
+        || args.bpv.is_some()
+        || args.target_bytes.is_some()
+        || args.max_error.is_some();
+    if args.mode != ModeArg::Swing && (rate_given || args.emit_retiled.is_some()) {
+        return Err(Failure::other(anyhow::anyhow!(
+            "--edge-length, --bpv, --target-bytes, --max-error and --emit-retiled apply to \
+             --mode swing only"
+        )));
+    }
     let mesh = read_mesh(&args.input, args.format)?;
-    let mode = match args.mode {
-        ModeArg::Exact => Mode::Exact,
-    };
-    let opts = EncodeOptions::DEFAULT
-        .with_mode(mode)
-        .with_quant_bits(args.quant_bits);
-    let encoded = Encoder::new(opts).encode(&mesh).map_err(|e| {
-        let input = !matches!(e, whet_codec::Error::Parameter(_));
-        let err = anyhow::Error::new(e).context(format!("cannot encode {}", args.input.display()));
-        if input {
-            Failure::input(err)
-        } else {
-            Failure::other(err)
-        }
-    })?;
-    std::fs::write(&args.output, &encoded.bytes).map_err(|e| {
+    match args.mode {
+        ModeArg::Exact => run_exact(args, &mesh),
+        ModeArg::Swing => run_swing(args, &mesh),
+        ModeArg::Subdiv => super::encode_subdiv::run_subdiv(
+            &args.input,
+            &args.output,
+            &mesh,
+            args.control_vertices,
+            args.levels,
+            args.quant_bits,
+            args.json,
+        ),
+    }
+}
+
+fn write_stream(args: &EncodeArgs, bytes: &[u8]) -> CliResult {
+    std::fs::write(&args.output, bytes).map_err(|e| {
         Failure::other(
             anyhow::Error::new(e).context(format!("cannot write {}", args.output.display())),
         )
-    })?;
-    let r = &encoded.report;
+    })
+}
+
+fn report_repair(r: &whet_codec::EncodeReport) {
     if !r.repair.is_unchanged() {
         eprintln!(
             "whet: the input was not an oriented manifold; make_manifold {}",
@@ -70,6 +124,36 @@ pub fn run(args: &EncodeArgs) -> CliResult {
             r.dropped_unused_vertices
         );
     }
+}
+
+fn repair_json(r: &whet_codec::EncodeReport) -> serde_json::Value {
+    json!({
+        "dropped_out_of_range": r.repair.dropped_out_of_range,
+        "dropped_degenerate": r.repair.dropped_degenerate,
+        "dropped_duplicates": r.repair.dropped_duplicates,
+        "flipped_triangles": r.repair.flipped_triangles,
+        "cut_edges": r.repair.cut_edges,
+        "added_vertices": r.repair.added_vertices,
+    })
+}
+
+fn run_exact(args: &EncodeArgs, mesh: &whet::Mesh) -> CliResult {
+    let quant_bits = args.quant_bits.unwrap_or(14);
+    let opts = EncodeOptions::DEFAULT
+        .with_mode(Mode::Exact)
+        .with_quant_bits(quant_bits);
+    let encoded = Encoder::new(opts).encode(mesh).map_err(|e| {
+        let input = !matches!(e, whet_codec::Error::Parameter(_));
+        let err = anyhow::Error::new(e).context(format!("cannot encode {}", args.input.display()));
+        if input {
+            Failure::input(err)
+        } else {
+            Failure::other(err)
+        }
+    })?;
+    write_stream(args, &encoded.bytes)?;
+    let r = &encoded.report;
+    report_repair(r);
     let h = r.clers_histogram;
     if args.json {
         print_json(&json!({
@@ -81,17 +165,10 @@ pub fn run(args: &EncodeArgs) -> CliResult {
             "geometry_bits": r.geometry_bits,
             "bits_per_vertex": r.bits_per_vertex(),
             "bits_per_triangle": r.bits_per_triangle(),
-            "quant_bits": args.quant_bits,
+            "quant_bits": quant_bits,
             "components": r.components,
             "clers_histogram": { "C": h[0], "L": h[1], "E": h[2], "R": h[3], "S": h[4] },
-            "repair": {
-                "dropped_out_of_range": r.repair.dropped_out_of_range,
-                "dropped_degenerate": r.repair.dropped_degenerate,
-                "dropped_duplicates": r.repair.dropped_duplicates,
-                "flipped_triangles": r.repair.flipped_triangles,
-                "cut_edges": r.repair.cut_edges,
-                "added_vertices": r.repair.added_vertices,
-            },
+            "repair": repair_json(r),
             "dropped_unused_vertices": r.dropped_unused_vertices,
         }));
     } else {
@@ -103,6 +180,91 @@ pub fn run(args: &EncodeArgs) -> CliResult {
             r.vertices,
             r.triangles,
             r.bits_per_vertex(),
+            r.bits_per_triangle(),
+            r.connectivity_bits,
+            r.geometry_bits
+        );
+    }
+    Ok(())
+}
+
+fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh) -> CliResult {
+    let rate = if let Some(l) = args.edge_length {
+        Rate::EdgeLength(l)
+    } else if let Some(r) = args.bpv {
+        Rate::BitsPerVertex(r)
+    } else if let Some(n) = args.target_bytes {
+        Rate::TargetBytes(n)
+    } else if let Some(e) = args.max_error {
+        Rate::MaxError(e)
+    } else {
+        Rate::EdgeLength(DEFAULT_EDGE_LENGTH)
+    };
+    let quant_bits = args.quant_bits.unwrap_or(SwingOptions::DEFAULT.quant_bits);
+    let opts = SwingOptions::DEFAULT
+        .with_rate(rate)
+        .with_angle_bits(args.angle_bits)
+        .with_quant_bits(quant_bits);
+    let out = whet_swing::encode(mesh, &opts).map_err(|e| {
+        let input = e.is_input_error();
+        let err = anyhow::Error::new(e).context(format!("cannot encode {}", args.input.display()));
+        if input {
+            Failure::input(err)
+        } else {
+            Failure::other(err)
+        }
+    })?;
+    write_stream(args, &out.bytes)?;
+    if let Some(path) = &args.emit_retiled {
+        write_mesh(path, &out.retiled, None, &whet::io::WriteOptions::DEFAULT)?;
+    }
+    let r = &out.report;
+    report_repair(r);
+    if let whet_codec::SwingGeometry::Explicit(reason) = &out.geometry {
+        eprintln!("whet: swing geometry coded as explicit positions: {reason}");
+    }
+    let h = r.clers_histogram;
+    if args.json {
+        print_json(&json!({
+            "mode": "swing",
+            "bytes": r.bytes,
+            "triangles": r.triangles,
+            "vertices": r.vertices,
+            "connectivity_bits": r.connectivity_bits,
+            "geometry_bits": r.geometry_bits,
+            "bits_per_vertex": r.bits_per_vertex(),
+            "bits_per_triangle": r.bits_per_triangle(),
+            "edge_length": out.edge_length_fraction,
+            "edge_length_absolute": out.edge_length,
+            "angle_bits": out.angle_bits,
+            "quant_bits": quant_bits,
+            "retiled_vertices": r.vertices,
+            "retiled_triangles": r.triangles,
+            "original_vertices": out.original_vertices,
+            "original_triangles": out.original_triangles,
+            "bits_per_original_vertex": out.bits_per_original_vertex(),
+            "clers_histogram": { "C": h[0], "L": h[1], "E": h[2], "R": h[3], "S": h[4] },
+            "valence6_fraction": out.valence6_fraction(),
+            "components": r.components,
+            "geometry": match &out.geometry {
+                whet_codec::SwingGeometry::Swing => "swing",
+                _ => "explicit",
+            },
+            "rms_error_pct": out.rms_pct,
+            "search": out.search.iter().map(|&(f, b)| json!([f, b])).collect::<Vec<_>>(),
+            "repair": repair_json(r),
+            "dropped_unused_vertices": r.dropped_unused_vertices,
+        }));
+    } else {
+        outln!(
+            "{} -> {}: {} bytes, {} retiled vertices, {} retiled triangles (L = {:.4} of the diagonal), {:.3} bits per original vertex, {:.3} bits/retiled triangle (connectivity {} bits, geometry {} bits)",
+            args.input.display(),
+            args.output.display(),
+            r.bytes,
+            r.vertices,
+            r.triangles,
+            out.edge_length_fraction,
+            out.bits_per_original_vertex(),
             r.bits_per_triangle(),
             r.connectivity_bits,
             r.geometry_bits

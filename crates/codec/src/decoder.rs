@@ -81,7 +81,7 @@ pub fn decode_container(container: &Container, opts: &DecodeOptions) -> Result<M
                 .with_max_triangles(h.triangle_count.saturating_mul(2).saturating_add(64));
             decode_exact(conn, geom, &quantizer, &limits)?
         }
-        Mode::Swing => crate::swing::decode_swing(container)?,
+        Mode::Swing => crate::swing::decode_swing(container, &opts.limits)?,
         other => {
             return Err(Error::Parameter(format!(
                 "mode {other} is not available in this build"

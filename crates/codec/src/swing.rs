@@ -28,17 +28,22 @@
 //!   decoded connectivity: at each component start the seed's three vertices as raw
 //!   `quant_bits`-bit grid coordinates, at each `C` triangle the tip's swing index as a
 //!   zigzagged `angle_bits`-bit value through one adaptive bit tree (`docs/swing.md`);
-//! * kind 1, explicit: the exact mode's position coder on the retiled mesh quantized to
-//!   `quant_bits` (used when the retiled mesh is open, or as the safety net when the
-//!   encoder's self-check fails).
+//! * kind 2, swing with deletions: kind 0, then one adaptive flag per triangle in traversal
+//!   order (context: the previous flag); the decoder deletes the flagged triangles and the
+//!   vertices left unused. This is how originals with boundaries are coded: the retiler
+//!   closes their holes, retiles, and flags the triangles over the holes (whet-swing
+//!   `holes.rs`);
+//! * kind 1, explicit: the exact mode's position coder on the kept retiled triangles,
+//!   positions quantized to `quant_bits` — only the safety net for a failed encoder
+//!   self-check (a retiler bug), never written otherwise.
 //!
-//! Not handled here: the retiling itself (whet-swing), open retiled meshes in the swing kind.
+//! Not handled here: the retiling itself (whet-swing).
 
 use crate::exact::{code_positions, ResidualReader, ResidualWriter};
 use crate::{EncodeReport, Error, Quantizer};
-use whet_bits::{BitSink, BitTree, RangeDecoder, RangeEncoder};
+use whet_bits::{BitModel, BitSink, BitTree, RangeDecoder, RangeEncoder};
 use whet_edgebreaker::{traverse, Clers, Connectivity, ConnectivityLimits, Step};
-use whet_format::{tag, Container, Header, Mode, SectionKind, Version};
+use whet_format::{tag, Container, Header, Limits, Mode, SectionKind, Version};
 use whet_mesh::{Aabb, DVec3, ManifoldRepair, Mesh, VertexId};
 
 /// Fewest angle bits a stream may use.
@@ -49,6 +54,7 @@ pub const MAX_ANGLE_BITS: u32 = 14;
 /// Geometry payload kinds (first byte of the geometry section).
 const KIND_SWING: u8 = 0;
 const KIND_EXPLICIT: u8 = 1;
+const KIND_SWING_CUT: u8 = 2;
 
 // --- Exact arithmetic helpers --------------------------------------------------------------
 // Spelled out so that the evaluation order is fixed by this file, not by a library version.
@@ -71,6 +77,12 @@ fn scale(a: DVec3, s: f64) -> DVec3 {
 #[inline]
 fn dot(a: DVec3, b: DVec3) -> f64 {
     a.x * b.x + a.y * b.y + a.z * b.z
+}
+
+/// `x` is finite and above `min` (false for NaN).
+#[inline]
+fn finite_above(x: f64, min: f64) -> bool {
+    x.is_finite() && x > min
 }
 
 #[inline]
@@ -200,13 +212,13 @@ impl SwingFrame {
     pub fn new(a: DVec3, b: DVec3, c: DVec3, edge_length: f64) -> Option<SwingFrame> {
         let d = sub(b, a);
         let g2 = dot(d, d);
-        if !(g2 > 0.0) || !g2.is_finite() {
+        if !finite_above(g2, 0.0) {
             return None;
         }
         let g = g2.sqrt();
         let l2 = edge_length * edge_length;
         let r2 = l2 - 0.25 * g2;
-        if !(r2 > l2 * 1e-9) || !r2.is_finite() {
+        if !finite_above(r2, l2 * 1e-9) {
             return None;
         }
         let radius = r2.sqrt();
@@ -215,7 +227,7 @@ impl SwingFrame {
         let w = sub(m, c);
         let w_perp = sub(w, scale(u, dot(w, u)));
         let len2 = dot(w_perp, w_perp);
-        if !(len2 > g2 * 1e-18) || !len2.is_finite() {
+        if !finite_above(len2, g2 * 1e-18) {
             return None;
         }
         let e1 = scale(w_perp, 1.0 / len2.sqrt());
@@ -340,8 +352,9 @@ pub struct RetiledMesh {
     pub labels: Vec<Clers>,
     /// Connected components (seeds).
     pub components: usize,
-    /// True when the retiler left boundary edges (open `M'`).
-    pub open: bool,
+    /// Per triangle, true when it is to be deleted after decoding (it covers a hole of the
+    /// original); empty when none is.
+    pub deleted: Vec<bool>,
 }
 
 /// How the geometry of a swing stream was coded.
@@ -569,22 +582,28 @@ pub struct SwingStreamInfo<'a> {
 
 /// Writes the swing stream of a retiled mesh, after checking that Edgebreaker reproduces the
 /// retiler's labels and vertex order and that the shared reconstruction reproduces every
-/// position bit for bit. When a check fails (a retiler bug: this panics in debug builds) or
-/// the retiled mesh is open, the geometry is coded explicitly instead
-/// ([`SwingGeometry::Explicit`]) and the stream is still valid.
+/// position bit for bit. When a check fails (a retiler bug: this panics in debug builds) the
+/// geometry is coded explicitly instead ([`SwingGeometry::Explicit`]) and the stream is still
+/// valid. Triangles flagged in `retiled.deleted` (over holes of the original) are sent with
+/// the closed mesh and deleted by the decoder.
 pub fn encode_retiled(
     retiled: &RetiledMesh,
     params: &SwingParams,
     info: &SwingStreamInfo<'_>,
 ) -> Result<SwingEncoded, Error> {
     let nv = retiled.positions.len();
-    let enc = whet_edgebreaker::encode_connectivity(&retiled.triangles, nv)?;
-    let clers_histogram = enc.histogram();
+    let cutting = retiled.deleted.iter().any(|&d| d);
+    if cutting && retiled.deleted.len() != retiled.triangles.len() {
+        return Err(Error::Parameter(
+            "one deletion flag per retiled triangle is needed".into(),
+        ));
+    }
+    let mut enc = whet_edgebreaker::encode_connectivity(&retiled.triangles, nv)?;
     let conn = &enc.connectivity;
 
     let mut geometry_kind = SwingGeometry::Swing;
-    if retiled.open || conn.is_dummy.iter().any(|&d| d) {
-        geometry_kind = SwingGeometry::Explicit("the retiled mesh is open".into());
+    if conn.is_dummy.iter().any(|&d| d) {
+        geometry_kind = SwingGeometry::Explicit("the retiled mesh is not closed".into());
     } else if conn.summary.labels != retiled.labels {
         geometry_kind =
             SwingGeometry::Explicit("Edgebreaker does not reproduce the retiler's labels".into());
@@ -619,9 +638,15 @@ pub fn encode_retiled(
                 .zip(&retiled.positions)
                 .all(|(p, r)| p.to_array().map(f64::to_bits) == r.to_array().map(f64::to_bits));
         if exact {
-            geometry.push(KIND_SWING);
+            let mut mesh = output_mesh(conn, &positions, &tris);
+            if cutting {
+                // The walk met the triangles in creation order (the labels matched).
+                code_cut_flags(&mut range, &retiled.deleted);
+                mesh = cut(mesh, &retiled.deleted);
+            }
+            geometry.push(if cutting { KIND_SWING_CUT } else { KIND_SWING });
             geometry.extend_from_slice(&range.finish());
-            decoded = Some(output_mesh(conn, &positions, &tris));
+            decoded = Some(mesh);
         } else {
             geometry_kind = SwingGeometry::Explicit(match walked {
                 Err(e) => format!("the swing walk failed: {e}"),
@@ -632,17 +657,23 @@ pub fn encode_retiled(
         }
     }
     if let SwingGeometry::Explicit(reason) = &geometry_kind {
-        debug_assert!(
-            retiled.open,
-            "swing self-check failed on a closed retiled mesh: {reason}"
+        debug_assert!(false, "swing self-check failed: {reason}");
+        // The kept triangles as an ordinary (possibly open) mesh, positions quantized.
+        let kept = cut(
+            Mesh::new(retiled.positions.clone(), retiled.triangles.clone()),
+            if cutting { &retiled.deleted } else { &[] },
         );
-        let (bytes, positions) = encode_explicit(conn, &retiled.positions, &params.quantizer)?;
+        enc = whet_edgebreaker::encode_connectivity(&kept.triangles, kept.positions.len())?;
+        let (bytes, positions) =
+            encode_explicit(&enc.connectivity, &kept.positions, &params.quantizer)?;
         geometry.push(KIND_EXPLICIT);
         geometry.extend_from_slice(&bytes);
-        let tris = traversal_triangles(conn)?;
-        decoded = Some(output_mesh(conn, &positions, &tris));
+        let tris = traversal_triangles(&enc.connectivity)?;
+        decoded = Some(output_mesh(&enc.connectivity, &positions, &tris));
     }
     let decoded = decoded.unwrap_or_default();
+    let clers_histogram = enc.histogram();
+    let components = enc.connectivity.starts.len();
 
     let (min, max) = (params.bbox.min.to_array(), params.bbox.max.to_array());
     let mut header = Header::new(
@@ -651,7 +682,7 @@ pub fn encode_retiled(
         decoded.triangles.len() as u64,
     )
     .with_version(info.version)
-    .with(tag::COMPONENT_COUNT, conn.starts.len() as u64)
+    .with(tag::COMPONENT_COUNT, components as u64)
     .with(tag::QUANT_BITS, params.quantizer.bits as u64)
     .with(tag::EDGE_LENGTH, params.edge_length)
     .with(tag::ANGLE_BITS, params.angles.bits() as u64);
@@ -668,7 +699,7 @@ pub fn encode_retiled(
         triangles: decoded.triangles.len(),
         connectivity_bits,
         geometry_bits,
-        components: conn.starts.len(),
+        components,
         clers_histogram,
         vertex_order: Vec::new(),
         repair: *info.repair,
@@ -680,6 +711,59 @@ pub fn encode_retiled(
         decoded,
         geometry: geometry_kind,
     })
+}
+
+/// Deletion flags, one per triangle in traversal order, each in the context of the previous
+/// one (deleted triangles come in runs along the holes).
+fn code_cut_flags<S: BitSink>(sink: &mut S, flags: &[bool]) {
+    let mut models = [BitModel::new(); 2];
+    let mut prev = false;
+    for &f in flags {
+        sink.encode_bit(&mut models[prev as usize], f);
+        prev = f;
+    }
+}
+
+fn decode_cut_flags(dec: &mut RangeDecoder<'_>, n: usize) -> Vec<bool> {
+    let mut models = [BitModel::new(); 2];
+    let mut prev = false;
+    let mut out = Vec::with_capacity(n);
+    for _ in 0..n {
+        let f = dec.decode_bit(&mut models[prev as usize]);
+        out.push(f);
+        prev = f;
+    }
+    out
+}
+
+/// `mesh` without the triangles flagged in `deleted` (no flags: unchanged) and without the
+/// vertices no remaining triangle uses; the order of what remains is kept.
+fn cut(mesh: Mesh, deleted: &[bool]) -> Mesh {
+    if !deleted.iter().any(|&d| d) {
+        return mesh;
+    }
+    let tris: Vec<[u32; 3]> = mesh
+        .triangles
+        .iter()
+        .zip(deleted)
+        .filter(|(_, &d)| !d)
+        .map(|(t, _)| *t)
+        .collect();
+    let mut remap = vec![u32::MAX; mesh.positions.len()];
+    for t in &tris {
+        for &v in t {
+            remap[v as usize] = 0;
+        }
+    }
+    let mut positions = Vec::new();
+    for (i, p) in mesh.positions.iter().enumerate() {
+        if remap[i] == 0 {
+            remap[i] = positions.len() as u32;
+            positions.push(*p);
+        }
+    }
+    let triangles = tris.iter().map(|t| t.map(|v| remap[v as usize])).collect();
+    Mesh::new(positions, triangles)
 }
 
 /// The explicit geometry: positions quantized on `quantizer`, coded by the exact mode's
@@ -707,7 +791,7 @@ fn encode_explicit(
 }
 
 /// Decodes a swing container (called by [`crate::decode_container`]).
-pub(crate) fn decode_swing(container: &Container) -> Result<Mesh, Error> {
+pub(crate) fn decode_swing(container: &Container, limits: &Limits) -> Result<Mesh, Error> {
     let h = &container.header;
     let edge_length = h
         .get_f64(tag::EDGE_LENGTH)
@@ -751,10 +835,10 @@ pub(crate) fn decode_swing(container: &Container) -> Result<Mesh, Error> {
     let geom = container
         .section(SectionKind::GEOMETRY)
         .ok_or(Error::MissingSection("geometry"))?;
-    // Dummy fans add at most one triangle per real one.
-    let limits = ConnectivityLimits::DEFAULT
-        .with_max_triangles(h.triangle_count.saturating_mul(2).saturating_add(64));
-    let (conn, used) = whet_edgebreaker::decode_connectivity(conn_bytes, &limits)?;
+    // The connectivity may hold more triangles than the output (dummy fans of the explicit
+    // kind, triangles deleted over holes): bounded by the caller's face limit.
+    let conn_limits = ConnectivityLimits::DEFAULT.with_max_triangles(limits.max_faces);
+    let (conn, used) = whet_edgebreaker::decode_connectivity(conn_bytes, &conn_limits)?;
     if used != conn_bytes.len() {
         return Err(Error::Corrupt(
             "connectivity section has trailing bytes".into(),
@@ -770,7 +854,7 @@ pub(crate) fn decode_swing(container: &Container) -> Result<Mesh, Error> {
     let nv = conn.table.vertex_count();
     let mut dec = RangeDecoder::new(payload).map_err(|_| Error::Truncated("geometry"))?;
     match kind {
-        KIND_SWING => {
+        KIND_SWING | KIND_SWING_CUT => {
             if conn.is_dummy.iter().any(|&d| d) {
                 return Err(Error::Corrupt(
                     "swing geometry on an open connectivity".into(),
@@ -783,13 +867,18 @@ pub(crate) fn decode_swing(container: &Container) -> Result<Mesh, Error> {
                 max_level: params.quantizer.max_level(),
             };
             walk(&conn, &params, &mut io, &mut positions, &mut tris)?;
+            let flags = if kind == KIND_SWING_CUT {
+                decode_cut_flags(&mut dec, tris.len())
+            } else {
+                Vec::new()
+            };
             if dec.finish().is_err() {
                 return Err(Error::Truncated("geometry"));
             }
             if positions.iter().any(|p| !p.is_finite()) {
                 return Err(Error::Corrupt("a decoded position is not finite".into()));
             }
-            Ok(output_mesh(&conn, &positions, &tris))
+            Ok(cut(output_mesh(&conn, &positions, &tris), &flags))
         }
         KIND_EXPLICIT => {
             let mut q = vec![[0i32; 3]; nv];
@@ -855,6 +944,88 @@ mod tests {
         let (c, s) = t.cos_sin(64);
         assert!(c.abs() < 1e-15 && (s - 1.0).abs() < 1e-15);
         assert!(AngleTable::new(2).is_none() && AngleTable::new(15).is_none());
+    }
+
+    /// A tetrahedron built the way the retiler builds: seed [x0, x1, x2], a C at the first
+    /// gate x0 -> x2, then R and E.
+    fn tetrahedron(q: i32) -> (RetiledMesh, SwingParams) {
+        let bbox = Aabb {
+            min: DVec3::splat(-2.0),
+            max: DVec3::splat(2.0),
+        };
+        let params = SwingParams::new(1.0, 6, &bbox, 16).unwrap();
+        let seed = [
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(0.5, 0.85, 0.0),
+        ]
+        .map(|p| params.snap_seed(p));
+        let mut positions: Vec<DVec3> = seed.iter().map(|s| s.1).collect();
+        let frame = params
+            .frame(positions[0], positions[2], positions[1])
+            .unwrap();
+        positions.push(frame.tip(&params.angles, q));
+        let mut sources: Vec<VertexSource> = seed.iter().map(|s| VertexSource::Seed(s.0)).collect();
+        sources.push(VertexSource::Swing(q));
+        (
+            RetiledMesh {
+                positions,
+                triangles: vec![[0, 1, 2], [3, 0, 2], [1, 3, 2], [0, 3, 1]],
+                sources,
+                labels: vec![Clers::C, Clers::R, Clers::E],
+                components: 1,
+                deleted: Vec::new(),
+            },
+            params,
+        )
+    }
+
+    fn info() -> SwingStreamInfo<'static> {
+        static REPAIR: std::sync::OnceLock<ManifoldRepair> = std::sync::OnceLock::new();
+        SwingStreamInfo {
+            version: Version::CURRENT,
+            repair: REPAIR.get_or_init(ManifoldRepair::default),
+            dropped_unused_vertices: 0,
+        }
+    }
+
+    #[test]
+    fn a_hand_built_tetrahedron_round_trips_bit_exactly() {
+        // q = -20: the tip folds 112 degrees below the seed's plane.
+        let (retiled, params) = tetrahedron(-20);
+        let enc = encode_retiled(&retiled, &params, &info()).unwrap();
+        assert_eq!(enc.geometry, SwingGeometry::Swing);
+        assert_eq!(enc.decoded.positions, retiled.positions);
+        assert_eq!(enc.decoded.triangles, retiled.triangles);
+        let back = crate::decode(&enc.bytes, &crate::DecodeOptions::DEFAULT).unwrap();
+        assert_eq!(back, enc.decoded);
+        // One deleted triangle: kind 2 drops it and nothing else.
+        let mut cut_mesh = retiled.clone();
+        cut_mesh.deleted = vec![false, false, true, false];
+        let enc = encode_retiled(&cut_mesh, &params, &info()).unwrap();
+        let back = crate::decode(&enc.bytes, &crate::DecodeOptions::DEFAULT).unwrap();
+        assert_eq!(back.triangles.len(), 3);
+        assert_eq!(back, enc.decoded);
+    }
+
+    #[test]
+    #[cfg(debug_assertions)]
+    #[should_panic(expected = "swing self-check failed")]
+    fn a_retiler_bug_fails_loudly_in_debug_builds() {
+        let (mut retiled, params) = tetrahedron(-20);
+        retiled.labels[1] = Clers::L;
+        let _ = encode_retiled(&retiled, &params, &info());
+    }
+
+    #[test]
+    #[cfg(not(debug_assertions))]
+    fn a_retiler_bug_falls_back_to_explicit_positions_in_release_builds() {
+        let (mut retiled, params) = tetrahedron(-20);
+        retiled.labels[1] = Clers::L;
+        let enc = encode_retiled(&retiled, &params, &info()).unwrap();
+        assert!(matches!(enc.geometry, SwingGeometry::Explicit(_)));
+        let back = crate::decode(&enc.bytes, &crate::DecodeOptions::DEFAULT).unwrap();
+        assert_eq!(back, enc.decoded);
     }
 
     #[test]

@@ -1,5 +1,5 @@
 //! Measurement: cost of the swing indices under several context schemes.
-#![allow(clippy::unwrap_used)]
+#![allow(clippy::unwrap_used, clippy::type_complexity)] // a measurement tool
 use whet_bits::{BitSink, BitTree, CostCounter};
 use whet_codec::{SwingParams, VertexSource};
 use whet_edgebreaker::{traverse, Clers, Step};

@@ -10,15 +10,41 @@ use whet_swing::{retile, RetileTuning};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let path = if args[0].contains('/') {
-        std::path::PathBuf::from(&args[0])
-    } else {
-        whet_testkit::shared_fixture(&args[0])
+    let mesh = match args[0].as_str() {
+        name if name.starts_with("builtin:holes") => {
+            // builtin:holes:<icosphere level>:<modulus>:<width>
+            let p: Vec<usize> = name
+                .split(':')
+                .skip(2)
+                .map(|x| x.parse().unwrap())
+                .collect();
+            let (lev, m, w) = (
+                *p.first().unwrap_or(&4),
+                *p.get(1).unwrap_or(&97),
+                *p.get(2).unwrap_or(&6),
+            );
+            whet_testkit::meshes::punch(&whet_testkit::meshes::icosphere(lev as u32), |t| t % m < w)
+        }
+        "builtin:grid" => whet_testkit::meshes::grid(20, 20),
+        name if name.contains('/') => whet_io::read_path(std::path::Path::new(name), None).unwrap(),
+        name => whet_io::read_path(&whet_testkit::shared_fixture(name), None).unwrap(),
     };
-    let mesh = whet_io::read_path(&path, None).unwrap();
+    if let Some(out) = args.get(3) {
+        whet_io::write_path(
+            std::path::Path::new(out),
+            &mesh,
+            None,
+            &whet_io::WriteOptions::DEFAULT,
+        )
+        .unwrap();
+    }
     let f: f64 = args[1].parse().unwrap();
     let l = f * mesh.diagonal();
-    let params = SwingParams::new(l, 8, &mesh.bounding_box(), 20).unwrap();
+    let bits: u32 = std::env::var("BITS")
+        .ok()
+        .and_then(|b| b.parse().ok())
+        .unwrap_or(6);
+    let params = SwingParams::new(l, bits, &mesh.bounding_box(), 20).unwrap();
     match retile(&mesh, &params, &RetileTuning::DEFAULT) {
         Ok(r) => {
             let labels: String = r.mesh.labels.iter().map(|l| l.letter()).collect();

@@ -18,6 +18,7 @@ fn main() {
     let mut bits = SwingOptions::DEFAULT_ANGLE_BITS;
     let mut samples = 1_000_000usize;
     let mut meshes = Vec::new();
+    let mut tuning = whet_swing::RetileTuning::DEFAULT;
     while let Some(a) = args.next() {
         match a.as_str() {
             "--bpv" => rate = Rate::BitsPerVertex(args.next().unwrap().parse().unwrap()),
@@ -26,6 +27,11 @@ fn main() {
             "--max-error" => rate = Rate::MaxError(args.next().unwrap().parse().unwrap()),
             "--angle-bits" => bits = args.next().unwrap().parse().unwrap(),
             "--samples" => samples = args.next().unwrap().parse().unwrap(),
+            "--close" => {
+                tuning = tuning
+                    .with_close_angle(args.next().unwrap().parse::<f64>().unwrap().to_radians())
+            }
+            "--snap" => tuning = tuning.with_snap(args.next().unwrap().parse().unwrap()),
             m => meshes.push(m.to_string()),
         }
     }
@@ -43,7 +49,8 @@ fn main() {
         let opts = SwingOptions::DEFAULT
             .with_rate(rate)
             .with_angle_bits(bits)
-            .with_metro_samples(samples.min(300_000));
+            .with_metro_samples(samples.min(300_000))
+            .with_tuning(tuning);
         let t0 = Instant::now();
         let out = match encode(&mesh, &opts) {
             Ok(o) => o,

@@ -52,7 +52,7 @@ pub struct SwingOptions {
 
 impl SwingOptions {
     /// Default angle bits (chosen by measurement on the fixtures: docs/results.md).
-    pub const DEFAULT_ANGLE_BITS: u32 = 8;
+    pub const DEFAULT_ANGLE_BITS: u32 = 6;
 
     /// `L` = 1 % of the diagonal, default angle bits, 20-bit seeds, 5 % tolerance.
     pub const DEFAULT: SwingOptions = SwingOptions {
@@ -223,7 +223,7 @@ impl SwingEncoder {
             ));
         }
         let diagonal = p.mesh.diagonal();
-        if !(diagonal > 0.0) {
+        if diagonal.is_nan() || diagonal <= 0.0 {
             return Err(Error::InvalidInput(
                 "the mesh has no extent (all vertices coincide)".into(),
             ));
@@ -242,8 +242,8 @@ impl SwingEncoder {
                         "the edge length must be a positive fraction of the diagonal, got {f}"
                     )));
                 }
-                let mut out = self.encode_at(&prep, f)?;
-                out.search = vec![(f, out.bytes.len())];
+                let mut out = self.encode_near(&prep, f)?;
+                out.search = vec![(out.edge_length_fraction, out.bytes.len())];
                 Ok(out)
             }
             Rate::BitsPerVertex(r) => {
@@ -304,12 +304,13 @@ impl SwingEncoder {
     }
 
     /// [`Self::encode_at`], retrying at slightly different lengths when the retiler gets
-    /// stuck (a rare geometric configuration at one `L` is usually absent at the next).
+    /// stuck (a rare configuration at one `L` is usually absent at the next; shorter lengths
+    /// resolve thin parts better, so the retries lean that way).
     fn encode_near(&self, prep: &Prepared, fraction: f64) -> Result<SwingOutput, Error> {
+        const FACTORS: [f64; 8] = [1.0, 0.985, 1.015, 0.96, 0.93, 0.9, 0.85, 0.8];
         let mut last = None;
-        for k in 0..4 {
-            let f = fraction * (1.0 + 0.013 * k as f64);
-            match self.encode_at(prep, f) {
+        for k in FACTORS {
+            match self.encode_at(prep, fraction * k) {
                 Ok(out) => return Ok(out),
                 Err(e @ (Error::Stuck(_) | Error::Internal(_))) => last = Some(e),
                 Err(e) => return Err(e),
@@ -341,9 +342,9 @@ impl SwingEncoder {
             let x = out.edge_length_fraction.ln();
             let y = (size as f64).ln();
             let err = (size as f64 / target as f64 - 1.0).abs();
-            let better = best.as_ref().map_or(true, |b| {
-                err < (b.bytes.len() as f64 / target as f64 - 1.0).abs()
-            });
+            let better = best
+                .as_ref()
+                .is_none_or(|b| err < (b.bytes.len() as f64 / target as f64 - 1.0).abs());
             if better {
                 best = Some(out);
             }
@@ -395,7 +396,7 @@ impl SwingEncoder {
                 lo_ok = lo_ok.max(fr);
                 let cheaper = best_ok
                     .as_ref()
-                    .map_or(true, |b| out.bytes.len() < b.bytes.len());
+                    .is_none_or(|b| out.bytes.len() < b.bytes.len());
                 // Close enough to the target: nothing much cheaper remains.
                 let done = rms >= target * (1.0 - self.opts.tolerance);
                 if cheaper {
@@ -408,7 +409,7 @@ impl SwingEncoder {
                 hi_bad = hi_bad.min(fr);
                 let closer = best_any
                     .as_ref()
-                    .map_or(true, |b| b.rms_pct.unwrap_or(f64::MAX) > rms);
+                    .is_none_or(|b| b.rms_pct.unwrap_or(f64::MAX) > rms);
                 if closer {
                     best_any = Some(out);
                 }

@@ -20,6 +20,7 @@
 
 mod encoder;
 mod grid;
+mod holes;
 mod retiler;
 mod surface;
 

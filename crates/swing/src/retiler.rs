@@ -76,6 +76,9 @@ pub struct RetileTuning {
     /// Longest new edge (fraction of `L`) the regular rules may create: a gate of `2L`
     /// or more has no swing circle.
     pub max_edge: f64,
+    /// Where the swing circle misses the surface (a hole smaller than `L`), a point of it
+    /// within this fraction of `L` of the surface is still a regular new vertex.
+    pub bridge: f64,
 }
 
 impl RetileTuning {
@@ -88,9 +91,24 @@ impl RetileTuning {
         max_fold: 170.0 * PI / 180.0,
         cover_thickness: 0.3,
         interior_clearance: 0.45,
-        budget_factor: 12.0,
+        budget_factor: 2.5,
         max_edge: 1.7,
+        bridge: 0.35,
     };
+}
+
+impl RetileTuning {
+    /// Sets the wedge-closing angle (radians).
+    pub const fn with_close_angle(mut self, angle: f64) -> Self {
+        self.close_angle = angle;
+        self
+    }
+
+    /// Sets the snapping distance (fraction of `L`).
+    pub const fn with_snap(mut self, snap: f64) -> Self {
+        self.snap = snap;
+        self
+    }
 }
 
 impl Default for RetileTuning {
@@ -111,10 +129,13 @@ pub struct RetileStats {
     pub covered_hits: usize,
     /// Gates closed by the fallback rule (no swing possible or valid).
     pub fallbacks: usize,
-    /// Fallbacks that had to drop the geometric checks.
+    /// Fallbacks whose move clearly violates the geometric checks (cost above 2).
     pub forced: usize,
-    /// Gates declared boundary edges of `M'` (open originals).
-    pub boundary_edges: usize,
+    /// Triangles deleted after retiling because they cover a hole of the original.
+    pub deleted_triangles: usize,
+    /// New vertices placed off the surface, where the swing circle passed through a hole
+    /// or crack of the original smaller than `L` (the hole is covered over).
+    pub bridged: usize,
 }
 
 /// The result of [`retile`].
@@ -170,6 +191,20 @@ fn ccw(n: DVec3, d1: DVec3, d2: DVec3) -> f64 {
     }
 }
 
+/// Debugging output (`--features trace`): the environment variable `name`, read only when
+/// the feature is on, so that release builds carry no tracing at all. `WHET_SWING_TRACE`
+/// prints every refused swing and fallback, `WHET_SWING_DUMP=path` writes the partial mesh
+/// when the retiler gets stuck, `WHET_SWING_DUMP_AT=n` writes it to `/tmp/dump_at.off` when
+/// it has `n` triangles.
+#[inline]
+fn trace_var(name: &str) -> Option<std::ffi::OsString> {
+    if cfg!(feature = "trace") {
+        std::env::var_os(name)
+    } else {
+        None
+    }
+}
+
 /// The angle between two vectors (0 for a zero vector).
 #[inline]
 fn angle3(a: DVec3, b: DVec3) -> f64 {
@@ -178,6 +213,8 @@ fn angle3(a: DVec3, b: DVec3) -> f64 {
 
 struct Retiler<'s, 'm> {
     surf: &'s mut Surface<'m>,
+    /// Per original triangle (after capping): part of a hole's cap. Seeds avoid caps.
+    filler: &'s [bool],
     params: &'s SwingParams,
     tune: RetileTuning,
     l: f64,
@@ -193,9 +230,11 @@ struct Retiler<'s, 'm> {
     /// Loop nodes per vertex (head of the `same` list) and how many are alive.
     vnode: Vec<u32>,
     vlive: Vec<u32>,
+    /// Component of the original each retiled vertex was made for: the front of one
+    /// component never snaps to, or is blocked by, another's vertices.
+    vcomp: Vec<u32>,
     nodes: Vec<Node>,
     edges: FastMap<u64, u32>,
-    boundary: FastMap<u64, ()>,
     vgrid: PointGrid,
     stack: Vec<(u32, u32, u32)>,
     hits: Vec<Hit>,
@@ -212,6 +251,13 @@ pub fn retile(
     tune: &RetileTuning,
 ) -> Result<Retiled, Error> {
     let l = params.edge_length;
+    // Originals with boundaries: retile the surface with its holes capped, then delete the
+    // retiled triangles over the caps (holes.rs).
+    let capped = crate::holes::cap_holes(mesh, l);
+    let (mesh, filler) = match &capped {
+        Some((m, f)) => (m, Some(f.as_slice())),
+        None => (mesh, None),
+    };
     let mut surf = Surface::new(mesh, l);
     let bbox = mesh.bounding_box();
     let mut r = Retiler {
@@ -228,9 +274,9 @@ pub fn retile(
         corner_next: Vec::new(),
         vnode: Vec::new(),
         vlive: Vec::new(),
+        vcomp: Vec::new(),
         nodes: Vec::new(),
         edges: FastMap::default(),
-        boundary: FastMap::default(),
         vgrid: PointGrid::new(Cells::new(bbox.min, l)),
         stack: Vec::new(),
         hits: Vec::new(),
@@ -239,6 +285,7 @@ pub fn retile(
         comp: 0,
         stats: RetileStats::default(),
         surf: &mut surf,
+        filler: filler.unwrap_or(&[]),
     };
     let comps = r.surf.component_count;
     // Per component: its first triangle, area and box.
@@ -268,7 +315,11 @@ pub fn retile(
         r.component(first[c], budget)?;
         r.stats.components += 1;
     }
-    let open = !r.boundary.is_empty();
+    let deleted = match filler {
+        Some(f) => r.over_filler(f),
+        None => Vec::new(),
+    };
+    r.stats.deleted_triangles = deleted.iter().filter(|&&d| d).count();
     Ok(Retiled {
         mesh: RetiledMesh {
             positions: r.pos,
@@ -276,13 +327,192 @@ pub fn retile(
             sources: r.src,
             labels: r.labels,
             components: comps,
-            open,
+            deleted,
         },
         stats: r.stats,
     })
 }
 
 impl Retiler<'_, '_> {
+    // --- Holes of the original -----------------------------------------------------------
+
+    /// For each retiled triangle, whether it lies over the filler that capped a hole of the
+    /// original (its centroid's closest original triangle is filler); then, so that the
+    /// kept part stays vertex-manifold, at every vertex whose kept triangles form several
+    /// fans only the largest fan is kept.
+    fn over_filler(&mut self, filler: &[bool]) -> Vec<bool> {
+        let l = self.l;
+        // Over filler: at least three of the triangle's corners and centroid project onto
+        // filler (a triangle straddling the border stays: better a flap than a notch).
+        let mut deleted: Vec<bool> = (0..self.tris.len())
+            .map(|t| {
+                let [a, b, c] = self.tris[t].map(|v| self.pos[v as usize]);
+                let comp = self.vcomp[self.tris[t][0] as usize];
+                let on_filler = [a, b, c, (a + b + c) / 3.0]
+                    .iter()
+                    .filter(
+                        |&&p| match self.surf.closest_in_component(p, comp, 2.0 * l) {
+                            Some((_, o)) => filler.get(o as usize).copied().unwrap_or(false),
+                            None => false,
+                        },
+                    )
+                    .count();
+                on_filler >= 3
+            })
+            .collect();
+        if !deleted.iter().any(|&d| d) {
+            return deleted;
+        }
+        // A connected original keeps a connected retiling: of the kept pieces of each
+        // retiled component only the largest stays (small islands of kept triangles out on
+        // a cap would only add error).
+        let kept = self.pieces(&deleted, false);
+        let mut largest: std::collections::HashMap<u32, usize> = Default::default();
+        for (id, p) in kept.iter().enumerate() {
+            let comp = self.vcomp[self.tris[p[0] as usize][0] as usize];
+            let e = largest.entry(comp).or_insert(id);
+            if p.len() > kept[*e].len() {
+                *e = id;
+            }
+        }
+        for (id, p) in kept.iter().enumerate() {
+            let comp = self.vcomp[self.tris[p[0] as usize][0] as usize];
+            if largest.get(&comp) != Some(&id) {
+                for &t in p {
+                    deleted[t as usize] = true;
+                }
+            }
+        }
+        for _round in 0..4 {
+            // Pinholes: a connected piece of at most three deleted triangles is a notch of
+            // the border approximation, not a hole of the original: keep it.
+            let mut undeleted = false;
+            for p in self.pieces(&deleted, true) {
+                if p.len() <= 3 {
+                    for t in p {
+                        deleted[t as usize] = false;
+                    }
+                    undeleted = true;
+                }
+            }
+            if !self.fix_fans(&mut deleted) && !undeleted {
+                break;
+            }
+        }
+        deleted
+    }
+
+    /// At every vertex whose kept triangles form several fans, deletes all but the largest
+    /// fan (so the kept part stays vertex-manifold). Returns whether anything changed.
+    fn fix_fans(&self, deleted: &mut [bool]) -> bool {
+        let mut any = false;
+        for _pass in 0..4 {
+            let mut changed = false;
+            for v in 0..self.pos.len() as u32 {
+                let fan = self.fan(v);
+                if fan.is_empty() {
+                    continue;
+                }
+                // Runs of kept triangles around v (cyclic).
+                let n = fan.len();
+                let Some(start) = (0..n).find(|&i| deleted[fan[i] as usize]) else {
+                    continue; // all kept
+                };
+                let mut runs: Vec<Vec<u32>> = Vec::new();
+                let mut cur: Vec<u32> = Vec::new();
+                for k in 1..=n {
+                    let t = fan[(start + k) % n];
+                    if deleted[t as usize] {
+                        if !cur.is_empty() {
+                            runs.push(std::mem::take(&mut cur));
+                        }
+                    } else {
+                        cur.push(t);
+                    }
+                }
+                if !cur.is_empty() {
+                    runs.push(cur);
+                }
+                if runs.len() > 1 {
+                    let keep = runs
+                        .iter()
+                        .enumerate()
+                        .max_by_key(|(i, r)| (r.len(), usize::MAX - i))
+                        .map_or(0, |(i, _)| i);
+                    for (i, r) in runs.iter().enumerate() {
+                        if i != keep {
+                            for &t in r {
+                                deleted[t as usize] = true;
+                            }
+                        }
+                    }
+                    changed = true;
+                }
+            }
+            any |= changed;
+            if !changed {
+                break;
+            }
+        }
+        any
+    }
+
+    /// The connected pieces (across edges) of the triangles whose flag equals `which`.
+    fn pieces(&self, flags: &[bool], which: bool) -> Vec<Vec<u32>> {
+        let nt = self.tris.len();
+        let mut seen = vec![false; nt];
+        let mut out = Vec::new();
+        for t0 in 0..nt {
+            if flags[t0] != which || seen[t0] {
+                continue;
+            }
+            seen[t0] = true;
+            let mut piece = Vec::new();
+            let mut stack = vec![t0 as u32];
+            while let Some(t) = stack.pop() {
+                piece.push(t);
+                let tri = self.tris[t as usize];
+                for k in 0..3 {
+                    let (x, y) = (tri[k], tri[(k + 1) % 3]);
+                    if let Some(&n) = self.edges.get(&ekey(y, x)) {
+                        let n = n as usize;
+                        if flags[n] == which && !seen[n] {
+                            seen[n] = true;
+                            stack.push(n as u32);
+                        }
+                    }
+                }
+            }
+            out.push(piece);
+        }
+        out
+    }
+
+    /// The triangles around vertex `v` in cyclic order (the retiled mesh is closed).
+    fn fan(&self, v: u32) -> Vec<u32> {
+        let first = self.vcorner[v as usize];
+        if first == NONE {
+            return Vec::new();
+        }
+        let t0 = first / 3;
+        let mut out = vec![t0];
+        let mut t = t0;
+        for _ in 0..256 {
+            let tri = self.tris[t as usize];
+            let k = tri.iter().position(|&x| x == v).unwrap_or(0);
+            let p = tri[(k + 1) % 3];
+            // The neighbour across edge (v, p) holds p -> v.
+            match self.edges.get(&ekey(p, v)) {
+                Some(&n) if n != t0 => {
+                    out.push(n);
+                    t = n;
+                }
+                _ => break,
+            }
+        }
+        out
+    }
+
     // --- Construction -------------------------------------------------------------------
 
     fn add_vertex(&mut self, p: DVec3, n: DVec3, s: VertexSource) -> u32 {
@@ -293,6 +523,7 @@ impl Retiler<'_, '_> {
         self.vcorner.push(NONE);
         self.vnode.push(NONE);
         self.vlive.push(0);
+        self.vcomp.push(self.comp);
         self.vgrid.insert(v, p);
         v
     }
@@ -407,8 +638,20 @@ impl Retiler<'_, '_> {
     /// Seeds and retiles one component.
     fn component(&mut self, first_tri: u32, budget: usize) -> Result<(), Error> {
         let start = self.tris.len();
+        let forced_before = self.stats.forced;
         let mut gate = self.seed(first_tri)?;
         loop {
+            // Fail fast when the front degenerates (a cascade of fallbacks feeds itself):
+            // the encoder retries at a slightly different L.
+            let built = self.tris.len() - start;
+            if self.stats.forced - forced_before > 100 + built / 50 {
+                return Err(Error::Stuck(format!(
+                    "component {} needed {} forced moves in {built} triangles at L = {}",
+                    self.comp,
+                    self.stats.forced - forced_before,
+                    self.l
+                )));
+            }
             if self.tris.len() - start > budget {
                 return Err(Error::Stuck(format!(
                     "component {} needed more than {budget} triangles (the retiler is \
@@ -416,13 +659,13 @@ impl Retiler<'_, '_> {
                     self.comp
                 )));
             }
-            if let Some(at) = std::env::var_os("WHET_SWING_DUMP_AT") {
+            if let Some(at) = trace_var("WHET_SWING_DUMP_AT") {
                 if at.to_str().and_then(|x| x.parse::<usize>().ok()) == Some(self.tris.len()) {
                     self.dump(std::path::Path::new("/tmp/dump_at.off"), gate);
                 }
             }
             let stepped = self.step(gate);
-            if let (Err(_), Some(path)) = (&stepped, std::env::var_os("WHET_SWING_DUMP")) {
+            if let (Err(_), Some(path)) = (&stepped, trace_var("WHET_SWING_DUMP")) {
                 self.dump(std::path::Path::new(&path), gate);
             }
             match stepped? {
@@ -486,70 +729,76 @@ impl Retiler<'_, '_> {
         let mesh = self.surf.mesh;
         let l = self.l;
         let comp = self.comp;
-        // Candidates spread over the component, flattest first: a seed on a crease or a
-        // corner starts the spiral badly.
-        let tris: Vec<usize> = self
-            .surf
-            .component
-            .iter()
-            .enumerate()
-            .skip(first_tri as usize)
-            .filter(|(_, &c)| c == comp)
-            .map(|(t, _)| t)
-            .collect();
-        let stride = (tris.len() / 96).max(1);
-        // Candidate points are triangle centroids: on coarse CAD meshes the vertices all
-        // sit on creases and corners.
-        let mut candidates: Vec<(f64, usize, DVec3)> = Vec::new();
-        for &t in tris.iter().step_by(stride) {
-            let [p0, p1, p2] = mesh.triangle_positions(t);
-            let (n, flat) = self
+        // First pass strict (off the caps of holes, sides between 0.7 L and 1.4 L), then
+        // anywhere with sides between 0.3 L and 1.8 L (a surface riddled with holes).
+        for (avoid_caps, lo, hi) in [(true, 0.7, 1.4), (false, 0.3, 1.8)] {
+            // Candidates spread over the component, flattest first: a seed on a crease or a
+            // corner starts the spiral badly.
+            let tris: Vec<usize> = self
                 .surf
-                .normal_coherence((p0 + p1 + p2) / 3.0, 1.5 * l, comp);
-            if n != DVec3::ZERO {
-                candidates.push((flat, t, n));
+                .component
+                .iter()
+                .enumerate()
+                .skip(first_tri as usize)
+                .filter(|&(t, &c)| {
+                    c == comp && !(avoid_caps && self.filler.get(t).copied().unwrap_or(false))
+                })
+                .map(|(t, _)| t)
+                .collect();
+            let stride = (tris.len() / 96).max(1);
+            // Candidate points are triangle centroids: on coarse CAD meshes the vertices all
+            // sit on creases and corners.
+            let mut candidates: Vec<(f64, usize, DVec3)> = Vec::new();
+            for &t in tris.iter().step_by(stride) {
+                let [p0, p1, p2] = mesh.triangle_positions(t);
+                let (n, flat) = self
+                    .surf
+                    .normal_coherence((p0 + p1 + p2) / 3.0, 1.5 * l, comp);
+                if n != DVec3::ZERO {
+                    candidates.push((flat, t, n));
+                }
             }
-        }
-        candidates.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
-        for &(_, t0, n0) in candidates.iter().take(32) {
-            let [p0, p1, p2] = mesh.triangle_positions(t0);
-            let x0 = (p0 + p1 + p2) / 3.0;
-            let t = n0.any_orthonormal_vector();
-            let s = n0.cross(t);
-            let Some((x1, t1)) = self.surf.closest_in_component(x0 + t * l, comp, l) else {
-                continue;
-            };
-            let target2 = x0 + (t * 0.5 + s * (0.75f64).sqrt()) * l;
-            let Some((x2, t2)) = self.surf.closest_in_component(target2, comp, l) else {
-                continue;
-            };
-            let (g0, q0) = self.params.snap_seed(x0);
-            let (g1, q1) = self.params.snap_seed(x1);
-            let (g2, q2) = self.params.snap_seed(x2);
-            let nrm = (q1 - q0).cross(q2 - q0);
-            let edges_ok = [(q0, q1), (q1, q2), (q2, q0)].iter().all(|(a, b)| {
-                let d = (*a - *b).length();
-                d > 0.3 * l && d < 1.8 * l
-            });
-            if !(nrm.dot(n0) > 0.0) || !edges_ok {
-                continue;
+            candidates.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
+            for &(_, t0, n0) in candidates.iter().take(32) {
+                let [p0, p1, p2] = mesh.triangle_positions(t0);
+                let x0 = (p0 + p1 + p2) / 3.0;
+                let t = n0.any_orthonormal_vector();
+                let s = n0.cross(t);
+                let Some((x1, t1)) = self.surf.closest_in_component(x0 + t * l, comp, l) else {
+                    continue;
+                };
+                let target2 = x0 + (t * 0.5 + s * (0.75f64).sqrt()) * l;
+                let Some((x2, t2)) = self.surf.closest_in_component(target2, comp, l) else {
+                    continue;
+                };
+                let (g0, q0) = self.params.snap_seed(x0);
+                let (g1, q1) = self.params.snap_seed(x1);
+                let (g2, q2) = self.params.snap_seed(x2);
+                let nrm = (q1 - q0).cross(q2 - q0);
+                let edges_ok = [(q0, q1), (q1, q2), (q2, q0)].iter().all(|(a, b)| {
+                    let d = (*a - *b).length();
+                    d > lo * l && d < hi * l
+                });
+                if nrm.dot(n0).is_nan() || nrm.dot(n0) <= 0.0 || !edges_ok {
+                    continue;
+                }
+                let n1 = self.surf.normal_at(t1, x1);
+                let n1 = self.surf.smooth_normal(x1, 0.5 * l, comp, n1);
+                let n2 = self.surf.normal_at(t2, x2);
+                let n2 = self.surf.smooth_normal(x2, 0.5 * l, comp, n2);
+                let a = self.add_vertex(q0, n0, VertexSource::Seed(g0));
+                let b = self.add_vertex(q1, n1, VertexSource::Seed(g1));
+                let c = self.add_vertex(q2, n2, VertexSource::Seed(g2));
+                self.add_triangle([a, b, c]);
+                // Loop x0 -> x2 -> x1 -> x0 (the seed's edges reversed).
+                let n_a = self.add_node(a);
+                let n_c = self.add_node(c);
+                let n_b = self.add_node(b);
+                self.link(n_a, n_c);
+                self.link(n_c, n_b);
+                self.link(n_b, n_a);
+                return Ok(n_a);
             }
-            let n1 = self.surf.normal_at(t1, x1);
-            let n1 = self.surf.smooth_normal(x1, 0.5 * l, comp, n1);
-            let n2 = self.surf.normal_at(t2, x2);
-            let n2 = self.surf.smooth_normal(x2, 0.5 * l, comp, n2);
-            let a = self.add_vertex(q0, n0, VertexSource::Seed(g0));
-            let b = self.add_vertex(q1, n1, VertexSource::Seed(g1));
-            let c = self.add_vertex(q2, n2, VertexSource::Seed(g2));
-            self.add_triangle([a, b, c]);
-            // Loop x0 -> x2 -> x1 -> x0 (the seed's edges reversed).
-            let n_a = self.add_node(a);
-            let n_c = self.add_node(c);
-            let n_b = self.add_node(b);
-            self.link(n_a, n_c);
-            self.link(n_c, n_b);
-            self.link(n_b, n_a);
-            return Ok(n_a);
         }
         Err(Error::Stuck(format!(
             "no seed triangle of edge length {l} fits on component {comp}"
@@ -707,12 +956,16 @@ impl Retiler<'_, '_> {
         if wn != pn && self.built(a, w) {
             return false;
         }
-        // Boundary edges of M' stay open.
-        if wn == xn && self.boundary.contains_key(&ekey(b, w)) {
-            return false;
-        }
-        if wn == pn && self.boundary.contains_key(&ekey(w, a)) {
-            return false;
+        // Never glue a triangle onto the three edges of one and the same triangle: that
+        // closes a two-triangle pillow (only tiny components are pillows, built elsewhere).
+        if let (Some(r), Some(l), Some(p)) = (
+            self.edges.get(&ekey(w, b)),
+            self.edges.get(&ekey(a, w)),
+            self.edges.get(&ekey(b, a)),
+        ) {
+            if r == l && l == p {
+                return false;
+            }
         }
         if !geometric {
             return true;
@@ -770,7 +1023,7 @@ impl Retiler<'_, '_> {
         let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
         let n = (pa - pw).cross(pb - pw);
         let len = n.length();
-        if !(len > 1e-9 * self.l * self.l) {
+        if len.is_nan() || len <= 1e-9 * self.l * self.l {
             return false;
         }
         let nt = n / len;
@@ -822,7 +1075,13 @@ impl Retiler<'_, '_> {
         let q = self.query;
         let mut hit = false;
         let mut near = Vec::new();
-        self.vgrid.near(h, 1.2 * l, |v| near.push(v));
+        let comp = self.comp;
+        let vcomp = &self.vcomp;
+        self.vgrid.near(h, 1.2 * l, |v| {
+            if vcomp[v as usize] == comp {
+                near.push(v)
+            }
+        });
         'outer: for v in near {
             let mut c = self.vcorner[v as usize];
             while c != NONE {
@@ -852,7 +1111,7 @@ impl Retiler<'_, '_> {
                 });
                 if inside {
                     hit = true;
-                    if std::env::var_os("WHET_SWING_TRACE2").is_some() {
+                    if trace_var("WHET_SWING_TRACE2").is_some() {
                         eprintln!(
                             "   covered by tri {t} {:?} d {:.3}L at h {:?} tri pts {:?}",
                             self.tris[t],
@@ -885,7 +1144,7 @@ impl Retiler<'_, '_> {
         let r2 = radius * radius;
         let c2 = clearance * clearance;
         self.vgrid.near(p, radius.max(clearance), |v| {
-            if v == a || v == b {
+            if v == a || v == b || self.vcomp[v as usize] != self.comp {
                 return;
             }
             if self.nrm[v as usize].dot(np) < -0.2 {
@@ -898,7 +1157,7 @@ impl Retiler<'_, '_> {
                 }
                 return;
             }
-            if d2 <= r2 && best.map_or(true, |(bd, _)| d2 < bd) {
+            if d2 <= r2 && best.is_none_or(|(bd, _)| d2 < bd) {
                 best = Some((d2, v));
             }
         });
@@ -927,27 +1186,7 @@ impl Retiler<'_, '_> {
     // --- One step -----------------------------------------------------------------------
 
     /// Builds the triangle at gate node `an`; returns the next gate, or `None` after an E.
-    fn step(&mut self, mut an: u32) -> Result<Option<u32>, Error> {
-        // A gate declared boundary stays open: move along the loop to one that is not;
-        // a loop made only of boundary edges is finished (a hole of M').
-        if !self.boundary.is_empty() {
-            let start = an;
-            let mut guard = 0usize;
-            loop {
-                let b = self.nodes[self.nodes[an as usize].next as usize].v;
-                if !self
-                    .boundary
-                    .contains_key(&ekey(self.nodes[an as usize].v, b))
-                {
-                    break;
-                }
-                an = self.nodes[an as usize].next;
-                guard += 1;
-                if an == start || guard > self.nodes.len() {
-                    return Ok(None);
-                }
-            }
-        }
+    fn step(&mut self, an: u32) -> Result<Option<u32>, Error> {
         let bn = self.nodes[an as usize].next;
         let xn = self.nodes[bn as usize].next;
         let pn = self.nodes[an as usize].prev;
@@ -957,7 +1196,6 @@ impl Retiler<'_, '_> {
         let open_b = self.wedge(bn);
         let open_a = self.wedge(an);
         let close = self.tune.close_angle;
-
         // Rule 2: a small loop of three closes.
         if three && (open_a < close || open_b < close) && self.valid_existing(an, bn, xn, true) {
             return self.apply(an, Tip::Existing(xn));
@@ -1013,10 +1251,7 @@ impl Retiler<'_, '_> {
                         }
                         penalty += 1.0;
                     }
-                    if blocked {
-                        self.stats.covered_hits += 1;
-                        penalty += 2.0;
-                    } else if near.is_none() && self.covered(h.point, normal) {
+                    if blocked || (near.is_none() && self.covered(h.point, normal)) {
                         self.stats.covered_hits += 1;
                         penalty += 2.0;
                     }
@@ -1028,7 +1263,7 @@ impl Retiler<'_, '_> {
                         // Rule 5: a new vertex.
                         return self.apply(an, Tip::New { pos: v, normal, q });
                     }
-                    if std::env::var_os("WHET_SWING_TRACE").is_some() {
+                    if trace_var("WHET_SWING_TRACE").is_some() {
                         eprintln!(
                             "C refused at tri {}: theta {:.0} penalty {penalty} tri_ok {} fits b {} ({:.0}) fits a {} ({:.0}), viol b {:.2} a {:.2}",
                             self.tris.len(),
@@ -1048,15 +1283,31 @@ impl Retiler<'_, '_> {
                         q,
                         penalty,
                     });
-                } else if self.surf.open && self.near_boundary_of_m(pa, pb) {
-                    return Ok(Some(self.declare_boundary(an)));
                 }
                 // No clean hit: the point of the circle nearest to the surface, off the
                 // built part (the wrapper then bridges gaps narrower than L, as a shrink
                 // wrap would).
-                if spare.as_ref().map_or(true, |sp| sp.penalty > 0.0) {
+                if spare.as_ref().is_none_or(|sp| sp.penalty > 0.0) {
                     if let Some(sp) = self.nearest_on_circle(&frame, a, b) {
-                        if spare.as_ref().map_or(true, |s| sp.penalty < s.penalty) {
+                        // The circle passes through a hole smaller than L or a crack of
+                        // M, and a point of it lies near the surface: a regular new
+                        // vertex that covers the hole over.
+                        if best.is_none()
+                            && sp.penalty <= 0.5 + 2.0 * self.tune.bridge
+                            && self.fits_wedge(bn, sp.pos, pa)
+                            && self.fits_wedge(an, pb, sp.pos)
+                        {
+                            self.stats.bridged += 1;
+                            return self.apply(
+                                an,
+                                Tip::New {
+                                    pos: sp.pos,
+                                    normal: sp.normal,
+                                    q: sp.q,
+                                },
+                            );
+                        }
+                        if spare.as_ref().is_none_or(|s| sp.penalty < s.penalty) {
                             spare = Some(sp);
                         }
                     }
@@ -1073,15 +1324,16 @@ impl Retiler<'_, '_> {
         let tmax = self.tune.theta_max;
         let angles = &self.params.angles;
         let qmax = angles.quantize(tmax).abs().min(angles.max_index());
-        let stride = ((10.0f64.to_radians() / angles.step()).round() as i32).max(1);
+        let stride = ((15.0f64.to_radians() / angles.step()).round() as i32).max(1);
         let mut best: Option<(f64, i32, DVec3, DVec3)> = None;
         let eval = |r: &mut Self, q: i32, best: &mut Option<(f64, i32, DVec3, DVec3)>| {
             let p = frame.tip(&r.params.angles, q);
-            let Some((x, t)) = r.surf.closest_in_component(p, r.comp, l) else {
+            // Points farther than L/2 from the surface would cost more than any closure.
+            let Some((x, t)) = r.surf.closest_in_component(p, r.comp, 0.5 * l) else {
                 return;
             };
             let d = (x - p).length();
-            if best.map_or(false, |(bd, ..)| d >= bd) {
+            if best.is_some_and(|(bd, ..)| d >= bd) {
                 return;
             }
             let rough = r.surf.normal_at(t, x);
@@ -1130,7 +1382,8 @@ impl Retiler<'_, '_> {
         let radius = 2.5 * self.l + (pa - pb).length();
         let mut near = Vec::new();
         self.vgrid.near(mid, radius, |v| {
-            if v != a && v != b && self.vlive[v as usize] > 0 {
+            if v != a && v != b && self.vlive[v as usize] > 0 && self.vcomp[v as usize] == self.comp
+            {
                 near.push(v);
             }
         });
@@ -1145,18 +1398,18 @@ impl Retiler<'_, '_> {
         for wn in nodes {
             if self.valid_existing(an, bn, wn, false) {
                 let c = self.existing_cost(an, bn, wn);
-                if best.map_or(true, |(bc, _)| c < bc) {
+                if best.is_none_or(|(bc, _)| c < bc) {
                     best = Some((c, Some(wn)));
                 }
             }
         }
         if let Some(sp) = &spare {
             let c = 0.5 + sp.penalty + self.new_cost(an, bn, sp.pos, sp.normal);
-            if best.map_or(true, |(bc, _)| c < bc) {
+            if best.is_none_or(|(bc, _)| c < bc) {
                 best = Some((c, None));
             }
         }
-        if std::env::var_os("WHET_SWING_TRACE").is_some() {
+        if trace_var("WHET_SWING_TRACE").is_some() {
             let x = self.nodes[xn as usize].v;
             let px = self.pos[x as usize];
             eprintln!(
@@ -1181,7 +1434,7 @@ impl Retiler<'_, '_> {
         }
         match best {
             Some((c, choice)) => {
-                if c > 1.0 {
+                if c > 2.0 {
                     self.stats.forced += 1;
                 }
                 match (choice, spare) {
@@ -1244,7 +1497,7 @@ impl Retiler<'_, '_> {
         let mut c = 3.0 * (longest - 1.2).max(0.0) + 20.0 * (longest - 1.9).max(0.0);
         let n = (pa - pw).cross(pb - pw);
         let len = n.length();
-        if !(len > 1e-9 * l * l) {
+        if len.is_nan() || len <= 1e-9 * l * l {
             return c + 10.0;
         }
         let nt = n / len;
@@ -1262,23 +1515,6 @@ impl Retiler<'_, '_> {
             c += 2.0 * (fold - self.tune.max_fold).max(0.0);
         }
         c
-    }
-
-    /// Is the gate `pa -> pb` at a boundary of the (open) original?
-    fn near_boundary_of_m(&self, _pa: DVec3, _pb: DVec3) -> bool {
-        // Open originals: a gate whose circle misses M entirely lies at M's border.
-        true
-    }
-
-    /// Marks the gate edge as a boundary edge of `M'` and moves on along the loop; returns
-    /// the next gate to work on.
-    fn declare_boundary(&mut self, an: u32) -> u32 {
-        let bn = self.nodes[an as usize].next;
-        let a = self.nodes[an as usize].v;
-        let b = self.nodes[bn as usize].v;
-        self.boundary.insert(ekey(a, b), ());
-        self.stats.boundary_edges += 1;
-        bn
     }
 
     /// Adds the triangle of gate `an` with `tip`, updates the loops and returns the next gate.
@@ -1311,7 +1547,7 @@ impl Retiler<'_, '_> {
                     (false, false) => Clers::S,
                 };
                 self.labels.push(label);
-                if std::env::var_os("WHET_SWING_TRACE").is_some() {
+                if trace_var("WHET_SWING_TRACE").is_some() {
                     let (pa, pb, pw) = (
                         self.pos[a as usize],
                         self.pos[b as usize],

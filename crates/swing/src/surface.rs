@@ -33,8 +33,6 @@ pub(crate) struct Surface<'m> {
     pub face_normal: Vec<DVec3>,
     /// Area-weighted unit vertex normals.
     pub vertex_normal: Vec<DVec3>,
-    /// True when some edge of `M` has a single triangle (`M` has boundaries).
-    pub open: bool,
     grid: StaticGrid,
     /// Scratch: the query stamp of each triangle (dedupes triangles seen in several cells).
     stamp: Vec<u32>,
@@ -87,16 +85,6 @@ impl<'m> Surface<'m> {
             }
             component.push(label[r]);
         }
-        // Open when some undirected edge is used once.
-        let mut edges: crate::grid::FastMap<u64, i32> = Default::default();
-        edges.reserve(nt * 2);
-        for tri in &mesh.triangles {
-            for i in 0..3 {
-                let (a, b) = (tri[i], tri[(i + 1) % 3]);
-                *edges.entry(whet_mesh::edge_key(a, b)).or_default() += 1;
-            }
-        }
-        let open = edges.values().any(|&c| c == 1);
         let bbox = mesh.bounding_box();
         let cells = Cells::new(bbox.min, cell.max(1e-300));
         let grid = StaticGrid::build(
@@ -112,7 +100,6 @@ impl<'m> Surface<'m> {
             component_count: count as usize,
             face_normal,
             vertex_normal,
-            open,
             grid,
             stamp: vec![0; nt],
             query: 0,
@@ -267,7 +254,7 @@ impl<'m> Surface<'m> {
                 let (x1, y1) = to2(seg[1]);
                 let (dx, dy) = (x1 - x0, y1 - y0);
                 let aa = dx * dx + dy * dy;
-                if !(aa > 0.0) {
+                if aa.is_nan() || aa <= 0.0 {
                     continue;
                 }
                 let bb = x0 * dx + y0 * dy;
@@ -310,7 +297,7 @@ impl<'m> Surface<'m> {
                 let [a, b, c] = mesh.triangles[ti].map(|v| mesh.positions[v as usize]);
                 let x = closest_point_on_triangle(p, a, b, c);
                 let dist = (x - p).length_squared();
-                if best.map_or(true, |(bd, _)| dist < bd) {
+                if best.is_none_or(|(bd, _)| dist < bd) {
                     best = Some((dist, t));
                 }
             }
@@ -346,7 +333,7 @@ impl<'m> Surface<'m> {
                 let [a, b, c] = mesh.triangles[ti].map(|v| mesh.positions[v as usize]);
                 let x = closest_point_on_triangle(p, a, b, c);
                 let dist = (x - p).length_squared();
-                if best.map_or(true, |(bd, _, _)| dist < bd) {
+                if best.is_none_or(|(bd, _, _)| dist < bd) {
                     best = Some((dist, x, t));
                 }
             }

@@ -1,0 +1,87 @@
+//! Speed of the swing codec on a large original (issue target: retile and encode a
+//! 1M-triangle original into about 100k retiled triangles in under 3 s on one core; decode at
+//! 10 M retiled triangles/s or more).
+//!
+//! ```text
+//! cargo run --release -p whet-swing --example swing_speed [-- mesh.off [fraction]]
+//! ```
+//! Without arguments: armadillo split 1-to-4 twice (1.38 M triangles), L chosen for about
+//! 100 k retiled triangles.
+#![allow(clippy::unwrap_used)] // a measurement tool
+
+use std::collections::HashMap;
+use std::time::Instant;
+use whet_codec::{decode, DecodeOptions};
+use whet_mesh::Mesh;
+use whet_swing::{encode, Rate, SwingOptions};
+
+/// 1-to-4 midpoint subdivision (flat: the surface does not change, only the triangle count).
+fn split(m: &Mesh) -> Mesh {
+    let mut pos = m.positions.clone();
+    let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
+    let mut tris = Vec::with_capacity(m.triangles.len() * 4);
+    let mut get = |a: u32, b: u32, pos: &mut Vec<whet_mesh::DVec3>| {
+        let k = (a.min(b), a.max(b));
+        *mid.entry(k).or_insert_with(|| {
+            pos.push((pos[a as usize] + pos[b as usize]) * 0.5);
+            (pos.len() - 1) as u32
+        })
+    };
+    for &[a, b, c] in &m.triangles {
+        let ab = get(a, b, &mut pos);
+        let bc = get(b, c, &mut pos);
+        let ca = get(c, a, &mut pos);
+        tris.extend_from_slice(&[[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]);
+    }
+    Mesh::new(pos, tris)
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let (mesh, fraction) = match args.first() {
+        Some(p) => (
+            whet_io::read_path(std::path::Path::new(p), None).unwrap(),
+            args.get(1).map_or(0.004, |f| f.parse().unwrap()),
+        ),
+        None => {
+            let a =
+                whet_io::read_path(&whet_testkit::shared_fixture("armadillo.off"), None).unwrap();
+            (split(&split(&a)), 0.0037)
+        }
+    };
+    eprintln!(
+        "original: {} vertices, {} triangles",
+        mesh.positions.len(),
+        mesh.triangles.len()
+    );
+    let opts = SwingOptions::DEFAULT.with_rate(Rate::EdgeLength(fraction));
+    let mut best_enc = f64::MAX;
+    let mut out = None;
+    for _ in 0..3 {
+        let t = Instant::now();
+        let o = encode(&mesh, &opts).unwrap();
+        best_enc = best_enc.min(t.elapsed().as_secs_f64());
+        out = Some(o);
+    }
+    let out = out.unwrap();
+    let tris = out.report.triangles;
+    let mut best_dec = f64::MAX;
+    for _ in 0..10 {
+        let t = Instant::now();
+        let m = decode(&out.bytes, &DecodeOptions::DEFAULT).unwrap();
+        best_dec = best_dec.min(t.elapsed().as_secs_f64());
+        assert_eq!(m.triangles.len(), tris);
+    }
+    println!(
+        "| {} | {} | {:.4} | {} | {} | {:.3} | {:.3} | {:.1} |",
+        mesh.triangles.len(),
+        mesh.positions.len(),
+        fraction,
+        tris,
+        out.bytes.len(),
+        best_enc,
+        best_dec * 1e3,
+        tris as f64 / best_dec / 1e6
+    );
+    println!("(original triangles | vertices | L/diag | retiled triangles | bytes | encode s | decode ms | decode M tri/s)");
+}

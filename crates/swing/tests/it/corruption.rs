@@ -1,0 +1,115 @@
+//! Corrupted swing streams give errors, never panics or garbage meshes.
+
+use whet_codec::{decode, DecodeOptions};
+use whet_format::{parse, tag, Container, Limits, SectionKind};
+use whet_swing::{encode, Rate, SwingOptions};
+use whet_testkit::meshes::icosphere;
+
+fn stream() -> Vec<u8> {
+    encode(
+        &icosphere(3),
+        &SwingOptions::DEFAULT.with_rate(Rate::EdgeLength(0.08)),
+    )
+    .unwrap()
+    .bytes
+}
+
+fn decode_ok_or_err(bytes: &[u8]) {
+    if let Ok(m) = decode(bytes, &DecodeOptions::DEFAULT) {
+        assert!(m.validate().is_ok());
+        assert!(m.positions.iter().all(|p| p.is_finite()));
+    }
+}
+
+#[test]
+fn every_truncation_is_an_error() {
+    let good = stream();
+    for n in 0..good.len() {
+        assert!(decode(&good[..n], &DecodeOptions::DEFAULT).is_err(), "{n}");
+    }
+}
+
+/// Rebuilds the container with `f` applied to its geometry section (CRCs recomputed, so
+/// the swing decoder itself sees the damage).
+fn with_geometry(good: &[u8], f: impl Fn(&mut Vec<u8>)) -> Vec<u8> {
+    let c = parse(good, &Limits::DEFAULT).unwrap();
+    let mut geom = c.section(SectionKind::GEOMETRY).unwrap().to_vec();
+    f(&mut geom);
+    let conn = c.section(SectionKind::CONNECTIVITY).unwrap().to_vec();
+    Container::new(c.header.clone())
+        .with_section(SectionKind::CONNECTIVITY, conn)
+        .with_section(SectionKind::GEOMETRY, geom)
+        .to_bytes()
+        .unwrap()
+}
+
+#[test]
+fn damaged_geometry_never_panics() {
+    let good = stream();
+    let len = parse(&good, &Limits::DEFAULT)
+        .unwrap()
+        .section(SectionKind::GEOMETRY)
+        .unwrap()
+        .len();
+    for i in 0..len {
+        for bit in [0x01u8, 0x10, 0x80] {
+            decode_ok_or_err(&with_geometry(&good, |g| g[i] ^= bit));
+        }
+    }
+    for n in 0..len {
+        let b = with_geometry(&good, |g| g.truncate(n));
+        assert!(
+            decode(&b, &DecodeOptions::DEFAULT).is_err(),
+            "geometry cut to {n}"
+        );
+    }
+    // An unknown geometry kind.
+    assert!(decode(&with_geometry(&good, |g| g[0] = 7), &DecodeOptions::DEFAULT).is_err());
+}
+
+#[test]
+fn bad_header_fields_are_errors() {
+    let good = stream();
+    let c = parse(&good, &Limits::DEFAULT).unwrap();
+    let rebuild = |f: &dyn Fn(&mut whet_format::Header)| {
+        let mut h = c.header.clone();
+        f(&mut h);
+        let mut out = Container::new(h);
+        for kind in [SectionKind::CONNECTIVITY, SectionKind::GEOMETRY] {
+            out = out.with_section(kind, c.section(kind).unwrap().to_vec());
+        }
+        out.to_bytes().unwrap()
+    };
+    let cases: Vec<(&str, Vec<u8>)> = vec![
+        ("negative L", rebuild(&|h| h.set(tag::EDGE_LENGTH, -1.0))),
+        ("NaN L", rebuild(&|h| h.set(tag::EDGE_LENGTH, f64::NAN))),
+        ("angle bits 2", rebuild(&|h| h.set(tag::ANGLE_BITS, 2u64))),
+        ("angle bits 99", rebuild(&|h| h.set(tag::ANGLE_BITS, 99u64))),
+        ("quant bits 0", rebuild(&|h| h.set(tag::QUANT_BITS, 0u64))),
+        (
+            "components",
+            rebuild(&|h| h.set(tag::COMPONENT_COUNT, 3u64)),
+        ),
+        (
+            "no L",
+            rebuild(&|h| {
+                h.remove(tag::EDGE_LENGTH);
+            }),
+        ),
+        (
+            "no angle bits",
+            rebuild(&|h| {
+                h.remove(tag::ANGLE_BITS);
+            }),
+        ),
+    ];
+    for (name, bytes) in cases {
+        let e = decode(&bytes, &DecodeOptions::DEFAULT);
+        assert!(e.is_err(), "{name}");
+        assert!(e.unwrap_err().is_input_error(), "{name}");
+    }
+    // A different L changes nothing structurally: it decodes (to another shape) or fails
+    // cleanly when some gate becomes longer than 2L.
+    decode_ok_or_err(&rebuild(&|h| h.set(tag::EDGE_LENGTH, 1e-6)));
+    decode_ok_or_err(&rebuild(&|h| h.set(tag::EDGE_LENGTH, 1e6)));
+}
