@@ -167,6 +167,14 @@ impl PointGrid {
         self.map.entry(k).or_default().push(id);
     }
 
+    /// Removes point `id`, inserted at `p`.
+    pub fn remove(&mut self, id: u32, p: DVec3) {
+        let k = Cells::key(self.cells.cell(p));
+        if let Some(v) = self.map.get_mut(&k) {
+            v.retain(|&x| x != id);
+        }
+    }
+
     /// Calls `f` with every point id in the cells overlapping the ball of radius `r`
     /// around `p` (a superset of the points within `r`).
     #[inline]

@@ -37,6 +37,9 @@
 //! built neighbours, face outwards; a tip must not land on the built part: the cheap
 //! triangloid coverage test of `algorithms.md` 1.5).
 //!
+//! Originals with boundaries are retiled with their holes capped (`holes.rs`); the retiled
+//! triangles over the caps are flagged for deletion at the end ([`RetiledMesh::deleted`]).
+//!
 //! Not handled: retiling features narrower than about `L` faithfully (thin parts are
 //! wrapped as well as the rules allow, never by more than a bounded number of triangles);
 //! sharp edges are chamfered by design (EdgeSharpener restores them after decoding).
@@ -125,6 +128,9 @@ pub struct RetileStats {
     pub components: usize,
     /// Components smaller than about `L`, coded as a flat two-triangle pillow.
     pub tiny_components: usize,
+    /// Small components (at most a tenth of the area) the front could not cover, coded as
+    /// pillows instead.
+    pub degraded_components: usize,
     /// Gates where the smallest-angle swing hit fell on the built part.
     pub covered_hits: usize,
     /// Gates closed by the fallback rule (no swing possible or valid).
@@ -302,6 +308,7 @@ pub fn retile(
             boxes[c].include(p);
         }
     }
+    let total_area: f64 = area.iter().sum();
     for c in 0..comps {
         r.comp = c as u32;
         let tiny = boxes[c].diagonal() < 1.5 * l || area[c] < 0.75 * l * l;
@@ -312,8 +319,19 @@ pub fn retile(
         }
         // Expected triangles: 2.4 · area / L² (algorithms.md 1.9).
         let budget = (tune.budget_factor * 2.4 * area[c] / (l * l)) as usize + 1000;
-        r.component(first[c], budget)?;
-        r.stats.components += 1;
+        let mark = r.mark();
+        match r.component(first[c], budget) {
+            Ok(()) => r.stats.components += 1,
+            // A small component the front cannot cover (a strip narrower than L, a
+            // splinter): a pillow loses it gracefully; a large one is an error (the encoder
+            // retries at another L).
+            Err(Error::Stuck(_)) if area[c] <= 0.1 * total_area => {
+                r.rollback(mark);
+                r.pillow(first[c])?;
+                r.stats.degraded_components += 1;
+            }
+            Err(e) => return Err(e),
+        }
     }
     let deleted = match filler {
         Some(f) => r.over_filler(f),
@@ -582,6 +600,43 @@ impl Retiler<'_, '_> {
     }
 
     // --- Components ---------------------------------------------------------------------
+
+    /// The sizes to roll a failed component back to.
+    fn mark(&self) -> (usize, usize, usize, usize) {
+        (
+            self.pos.len(),
+            self.tris.len(),
+            self.labels.len(),
+            self.nodes.len(),
+        )
+    }
+
+    /// Forgets everything built since `mark` (one component: it created all its vertices,
+    /// triangles and loop nodes after the mark and touched nothing older).
+    fn rollback(&mut self, (nv, nt, nl, nn): (usize, usize, usize, usize)) {
+        for t in nt..self.tris.len() {
+            let [w, a, b] = self.tris[t];
+            for (x, y) in [(w, a), (a, b), (b, w)] {
+                self.edges.remove(&ekey(x, y));
+            }
+        }
+        for v in nv..self.pos.len() {
+            self.vgrid.remove(v as u32, self.pos[v]);
+        }
+        self.pos.truncate(nv);
+        self.nrm.truncate(nv);
+        self.src.truncate(nv);
+        self.vcorner.truncate(nv);
+        self.vnode.truncate(nv);
+        self.vlive.truncate(nv);
+        self.vcomp.truncate(nv);
+        self.tris.truncate(nt);
+        self.tri_normal.truncate(nt);
+        self.corner_next.truncate(3 * nt);
+        self.labels.truncate(nl);
+        self.nodes.truncate(nn);
+        self.stack.clear();
+    }
 
     /// A component smaller than about `L`: its three most spread-out vertices as a seed and
     /// the seed's back face (label E), a flat closed pillow.

@@ -88,3 +88,35 @@ fn emitted_mesh_file_is_byte_identical_to_the_decoded_one() {
         assert_eq!(a, b, "{format:?}");
     }
 }
+
+/// Every triangle split 1-to-3 at a point `t` of the way from its first corner to its
+/// centroid: two needles and a sliver per triangle for small `t` (zero-area ones at 0).
+fn needles(mesh: &whet_mesh::Mesh, t: f64) -> whet_mesh::Mesh {
+    let mut m = mesh.clone();
+    m.triangles.clear();
+    for &[a, b, c] in &mesh.triangles {
+        let [pa, pb, pc] = [a, b, c].map(|v| mesh.positions[v as usize]);
+        let p = pa + ((pa + pb + pc) / 3.0 - pa) * t;
+        let x = m.positions.len() as u32;
+        m.positions.push(p);
+        m.triangles
+            .extend_from_slice(&[[a, b, x], [b, c, x], [c, a, x]]);
+    }
+    m
+}
+
+#[test]
+fn needles_slivers_and_zero_area_triangles_are_retiled() {
+    for t in [1e-3, 1e-9, 0.0] {
+        let out = round_trip(&needles(&icosphere(3), t), 0.05);
+        assert_swing(&out);
+        let r = whet_metro::metro(
+            &icosphere(3),
+            &out.retiled,
+            &whet_metro::MetroOptions::DEFAULT.with_samples(20_000),
+        )
+        .unwrap();
+        assert!(r.symmetric.rms_pct < 0.5, "{t}: {}", r.symmetric.rms_pct);
+        assert_eq!(out.retiled.topology_report().genus, Some(0));
+    }
+}
