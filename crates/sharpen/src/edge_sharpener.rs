@@ -171,6 +171,9 @@ impl EdgeSharpener {
 
     /// Sharpens `mesh`; see [`crate::sharpen`].
     pub fn sharpen(&mut self, mesh: &Mesh) -> Result<Sharpened, Error> {
+        if self.options.method == Method::NormalFilter {
+            return crate::normal_filter::run(mesh, &self.options, None);
+        }
         let start = Instant::now();
         self.options.validate()?;
         if let Some(v) = mesh.positions.iter().position(|p| !p.is_finite()) {

@@ -6,6 +6,8 @@
 //! sharpened mesh, the [`SharpTags`] and a [`SharpenReport`]; input vertices keep their indices
 //! and, outside the chamfers, their exact coordinates. [`Method::Papers`] is the papers'
 //! algorithm alone, [`Method::Extended`] (the default) adds whet's extended chamfer detection.
+//! [`Method::NormalFilter`] is the normal-filtering sharpener of seed 002 (fillets, chamfers
+//! with samples, noisy creases; [`sharpen_region`] limits it to a [`VertexSelection`]).
 //! See `docs/sharpen.md` for the rules and the degenerate cases.
 //!
 //! ```
@@ -27,6 +29,7 @@
 
 mod edge_sharpener;
 mod extended;
+mod normal_filter;
 mod options;
 mod report;
 mod slivers;
@@ -35,6 +38,7 @@ mod tags;
 
 pub use edge_sharpener::EdgeSharpener;
 
+pub use normal_filter::VertexSelection;
 pub use options::{Method, SharpenOptions};
 pub use report::{SharpenReport, UnmovedReason};
 pub use tags::SharpTags;
@@ -68,10 +72,13 @@ pub enum Error {
     #[error("bad sharpen option: {0}")]
     Parameter(String),
     /// Reading or writing a tag file failed.
-    #[error("tag file I/O: {0}")]
+    #[error("tag or selection file I/O: {0}")]
     Io(#[from] std::io::Error),
-    /// A tag file that does not follow the format or does not fit the mesh.
-    #[error("tag file line {line}: {message}")]
+    /// A broken internal invariant (a bug), reported instead of returning a broken mesh.
+    #[error("internal error in whet-sharpen: {0}")]
+    Internal(String),
+    /// A tag or selection file that does not follow the format or does not fit the mesh.
+    #[error("tag or selection file line {line}: {message}")]
     Format {
         /// 1-based line number.
         line: usize,
@@ -95,4 +102,16 @@ impl Error {
 /// and with [`Error::Parameter`] for options out of range. Never panics.
 pub fn sharpen(mesh: &Mesh, options: &SharpenOptions) -> Result<Sharpened, Error> {
     EdgeSharpener::new(*options).sharpen(mesh)
+}
+
+/// The normal filter ([`Method::NormalFilter`], whatever `options.method` says) limited to
+/// `region`: only faces whose three vertices are selected can be feature faces, and only
+/// selected vertices move or are removed (docs/sharpen.md, "The normal-filtering sharpener").
+pub fn sharpen_region(
+    mesh: &Mesh,
+    options: &SharpenOptions,
+    region: &VertexSelection,
+) -> Result<Sharpened, Error> {
+    let options = options.with_method(Method::NormalFilter);
+    normal_filter::run(mesh, &options, Some(region))
 }

@@ -14,17 +14,24 @@ pub enum Method {
     /// default.
     #[default]
     Extended,
+    /// Seed 002's normal-filtering sharpener (`docs/sharpen.md`, "The normal-filtering
+    /// sharpener"): feature faces by bounded normal variation, greedy normal filtering from
+    /// the outside of each feature inwards, least-squares vertex updating with flip avoidance
+    /// and cap/needle removal. Handles fillets, chamfers with samples, and noisy creases.
+    /// `whet sharpen --method normal-filter`.
+    NormalFilter,
 }
 
 impl Method {
     /// Every method, in declaration order.
-    pub const ALL: [Method; 2] = [Method::Papers, Method::Extended];
+    pub const ALL: [Method; 3] = [Method::Papers, Method::Extended, Method::NormalFilter];
 
     /// The name used on the command line and in reports (`papers`, `extended`).
     pub const fn name(self) -> &'static str {
         match self {
             Method::Papers => "papers",
             Method::Extended => "extended",
+            Method::NormalFilter => "normal-filter",
         }
     }
 }
@@ -43,7 +50,9 @@ impl std::str::FromStr for Method {
             .into_iter()
             .find(|m| m.name() == s)
             .ok_or_else(|| {
-                crate::Error::Parameter(format!("unknown method {s:?} (known: papers, extended)"))
+                crate::Error::Parameter(format!(
+                    "unknown method {s:?} (known: papers, extended, normal-filter)"
+                ))
             })
     }
 }
@@ -62,14 +71,27 @@ pub struct SharpenOptions {
     /// (seed 001 section 3.3: 1 degree). Must be in `[0, 20]`; 0 turns the pass off except for
     /// reversed triangles.
     pub min_angle_degrees: f64,
+    /// Normal filter: radius of the neighbourhood `NFII`, in mean edge lengths (seed 002's
+    /// `rho/L`; a little more than the widest feature to sharpen). Finite, in `(0, 64]`.
+    pub rho: f64,
+    /// Normal filter: a face is a feature face when the smallest dot product of two normals in
+    /// its neighbourhood is under `eta`. In `[-1, 1]`.
+    pub eta: f64,
+    /// Normal filter: the neighbourhood flood does not cross an edge whose normals' dot product
+    /// is `lambda` or less (an edge that is already sharp). In `[-1, 1]`.
+    pub lambda: f64,
 }
 
 impl SharpenOptions {
-    /// [`Method::Extended`], smooth factor 2, minimum angle 1 degree.
+    /// [`Method::Extended`], smooth factor 2, minimum angle 1 degree; for the normal filter
+    /// `rho` 4, `eta` 0.1, `lambda` 0.
     pub const DEFAULT: SharpenOptions = SharpenOptions {
         method: Method::Extended,
         smooth_factor: 2.0,
         min_angle_degrees: 1.0,
+        rho: 4.0,
+        eta: 0.1,
+        lambda: 0.0,
     };
 
     /// The papers' algorithm with their constants (`--method papers`).
@@ -93,6 +115,24 @@ impl SharpenOptions {
         self
     }
 
+    /// Sets the normal filter's neighbourhood radius, in mean edge lengths.
+    pub const fn with_rho(mut self, rho: f64) -> Self {
+        self.rho = rho;
+        self
+    }
+
+    /// Sets the normal filter's feature threshold.
+    pub const fn with_eta(mut self, eta: f64) -> Self {
+        self.eta = eta;
+        self
+    }
+
+    /// Sets the normal filter's flood stop.
+    pub const fn with_lambda(mut self, lambda: f64) -> Self {
+        self.lambda = lambda;
+        self
+    }
+
     /// Checks the values; [`crate::sharpen`] calls this first.
     pub fn validate(&self) -> Result<(), crate::Error> {
         if !(self.smooth_factor.is_finite() && self.smooth_factor > 0.0) {
@@ -106,6 +146,19 @@ impl SharpenOptions {
                 "min_angle_degrees must be between 0 and 20, got {}",
                 self.min_angle_degrees
             )));
+        }
+        if !(self.rho.is_finite() && self.rho > 0.0 && self.rho <= 64.0) {
+            return Err(crate::Error::Parameter(format!(
+                "rho must be in (0, 64] mean edge lengths, got {}",
+                self.rho
+            )));
+        }
+        for (name, x) in [("eta", self.eta), ("lambda", self.lambda)] {
+            if !(-1.0..=1.0).contains(&x) {
+                return Err(crate::Error::Parameter(format!(
+                    "{name} must be between -1 and 1, got {x}"
+                )));
+            }
         }
         Ok(())
     }

@@ -111,6 +111,40 @@ pub struct SharpenReport {
     pub sharp_edges: usize,
     /// Wall time of the run.
     pub time: Duration,
+    /// Normal filter (zero for the other methods): the neighbourhood radius in mean edge
+    /// lengths, and `eta`, `lambda`.
+    pub rho: f64,
+    /// Normal filter: the feature threshold.
+    pub eta: f64,
+    /// Normal filter: the flood stop.
+    pub lambda: f64,
+    /// Normal filter: feature faces found by detection (`FFt`).
+    pub feature_faces: usize,
+    /// Normal filter: vertices with a feature face around them (`VFt`).
+    pub feature_vertices: usize,
+    /// Normal filter: vertices with only feature faces around them (`FAFt`).
+    pub absolute_feature_vertices: usize,
+    /// Normal filter: bilaplacian pre-smoothing iterations (`ceil(4 / rho)`).
+    pub presmooth_iterations: usize,
+    /// Normal filter: feature faces that received a filtered normal.
+    pub filtered_normals: usize,
+    /// Normal filter: normals replaced by the rectifying pass.
+    pub rectified_normals: usize,
+    /// Normal filter: vertex-updating sweeps run.
+    pub update_iterations: usize,
+    /// Normal filter: vertex moves whose full step would have flipped or flattened a face, so
+    /// the step was shortened or refused.
+    pub flips_avoided: usize,
+    /// Normal filter: cap faces removed by swapping their longest edge.
+    pub swaps: usize,
+    /// Normal filter: needle faces removed by collapsing their shortest edge (one vertex each).
+    pub collapses: usize,
+    /// Normal filter: time of feature detection.
+    pub detection_time: Duration,
+    /// Normal filter: time of pre-smoothing, normal filtering and rectifying.
+    pub filtering_time: Duration,
+    /// Normal filter: time of vertex updating with cap and needle removal.
+    pub updating_time: Duration,
 }
 
 impl SharpenReport {
@@ -129,7 +163,11 @@ impl SharpenReport {
     /// counts, `smooth_edges`, `chamfer_edges`, `corner_triangles`, `chamfer_vertices`,
     /// `inserted_vertices`, `new_vertices`, `snapped_vertices`, `unmoved` (an object with one
     /// count per [`UnmovedReason`] name), `moved_input_vertices`, `collapsed_triangles`,
-    /// `restored_triangles`, `tagged_vertices`, `sharp_edges` and `time_ms`.
+    /// `restored_triangles`, `tagged_vertices`, `sharp_edges`, `time_ms`, then the normal
+    /// filter's `rho`, `eta`, `lambda`, `feature_faces`, `feature_vertices`,
+    /// `absolute_feature_vertices`, `presmooth_iterations`, `filtered_normals`,
+    /// `rectified_normals`, `update_iterations`, `flips_avoided`, `swaps`, `collapses`,
+    /// `detection_ms`, `filtering_ms` and `updating_ms` (zeros for the other methods).
     pub fn to_json(&self) -> String {
         let mut s = String::with_capacity(768);
         // Writing to a String cannot fail.
@@ -165,13 +203,36 @@ impl SharpenReport {
         let _ = write!(
             s,
             "}},\"moved_input_vertices\":{},\"collapsed_triangles\":{},\"restored_triangles\":{},\
-             \"tagged_vertices\":{},\"sharp_edges\":{},\"time_ms\":{}}}",
+             \"tagged_vertices\":{},\"sharp_edges\":{},\"time_ms\":{},",
             self.moved_input_vertices,
             self.collapsed_triangles,
             self.restored_triangles,
             self.tagged_vertices,
             self.sharp_edges,
             json_num(self.time.as_secs_f64() * 1e3),
+        );
+        let _ = write!(
+            s,
+            "\"rho\":{},\"eta\":{},\"lambda\":{},\"feature_faces\":{},\"feature_vertices\":{},\
+             \"absolute_feature_vertices\":{},\"presmooth_iterations\":{},\"filtered_normals\":{},\
+             \"rectified_normals\":{},\"update_iterations\":{},\"flips_avoided\":{},\"swaps\":{},\
+             \"collapses\":{},\"detection_ms\":{},\"filtering_ms\":{},\"updating_ms\":{}}}",
+            json_num(self.rho),
+            json_num(self.eta),
+            json_num(self.lambda),
+            self.feature_faces,
+            self.feature_vertices,
+            self.absolute_feature_vertices,
+            self.presmooth_iterations,
+            self.filtered_normals,
+            self.rectified_normals,
+            self.update_iterations,
+            self.flips_avoided,
+            self.swaps,
+            self.collapses,
+            json_num(self.detection_time.as_secs_f64() * 1e3),
+            json_num(self.filtering_time.as_secs_f64() * 1e3),
+            json_num(self.updating_time.as_secs_f64() * 1e3),
         );
         s
     }
@@ -208,6 +269,12 @@ mod tests {
             "too_long",
             "collapsed_triangles",
             "time_ms",
+            "feature_faces",
+            "absolute_feature_vertices",
+            "swaps",
+            "collapses",
+            "detection_ms",
+            "updating_ms",
         ] {
             assert_eq!(j.matches(&format!("\"{key}\":")).count(), 1, "{key} in {j}");
         }
