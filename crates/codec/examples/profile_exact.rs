@@ -1,32 +1,45 @@
 //! Times the stages of the exact mode on a ~1.3M-triangle icosphere (a profiling aid:
-//! `cargo run --release -p whet-codec --example profile_exact`).
+//! `cargo run --release -p whet-codec --example profile_exact -- [encodes] [decodes]`,
+//! e.g. `-- 0 20` to profile decoding alone).
 #![allow(clippy::unwrap_used)]
 
 use std::time::Instant;
 use whet_codec::{decode, encode, DecodeOptions, EncodeOptions};
 
 fn main() {
+    let arg = |i: usize, d: usize| {
+        std::env::args()
+            .nth(i)
+            .and_then(|a| a.parse().ok())
+            .unwrap_or(d)
+    };
+    let (encodes, decodes) = (arg(1, 1), arg(2, 1));
     let mesh = whet_testkit::meshes::shuffle(&whet_testkit::meshes::icosphere(8), 1);
-    let t = Instant::now();
-    let table = whet_mesh::CornerTable::new(&mesh).unwrap();
-    eprintln!("corner table: {:?}", t.elapsed());
-    let t = Instant::now();
-    let s = whet_edgebreaker::traverse(&table, None, |_| {}).unwrap();
-    eprintln!("traverse: {:?} ({} labels)", t.elapsed(), s.labels.len());
-    let t = Instant::now();
-    let c = whet_edgebreaker::encode_connectivity(&mesh.triangles, mesh.positions.len()).unwrap();
-    eprintln!("encode_connectivity: {:?}", t.elapsed());
-    let t = Instant::now();
-    let (_d, _) = whet_edgebreaker::decode_connectivity(&c.bytes, &Default::default()).unwrap();
-    eprintln!("decode_connectivity: {:?}", t.elapsed());
-    let t = Instant::now();
-    let e = encode(&mesh, &EncodeOptions::DEFAULT).unwrap();
-    eprintln!("encode: {:?}", t.elapsed());
-    for _ in 0..std::env::args()
-        .nth(1)
-        .and_then(|a| a.parse().ok())
-        .unwrap_or(1)
-    {
+    if encodes > 0 {
+        let t = Instant::now();
+        let table = whet_mesh::CornerTable::new(&mesh).unwrap();
+        eprintln!("corner table: {:?}", t.elapsed());
+        let t = Instant::now();
+        let s = whet_edgebreaker::traverse(&table, None, |_| {}).unwrap();
+        eprintln!("traverse: {:?} ({} labels)", t.elapsed(), s.labels.len());
+        let t = Instant::now();
+        let c =
+            whet_edgebreaker::encode_connectivity(&mesh.triangles, mesh.positions.len()).unwrap();
+        eprintln!("encode_connectivity: {:?}", t.elapsed());
+        let t = Instant::now();
+        let (_d, _) = whet_edgebreaker::decode_connectivity(&c.bytes, &Default::default()).unwrap();
+        eprintln!("decode_connectivity: {:?}", t.elapsed());
+    }
+    let mut e = None;
+    for _ in 0..encodes.max(1) {
+        let t = Instant::now();
+        e = Some(encode(&mesh, &EncodeOptions::DEFAULT).unwrap());
+        if encodes > 0 {
+            eprintln!("encode: {:?}", t.elapsed());
+        }
+    }
+    let e = e.unwrap();
+    for _ in 0..decodes {
         let t = Instant::now();
         let m = decode(&e.bytes, &DecodeOptions::DEFAULT).unwrap();
         eprintln!(

@@ -255,12 +255,17 @@ pub(crate) fn prepare(mesh: &Mesh, repair: bool) -> Result<Prepared, Error> {
     let mut work = mesh.clone();
     let input_vertices = work.positions.len();
     let mut rep = ManifoldRepair::default();
-    if let Err(e) = whet_mesh::CornerTable::new(&work) {
-        if !repair {
-            return Err(Error::InvalidInput(e));
+    // The table of a valid input is built once and kept unless vertices are dropped below.
+    let mut table = match whet_mesh::CornerTable::new(&work) {
+        Ok(t) => Some(t),
+        Err(e) => {
+            if !repair {
+                return Err(Error::InvalidInput(e));
+            }
+            rep = work.make_manifold();
+            None
         }
-        rep = work.make_manifold();
-    }
+    };
     // Repair appends copies; remember which input vertex each one copies by position (the
     // repair copies positions exactly, and the first input vertex at that position is the
     // one it split from or an identical one).
@@ -308,8 +313,12 @@ pub(crate) fn prepare(mesh: &Mesh, repair: bool) -> Result<Prepared, Error> {
         }
         work.positions = positions;
         original = orig;
+        table = None;
     }
-    let table = whet_mesh::CornerTable::new(&work).map_err(Error::InvalidInput)?;
+    let table = match table {
+        Some(t) => t,
+        None => whet_mesh::CornerTable::new(&work).map_err(Error::InvalidInput)?,
+    };
     Ok(Prepared {
         table,
         mesh: work,

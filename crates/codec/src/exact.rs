@@ -12,7 +12,7 @@
 //! x bit length of the previous axis's residual of the same vertex (0..=5), which captures that
 //! a vertex badly predicted on one axis is usually badly predicted on the others.
 
-use crate::parallelogram::{average, candidates, gate_fallback, MAX_CANDIDATES};
+use crate::parallelogram::{average, gate_midpoint, MAX_CANDIDATES};
 use whet_bits::{BitModel, RangeDecoder, SignedIntModel};
 use whet_edgebreaker::{Connectivity, TraversalError};
 
@@ -238,6 +238,133 @@ impl ResidualIo for ResidualReader<'_, '_> {
 /// Highest priority bucket of the prediction-degree order.
 const MAX_DEGREE: usize = 4;
 
+/// Vertex states of the prediction-degree walk.
+const UNKNOWN: u8 = 0;
+const KNOWN: u8 = 1;
+const DUMMY: u8 = 2;
+
+/// The walk state of [`code_positions`]: one byte of state, a degree and an anchor corner
+/// per vertex, and the degree buckets.
+struct DegreeOrder<'t> {
+    cv: &'t [u32],
+    opp: &'t [u32],
+    state: Vec<u8>,
+    degree: Vec<u8>,
+    // Each vertex's fan is walked from an anchor corner fixed by the order itself (the start
+    // corners, then the corner where a vertex was first met), never from the table's own
+    // vertex_corner: corner numbering differs between the encoder's table and the decoder's.
+    anchor: Vec<u32>,
+    buckets: [Vec<u32>; MAX_DEGREE + 1],
+}
+
+#[inline(always)]
+fn next_corner(c: usize) -> usize {
+    if c % 3 == 2 {
+        c - 2
+    } else {
+        c + 1
+    }
+}
+
+#[inline(always)]
+fn prev_corner(c: usize) -> usize {
+    if c % 3 == 0 {
+        c + 2
+    } else {
+        c - 1
+    }
+}
+
+impl DegreeOrder<'_> {
+    /// Raises the degree of unknown neighbour `x` of a known vertex across the triangle
+    /// whose third vertex is `y`, and queues it.
+    #[inline(always)]
+    fn raise_one(&mut self, x: usize, y: usize, cx: usize) {
+        if self.anchor[x] == u32::MAX {
+            self.anchor[x] = cx as u32;
+        }
+        if self.state[x] == UNKNOWN {
+            if self.state[y] == KNOWN {
+                self.degree[x] = self.degree[x].saturating_add(1);
+            }
+            let d = (self.degree[x] as usize).min(MAX_DEGREE);
+            self.buckets[d].push(x as u32);
+        }
+    }
+
+    /// One walk around the fan of vertex `v` from its anchor: with `cands`, collects the
+    /// parallelogram predictions of `v` (as [`crate::parallelogram::candidates`] does, in
+    /// the same order) before `v` is known; and raises the degree of `v`'s unknown
+    /// neighbours as if `v` were known (the raise reads only the neighbours' states, so
+    /// both fit in one walk). Returns the number of candidates.
+    #[inline(always)]
+    fn walk(
+        &mut self,
+        v: usize,
+        q: &[[i32; 3]],
+        mut cands: Option<&mut [[i64; 3]; MAX_CANDIDATES]>,
+    ) -> usize {
+        let nc = self.cv.len();
+        let start = self.anchor[v] as usize;
+        if start >= nc {
+            return 0;
+        }
+        let mut count = 0usize;
+        let mut c = start;
+        let mut guard = 0usize;
+        loop {
+            let (ca, cb) = (next_corner(c), prev_corner(c));
+            let a = self.cv[ca] as usize;
+            let b = self.cv[cb] as usize;
+            if let Some(out) = cands.as_deref_mut() {
+                if count < MAX_CANDIDATES && self.state[a] == KNOWN && self.state[b] == KNOWN {
+                    let o = self.opp[c] as usize;
+                    if o < nc {
+                        let w = self.cv[o] as usize;
+                        if self.state[w] == KNOWN && w != v {
+                            let (qa, qb, qw) = (q[a], q[b], q[w]);
+                            out[count] =
+                                [0, 1, 2].map(|k| qa[k] as i64 + qb[k] as i64 - qw[k] as i64);
+                            count += 1;
+                        }
+                    }
+                }
+            }
+            self.raise_one(a, b, ca);
+            self.raise_one(b, a, cb);
+            let o = self.opp[ca] as usize;
+            if o >= nc {
+                break;
+            }
+            let n = next_corner(o);
+            if n == start {
+                break;
+            }
+            c = n;
+            guard += 1;
+            if guard > nc {
+                break;
+            }
+        }
+        count
+    }
+
+    /// Pops the vertex with the highest degree; stale entries (already known, or queued at
+    /// a degree it no longer has) are dropped on the way.
+    #[inline]
+    fn pop(&mut self) -> Option<usize> {
+        for d in (0..=MAX_DEGREE).rev() {
+            while let Some(x) = self.buckets[d].pop() {
+                let x = x as usize;
+                if self.state[x] == UNKNOWN && (self.degree[x] as usize).min(MAX_DEGREE) == d {
+                    return Some(x);
+                }
+            }
+        }
+        None
+    }
+}
+
 /// Codes each real vertex's grid coordinates through `io`, in the prediction-degree order
 /// (Draco's `MESH_TRAVERSAL_PREDICTION_DEGREE` idea): per component, the start triangle's
 /// vertices, then always a vertex with the most incident triangles whose two other vertices
@@ -245,6 +372,9 @@ const MAX_DEGREE: usize = 4;
 /// several parallelograms. The order depends only on the connectivity, which the decoder has
 /// in full before the positions. `q` is indexed by table vertex id; on return the vector marks
 /// every real vertex reached.
+///
+/// One walk around each vertex's fan both collects its parallelograms and raises its
+/// neighbours' degrees.
 pub(crate) fn code_positions<I: ResidualIo>(
     conn: &Connectivity,
     bits: u32,
@@ -254,54 +384,28 @@ pub(crate) fn code_positions<I: ResidualIo>(
     let table = &conn.table;
     let nv = table.vertex_count();
     let max_level = ((1u64 << bits.clamp(1, 30)) - 1) as i32;
-    let mut known = vec![false; nv];
-    let mut degree = vec![0u8; nv];
-    let mut buckets: [Vec<u32>; MAX_DEGREE + 1] = Default::default();
     let mut models = PositionModels::new();
-    let is_dummy = &conn.is_dummy;
-
-    // Each vertex's fan is walked from an anchor corner fixed by the order itself (the start
-    // corners, then the corner where a vertex was first met), never from the table's own
-    // vertex_corner: corner numbering differs between the encoder's table and the decoder's.
-    let mut anchor = vec![u32::MAX; nv];
-    // Raises the degree of the unknown neighbours of known vertex `u`.
-    let raise = |u: usize,
-                 known: &[bool],
-                 degree: &mut [u8],
-                 anchor: &mut [u32],
-                 buckets: &mut [Vec<u32>; MAX_DEGREE + 1]| {
-        let start = whet_mesh::CornerId(anchor[u]);
-        if start.index() >= table.corner_count() {
-            return;
-        }
-        let mut c = start;
-        let mut guard = 0usize;
-        loop {
-            let (ca, cb) = (table.next(c), table.prev(c));
-            let a = table.vertex(ca).index();
-            let b = table.vertex(cb).index();
-            for (x, y, cx) in [(a, b, ca), (b, a, cb)] {
-                if anchor[x] == u32::MAX {
-                    anchor[x] = cx.0;
+    let mut st = DegreeOrder {
+        cv: table.corner_vertices(),
+        opp: table.opposites(),
+        state: (0..nv)
+            .map(|v| {
+                if conn.is_dummy.get(v).copied().unwrap_or(false) {
+                    DUMMY
+                } else {
+                    UNKNOWN
                 }
-                if !known[x] && !is_dummy[x] {
-                    if known[y] {
-                        degree[x] = degree[x].saturating_add(1);
-                    }
-                    let d = (degree[x] as usize).min(MAX_DEGREE);
-                    buckets[d].push(x as u32);
-                }
-            }
-            match table.swing(c) {
-                Some(n) if n != start => c = n,
-                _ => break,
-            }
-            guard += 1;
-            if guard > table.corner_count() {
-                break;
-            }
-        }
+            })
+            .collect(),
+        degree: vec![0u8; nv],
+        anchor: vec![u32::MAX; nv],
+        buckets: Default::default(),
     };
+    // About one queue entry per fan corner; reserve what a closed mesh needs at the start.
+    st.buckets[MAX_DEGREE].reserve(nv);
+    st.buckets[1].reserve(nv / 4);
+    st.buckets[2].reserve(nv / 4);
+    let known_vec = |st: &DegreeOrder| st.state.iter().map(|&s| s == KNOWN).collect();
 
     for &start in &conn.starts {
         if start.index() >= table.corner_count() {
@@ -310,14 +414,14 @@ pub(crate) fn code_positions<I: ResidualIo>(
         let corners = [start, table.next(start), table.prev(start)];
         let vs = corners.map(|c| table.vertex(c).index());
         for (&vi, c) in vs.iter().zip(corners) {
-            if anchor[vi] == u32::MAX {
-                anchor[vi] = c.0;
+            if st.anchor[vi] == u32::MAX {
+                st.anchor[vi] = c.0;
             }
         }
         let mut first: Option<[i32; 3]> = None;
         let mut second: Option<[i32; 3]> = None;
         for &vi in &vs {
-            if is_dummy[vi] || known[vi] {
+            if st.state[vi] != UNKNOWN {
                 continue;
             }
             let mut value = q[vi];
@@ -337,38 +441,28 @@ pub(crate) fn code_positions<I: ResidualIo>(
                 }
             }
             q[vi] = value;
-            known[vi] = true;
+            st.state[vi] = KNOWN;
         }
         for &vi in &vs {
-            if known[vi] {
-                raise(vi, &known, &mut degree, &mut anchor, &mut buckets);
+            if st.state[vi] == KNOWN {
+                st.walk(vi, q, None);
             }
         }
-        // Pop the vertex with the highest degree; stale entries (already known, or queued
-        // at a degree it no longer has) are dropped on the way.
-        let next_vertex =
-            |buckets: &mut [Vec<u32>; MAX_DEGREE + 1], known: &[bool], degree: &[u8]| {
-                (0..=MAX_DEGREE).rev().find_map(|d| {
-                    while let Some(x) = buckets[d].pop() {
-                        let x = x as usize;
-                        if !known[x] && (degree[x] as usize).min(MAX_DEGREE) == d {
-                            return Some(x);
-                        }
-                    }
-                    None
-                })
-            };
-        while let Some(v) = next_vertex(&mut buckets, &known, &degree) {
+        while let Some(v) = st.pop() {
             // v was queued by a neighbour, so it has an anchor.
-            let corner = whet_mesh::CornerId(anchor[v]);
-            if corner.index() >= table.corner_count() {
+            let corner = st.anchor[v];
+            if corner as usize >= table.corner_count() {
                 continue;
             }
             let mut cands = [[0i64; 3]; MAX_CANDIDATES];
-            let k = candidates(table, corner, q, &known, &mut cands);
+            let k = st.walk(v, q, Some(&mut cands));
             let mut value = q[v];
             let (class, prediction) = if k == 0 {
-                (0, neighbour_fallback(table, corner, q, &known))
+                let known: &[u8] = &st.state;
+                (
+                    0,
+                    neighbour_fallback(table, whet_mesh::CornerId(corner), q, known),
+                )
             } else {
                 let mask = io.select(&mut models, &cands[..k], &value);
                 (class_of(mask), average(&cands[..k], mask))
@@ -378,14 +472,13 @@ pub(crate) fn code_positions<I: ResidualIo>(
             let prediction = prediction.map(|c| c.clamp(0, max_level));
             io.residual(&mut models, Some(class), prediction, &mut value);
             q[v] = value;
-            known[v] = true;
-            raise(v, &known, &mut degree, &mut anchor, &mut buckets);
+            st.state[v] = KNOWN;
             if io.exhausted() {
-                return Ok(known);
+                return Ok(known_vec(&st));
             }
         }
     }
-    Ok(known)
+    Ok(known_vec(&st))
 }
 
 /// Prediction without a parallelogram: the midpoint of the first triangle around the vertex
@@ -394,19 +487,20 @@ fn neighbour_fallback(
     table: &whet_mesh::CornerTable,
     corner: whet_mesh::CornerId,
     q: &[[i32; 3]],
-    known: &[bool],
+    state: &[u8],
 ) -> [i32; 3] {
+    let known = |x: usize| state[x] == KNOWN;
     let mut c = corner;
     let mut single: Option<usize> = None;
     let mut guard = 0usize;
     loop {
         let a = table.vertex(table.next(c)).index();
         let b = table.vertex(table.prev(c)).index();
-        if known[a] && known[b] {
-            return gate_fallback(table, c, q, known);
+        if known(a) && known(b) {
+            return gate_midpoint(q[a], q[b]);
         }
         if single.is_none() {
-            single = [a, b].into_iter().find(|&x| known[x]);
+            single = [a, b].into_iter().find(|&x| known(x));
         }
         match table.swing(c) {
             Some(n) if n != corner => c = n,
@@ -453,10 +547,20 @@ pub(crate) fn encode_exact(
         mesh.positions.len(),
     )?;
     let clers_histogram = enc.histogram();
-    let conn = enc.connectivity;
+    // The geometry passes walk a copy of the table relabelled in traversal order: the same
+    // corners, so the same coding order, but walked roughly in memory order.
+    let (conn, old_id) = enc.traversal_ordered()?;
+    let vertex_order = enc
+        .connectivity
+        .output_vertices()
+        .iter()
+        .map(|v| v.0)
+        .collect();
     let mut q: Vec<[i32; 3]> = vec![[0; 3]; conn.table.vertex_count()];
-    for (i, p) in mesh.positions.iter().enumerate() {
-        q[i] = quantizer.quantize(*p);
+    for (qi, &old) in q.iter_mut().zip(&old_id) {
+        if let Some(p) = mesh.positions.get(old as usize) {
+            *qi = quantizer.quantize(*p);
+        }
     }
     // Per mesh, keep the cheaper of the two prediction strategies: averaging every
     // parallelogram suits smooth surfaces, choosing subsets suits creased CAD parts.
@@ -482,7 +586,6 @@ pub(crate) fn encode_exact(
             geometry = bytes;
         }
     }
-    let vertex_order = conn.output_vertices().iter().map(|v| v.0).collect();
     Ok(ExactPayloads {
         connectivity: enc.bytes,
         geometry,

@@ -93,11 +93,17 @@ pub fn gate_fallback(
     let a = table.vertex(table.next(tip)).index();
     let b = table.vertex(table.prev(tip)).index();
     match (known[a], known[b]) {
-        (true, true) => [0, 1, 2].map(|k| div_round(q[a][k] as i64 + q[b][k] as i64, 2) as i32),
+        (true, true) => gate_midpoint(q[a], q[b]),
         (true, false) => q[a],
         (false, true) => q[b],
         (false, false) => [0; 3],
     }
+}
+
+/// The midpoint of two known gate vertices, rounded half away from zero.
+#[inline]
+pub(crate) fn gate_midpoint(a: [i32; 3], b: [i32; 3]) -> [i32; 3] {
+    [0, 1, 2].map(|k| div_round(a[k] as i64 + b[k] as i64, 2) as i32)
 }
 
 /// `s / n` rounded half away from zero (n > 0), identical on every machine.

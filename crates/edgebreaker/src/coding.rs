@@ -12,7 +12,7 @@
 
 use crate::holes::close_holes;
 use crate::reverse_decoder::{ReverseDecoder, VALENCE_CONTEXTS};
-use crate::traversal::{traverse, Clers, SplitEvent, TraversalSummary};
+use crate::traversal::{traverse, Clers, SplitEvent, Step, TraversalSummary};
 use crate::Error;
 use whet_bits::{
     BitModel, BitSink, CostCounter, RangeDecoder, RangeEncoder, SymbolModel, UnsignedIntModel,
@@ -153,6 +153,8 @@ pub struct EncodedConnectivity {
     /// The encoder-side connectivity (original vertex ids; dummies numbered from the input's
     /// vertex count on).
     pub connectivity: Connectivity,
+    /// Face of each triangle in traversal order (start triangles included).
+    face_order: Vec<u32>,
 }
 
 impl EncodedConnectivity {
@@ -163,6 +165,74 @@ impl EncodedConnectivity {
             h[l as usize] += 1;
         }
         h
+    }
+
+    /// The connectivity relabelled in traversal order: triangle `i` is the `i`-th the
+    /// traversal visits (each keeps its corners' rotation) and vertex `i` is the `i`-th
+    /// created, dummies included, so the new ids of the real vertices are increasing in
+    /// output order. Walks over it touch memory roughly in order, unlike the input's table,
+    /// and it is the same mesh corner for corner, so every order fixed by the traversal
+    /// itself (the geometry coders') is unchanged. Returns it and, per new vertex id, the
+    /// old one.
+    pub fn traversal_ordered(&self) -> Result<(Connectivity, Vec<u32>), Error> {
+        let conn = &self.connectivity;
+        let table = &conn.table;
+        let nt = table.triangle_count();
+        let nv = table.vertex_count();
+        let order = &conn.summary.vertex_order;
+        let mut vertex_rank = vec![u32::MAX; nv];
+        for (i, v) in order.iter().enumerate() {
+            vertex_rank[v.index()] = i as u32;
+        }
+        let mut face_rank = vec![u32::MAX; nt];
+        for (i, &f) in self.face_order.iter().enumerate() {
+            face_rank[f as usize] = i as u32;
+        }
+        if self.face_order.len() != nt || face_rank.contains(&u32::MAX) {
+            return Err(Error::Corrupt("the traversal did not visit every triangle"));
+        }
+        let map_corner = |c: u32| 3 * face_rank[c as usize / 3] + c % 3;
+        let cv = table.corner_vertices();
+        let opp = table.opposites();
+        let mut v = vec![0u32; 3 * nt];
+        let mut o = vec![u32::MAX; 3 * nt];
+        for (i, &f) in self.face_order.iter().enumerate() {
+            for j in 0..3 {
+                let c = 3 * f as usize + j;
+                v[3 * i + j] = vertex_rank[cv[c] as usize];
+                if opp[c] != u32::MAX {
+                    o[3 * i + j] = map_corner(opp[c]);
+                }
+            }
+        }
+        let new_table = CornerTable::from_raw(v, o, order.len(), false)
+            .map_err(|_| Error::Corrupt("relabelled table is inconsistent"))?;
+        let starts = conn
+            .starts
+            .iter()
+            .map(|c| CornerId(map_corner(c.0)))
+            .collect();
+        let is_dummy = order.iter().map(|v| conn.is_dummy[v.index()]).collect();
+        let summary = TraversalSummary {
+            labels: conn.summary.labels.clone(),
+            splits: conn.summary.splits.clone(),
+            starts: conn
+                .starts
+                .iter()
+                .map(|c| CornerId(map_corner(c.0)))
+                .collect(),
+            vertex_order: (0..order.len() as u32).map(VertexId).collect(),
+        };
+        let old = order.iter().map(|v| v.0).collect();
+        Ok((
+            Connectivity {
+                table: new_table,
+                starts,
+                is_dummy,
+                summary,
+            },
+            old,
+        ))
     }
 }
 
@@ -252,7 +322,13 @@ pub fn encode_connectivity_with_table(
         (open, 0)
     };
     let total_vertices = vertex_count + dummies;
-    let summary = traverse(&table, None, |_| {})?;
+    let mut face_order = Vec::with_capacity(table.triangle_count());
+    let summary = traverse(&table, None, |step| {
+        face_order.push(match step {
+            Step::Start { corner } => corner.0 / 3,
+            Step::Triangle { tip, .. } => tip.0 / 3,
+        })
+    })?;
     let starts = summary.starts.clone();
     let mut is_dummy = vec![false; total_vertices];
     for d in is_dummy.iter_mut().skip(vertex_count) {
@@ -292,6 +368,7 @@ pub fn encode_connectivity_with_table(
             is_dummy,
             summary,
         },
+        face_order,
     })
 }
 

@@ -356,6 +356,18 @@ impl CornerTable {
         self.vertex_corner.len()
     }
 
+    /// The vertex of every corner, indexed by corner (for hot loops that walk fans).
+    #[inline]
+    pub fn corner_vertices(&self) -> &[u32] {
+        &self.corner_vertex
+    }
+
+    /// The opposite of every corner, indexed by corner; `u32::MAX` at a boundary.
+    #[inline]
+    pub fn opposites(&self) -> &[u32] {
+        &self.opposite
+    }
+
     /// All corners in order.
     pub fn corners(&self) -> impl Iterator<Item = CornerId> + '_ {
         (0..self.corner_vertex.len() as u32).map(CornerId)
