@@ -1,13 +1,11 @@
 //! `whet demo`: the main job on a mesh whet makes itself — the synthetic fandisk, densely
 //! tessellated with its creases exact, swept through the codec at a default set of rates.
 
-use super::rd::{run_plan, Plan};
+use super::rd::{run_plan, Plan, DEFAULT_SWING_RATES};
 use super::{write_mesh, CliResult, Failure};
 use clap::Args;
 use std::path::PathBuf;
-use whet::Mesh;
-use whet_rd::to_markdown;
-use whet_synth::{Shape, ShapeKind, ShapeParams};
+use whet_synth::{jitter_within_surface, midpoint_subdivide, Shape, ShapeKind, ShapeParams};
 
 #[derive(Args, Debug)]
 pub struct DemoArgs {
@@ -19,36 +17,13 @@ pub struct DemoArgs {
     samples: usize,
 }
 
-/// Splits every triangle into four at its edge midpoints (shared midpoints), `levels` times:
-/// the surface is unchanged, so creases stay exact.
-fn midpoint_subdivide(mesh: &Mesh, levels: u32) -> Mesh {
-    let mut m = mesh.clone();
-    for _ in 0..levels {
-        let mut mid = std::collections::HashMap::new();
-        let mut tris = Vec::with_capacity(m.triangles.len() * 4);
-        let mut pos = m.positions.clone();
-        let mut midpoint = |a: u32, b: u32, pos: &mut Vec<whet::DVec3>| -> u32 {
-            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
-                pos.push((pos[a as usize] + pos[b as usize]) * 0.5);
-                (pos.len() - 1) as u32
-            })
-        };
-        for &[a, b, c] in &m.triangles {
-            let ab = midpoint(a, b, &mut pos);
-            let bc = midpoint(b, c, &mut pos);
-            let ca = midpoint(c, a, &mut pos);
-            tris.extend_from_slice(&[[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        m = Mesh::new(pos, tris);
-    }
-    m
-}
-
 pub fn run(args: &DemoArgs) -> CliResult {
     let shape = Shape::new(ShapeKind::Fandisk, &ShapeParams::default())
         .map_err(|e| Failure::other(anyhow::Error::new(e)))?;
-    // 674 truth triangles x 4^3 = 43k triangles.
-    let original = midpoint_subdivide(shape.truth_mesh_ref(), 3);
+    // 674 truth triangles x 4^3 = 43k triangles, each vertex then jittered within its facet
+    // or along its crease: the surface stays exact, the tessellation is as irregular as a
+    // real mesher's (a plain subdivision grid would flatter the parallelogram predictor).
+    let original = jitter_within_surface(&midpoint_subdivide(shape.truth_mesh_ref(), 3), 0.3, 1);
     std::fs::create_dir_all(&args.out).map_err(|e| {
         Failure::other(
             anyhow::Error::new(e).context(format!("cannot create {}", args.out.display())),
@@ -68,18 +43,22 @@ pub fn run(args: &DemoArgs) -> CliResult {
         mesh_path.display()
     );
     let plan = Plan {
-        modes: vec!["exact".into()],
-        rates: None,
+        // swing is the main codec; exact (Draco's job) is the baseline curve.
+        modes: vec!["swing".into(), "exact".into()],
+        rates: DEFAULT_SWING_RATES.to_vec(),
+        angle_bits: whet_swing::SwingOptions::DEFAULT_ANGLE_BITS,
         exact_bits: vec![6.0, 7.0, 8.0, 9.0, 10.0, 11.0, 12.0, 14.0],
         subdiv_control: vec![100.0, 200.0, 400.0],
-        stages: vec!["decoded".into(), "sharpened".into()],
+        stages: vec!["decoded".into(), "sharpened".into(), "bent".into()],
+        // The baseline is dense and already sharp: sharpening and Bender are for retilings.
+        exact_stages: Some(vec!["decoded".into()]),
         out: args.out.clone(),
         samples: args.samples,
         seed: 0,
         draco: None,
     };
-    let points = run_plan(vec![("synth-fandisk".into(), original)], &plan)?;
-    out!("{}", to_markdown(&points));
+    let (_, md) = run_plan(vec![("synth-fandisk".into(), original)], &plan)?;
+    out!("{md}");
     eprintln!(
         "plot: {}  tables: {}/rd.csv, rd.json, rd.md",
         args.out.join("synth-fandisk.svg").display(),

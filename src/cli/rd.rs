@@ -6,8 +6,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
 use whet::Mesh;
 use whet_rd::{
-    job_count, parse_draco_anchors, svg_plot, sweep, to_csv, to_json, to_markdown, Codec,
-    CodecSweep, Point, Stage, SweepOptions,
+    compare_with_draco, draco_markdown, job_count, parse_draco_anchors, svg_plot, sweep, to_csv,
+    to_json, to_markdown, Codec, CodecSweep, Point, Stage, SweepOptions,
 };
 
 /// The exact mode as an rd codec; the rate is the quantization bits.
@@ -33,14 +33,48 @@ impl Codec for ExactCodec {
     }
 }
 
+/// The swing mode (SwingWrapper) as an rd codec; the rate is bits per ORIGINAL vertex, the
+/// papers' unit (the encoder searches the edge length to land within 5 %).
+struct SwingCodec {
+    angle_bits: u32,
+}
+
+impl Codec for SwingCodec {
+    fn name(&self) -> String {
+        "swing".into()
+    }
+    fn encode(&self, mesh: &Mesh, rate: f64) -> Result<Vec<u8>, String> {
+        if !(rate.is_finite() && rate > 0.0) {
+            return Err(format!(
+                "swing rates are bits per original vertex (> 0), got {rate}"
+            ));
+        }
+        let opts = whet_swing::SwingOptions::DEFAULT
+            .with_rate(whet_swing::Rate::BitsPerVertex(rate))
+            .with_angle_bits(self.angle_bits);
+        whet_swing::encode(mesh, &opts)
+            .map(|o| o.bytes)
+            .map_err(|e| e.to_string())
+    }
+    fn decode(&self, bytes: &[u8]) -> Result<Mesh, String> {
+        whet::decode(bytes, &whet_codec::DecodeOptions::DEFAULT).map_err(|e| e.to_string())
+    }
+}
+
+/// Default rates of the swing curve, bits per original vertex.
+pub const DEFAULT_SWING_RATES: [f64; 6] = [0.5, 1.0, 2.0, 3.0, 4.0, 6.0];
+
 #[derive(Args, Debug)]
 pub struct RdArgs {
     /// Meshes to sweep.
     #[arg(required = true)]
     meshes: Vec<PathBuf>,
-    /// Rates of the lossy modes, comma separated (swing: bits per original vertex).
-    #[arg(long, value_delimiter = ',')]
-    rates: Option<Vec<f64>>,
+    /// Rates of the swing mode, bits per ORIGINAL vertex, comma separated.
+    #[arg(long, value_delimiter = ',', default_value = "0.5,1,2,3,4,6")]
+    rates: Vec<f64>,
+    /// Swing angle bits of the swing curve.
+    #[arg(long, default_value_t = whet_swing::SwingOptions::DEFAULT_ANGLE_BITS)]
+    angle_bits: u32,
     /// Quantization bits of the exact mode's baseline curve, comma separated.
     #[arg(
         long,
@@ -51,12 +85,16 @@ pub struct RdArgs {
     /// Control vertex counts of the subdiv mode's curve, comma separated.
     #[arg(long, value_delimiter = ',', default_value = "100,200,400,800")]
     subdiv_control: Vec<f64>,
-    /// Codec modes to sweep.
-    #[arg(long, value_delimiter = ',', default_value = "exact")]
+    /// Codec modes to sweep (swing, exact, subdiv).
+    #[arg(long, value_delimiter = ',', default_value = "swing,exact")]
     modes: Vec<String>,
     /// Post-processing stages to measure after decoding.
     #[arg(long, value_delimiter = ',', default_value = "decoded")]
     stages: Vec<String>,
+    /// Stages of the exact mode's baseline curve, when they should differ from --stages
+    /// (e.g. `decoded` only: Bender is meant for coarse retilings, not a dense exact mesh).
+    #[arg(long, value_delimiter = ',')]
+    exact_stages: Option<Vec<String>>,
     /// Output folder for rd.csv, rd.json, rd.md and one SVG per mesh.
     #[arg(long, default_value = "rd-out")]
     out: PathBuf,
@@ -75,10 +113,12 @@ pub struct RdArgs {
 /// What a sweep needs besides the meshes.
 pub struct Plan {
     pub modes: Vec<String>,
-    pub rates: Option<Vec<f64>>,
+    pub rates: Vec<f64>,
+    pub angle_bits: u32,
     pub exact_bits: Vec<f64>,
     pub subdiv_control: Vec<f64>,
     pub stages: Vec<String>,
+    pub exact_stages: Option<Vec<String>>,
     pub out: PathBuf,
     pub samples: usize,
     pub seed: u64,
@@ -138,34 +178,47 @@ fn stage_by_name(name: &str) -> Result<Stage, Failure> {
     }
 }
 
-/// Runs a sweep and writes its files; returns the points.
-pub fn run_plan(meshes: Vec<(String, Mesh)>, plan: &Plan) -> CliResult<Vec<Point>> {
+/// Runs a sweep and writes its files; returns the points and the markdown report (`rd.md`).
+pub fn run_plan(meshes: Vec<(String, Mesh)>, plan: &Plan) -> CliResult<(Vec<Point>, String)> {
     let exact = ExactCodec;
     let subdiv = SubdivCodec;
+    let swing = SwingCodec {
+        angle_bits: plan.angle_bits,
+    };
     let mut codecs: Vec<CodecSweep<'_>> = Vec::new();
     for m in &plan.modes {
         match m.as_str() {
-            "exact" => codecs.push(CodecSweep {
-                codec: &exact,
-                rates: plan.exact_bits.clone(),
-            }),
-            "subdiv" => codecs.push(CodecSweep {
-                codec: &subdiv,
-                rates: plan.subdiv_control.clone(),
-            }),
+            "swing" => codecs.push(CodecSweep::new(&swing, plan.rates.clone())),
+            "exact" => {
+                let mut c = CodecSweep::new(&exact, plan.exact_bits.clone());
+                if let Some(s) = &plan.exact_stages {
+                    c = c.with_stages(s.clone());
+                }
+                codecs.push(c)
+            }
+            "subdiv" => codecs.push(CodecSweep::new(&subdiv, plan.subdiv_control.clone())),
             other => {
                 return Err(Failure::input(anyhow::anyhow!(
-                    "unknown or unavailable mode {other:?} (available: exact, subdiv)"
+                    "unknown mode {other:?} (available: swing, exact, subdiv)"
                 )))
             }
         }
     }
-    let _ = &plan.rates;
     let stages: Vec<Stage> = plan
         .stages
         .iter()
         .map(|s| stage_by_name(s))
         .collect::<Result<_, _>>()?;
+    if let Some(extra) = &plan.exact_stages {
+        for s in extra {
+            stage_by_name(s)?;
+            if !plan.stages.contains(s) {
+                return Err(Failure::input(anyhow::anyhow!(
+                    "--exact-stages names {s:?}, which --stages does not run"
+                )));
+            }
+        }
+    }
     let draco = match &plan.draco {
         Some(p) => Some(parse_draco_anchors(&std::fs::read_to_string(p).map_err(
             |e| {
@@ -186,8 +239,8 @@ pub fn run_plan(meshes: Vec<(String, Mesh)>, plan: &Plan) -> CliResult<Vec<Point
         .with_seed(plan.seed);
     let points = sweep(&meshes, &codecs, &stages, &opts, &|| bar.inc(1));
     bar.finish_and_clear();
-    write_outputs(&plan.out, &meshes, &points, draco.as_ref())?;
-    Ok(points)
+    let md = write_outputs(&plan.out, &meshes, &points, draco.as_ref())?;
+    Ok((points, md))
 }
 
 fn write_file(path: &Path, text: &str) -> CliResult {
@@ -196,24 +249,49 @@ fn write_file(path: &Path, text: &str) -> CliResult {
     })
 }
 
+/// The quantization whose RMS error the project's bar refers to, and the bar itself: reach
+/// Draco's quantization-10 RMS with at most a quarter of its bytes.
+pub const DRACO_BAR_QUANT_BITS: u32 = 10;
+/// See [`DRACO_BAR_QUANT_BITS`].
+pub const DRACO_BAR_RATIO: f64 = 0.25;
+
+/// The bytes every curve needs for Draco's quantization-10 RMS error.
+pub fn vs_draco_markdown(
+    points: &[Point],
+    draco: &std::collections::BTreeMap<String, Vec<whet_rd::DracoPoint>>,
+) -> String {
+    let matches = compare_with_draco(points, draco, DRACO_BAR_QUANT_BITS);
+    if matches.is_empty() {
+        return "No mesh of the sweep has a Draco anchor at quantization 10.\n".into();
+    }
+    draco_markdown(&matches, DRACO_BAR_RATIO)
+}
+
 fn write_outputs(
     out: &Path,
     meshes: &[(String, Mesh)],
     points: &[Point],
     draco: Option<&std::collections::BTreeMap<String, Vec<whet_rd::DracoPoint>>>,
-) -> CliResult {
+) -> CliResult<String> {
     std::fs::create_dir_all(out).map_err(|e| {
         Failure::other(anyhow::Error::new(e).context(format!("cannot create {}", out.display())))
     })?;
     write_file(&out.join("rd.csv"), &to_csv(points))?;
     write_file(&out.join("rd.json"), &to_json(points))?;
-    write_file(&out.join("rd.md"), &to_markdown(points))?;
+    let mut md = to_markdown(points);
+    if let Some(d) = draco {
+        let vs = vs_draco_markdown(points, d);
+        write_file(&out.join("vs-draco.md"), &vs)?;
+        md.push_str("### Against Draco\n\n");
+        md.push_str(&vs);
+    }
+    write_file(&out.join("rd.md"), &md)?;
     for (name, _) in meshes {
         let d = draco.and_then(|m| m.get(name)).map(|v| v.as_slice());
         let svg = svg_plot(name, points, d).map_err(|e| Failure::other(anyhow::anyhow!(e)))?;
         write_file(&out.join(format!("{name}.svg")), &svg)?;
     }
-    Ok(())
+    Ok(md)
 }
 
 pub fn run(args: &RdArgs) -> CliResult {
@@ -228,16 +306,18 @@ pub fn run(args: &RdArgs) -> CliResult {
     let plan = Plan {
         modes: args.modes.clone(),
         rates: args.rates.clone(),
+        angle_bits: args.angle_bits,
         exact_bits: args.exact_bits.clone(),
         subdiv_control: args.subdiv_control.clone(),
         stages: args.stages.clone(),
+        exact_stages: args.exact_stages.clone(),
         out: args.out.clone(),
         samples: args.samples,
         seed: args.seed,
         draco: args.draco.clone(),
     };
-    let points = run_plan(meshes, &plan)?;
-    out!("{}", to_markdown(&points));
+    let (_, md) = run_plan(meshes, &plan)?;
+    out!("{md}");
     eprintln!(
         "wrote {}/rd.csv, rd.json, rd.md and one SVG per mesh",
         plan.out.display()

@@ -4,7 +4,8 @@
 //! bent), each result measured with whet-metro against the original; the results as
 //! `rd.csv`, `rd.json` and markdown ([`to_csv`], [`to_json`], [`to_markdown`], one schema),
 //! SVG curves in the papers' units ([`svg_plot`]), and Draco's published anchors for the
-//! baseline ([`parse_draco_anchors`]). Codecs and stages are plugged in by the caller, so
+//! baseline ([`parse_draco_anchors`]) with the bytes each curve needs to reach Draco's error
+//! ([`compare_with_draco`]). Codecs and stages are plugged in by the caller, so
 //! this crate depends on none of them.
 //!
 //! ```
@@ -24,18 +25,20 @@
 //!     vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z],
 //!     vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]],
 //! );
-//! let points = run_point("tet", &tet, &Rounding, 2.0, &[Stage::decoded()], &SweepOptions::DEFAULT);
+//! let points = run_point("tet", &tet, &Rounding, 2.0, &[&Stage::decoded()], &SweepOptions::DEFAULT);
 //! // A failed point is reported, not fatal.
 //! assert_eq!(points.len(), 1);
 //! assert!(points[0].error.as_deref().unwrap().starts_with("decode"));
 //! ```
 #![forbid(unsafe_code)]
 
+mod compare;
 mod draco;
 mod output;
 mod plot;
 mod sweep;
 
+pub use compare::{bytes_at_rms, compare_with_draco, draco_markdown, CurveReach, DracoMatch};
 pub use draco::{parse_draco_anchors, DracoPoint};
 pub use output::{point_json, to_csv, to_json, to_markdown, COLUMNS};
 pub use plot::svg_plot;

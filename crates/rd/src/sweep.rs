@@ -52,6 +52,26 @@ pub struct CodecSweep<'a> {
     pub codec: &'a dyn Codec,
     /// Rate parameters.
     pub rates: Vec<f64>,
+    /// Names of the sweep's stages this codec's decoded meshes go through (`None`: all of
+    /// them). A baseline curve often needs only `decoded`.
+    pub stages: Option<Vec<String>>,
+}
+
+impl<'a> CodecSweep<'a> {
+    /// `codec` at `rates`, through every stage of the sweep.
+    pub fn new(codec: &'a dyn Codec, rates: Vec<f64>) -> Self {
+        CodecSweep {
+            codec,
+            rates,
+            stages: None,
+        }
+    }
+
+    /// Limits the stages this codec goes through to the named ones.
+    pub fn with_stages(mut self, stages: Vec<String>) -> Self {
+        self.stages = Some(stages);
+        self
+    }
 }
 
 /// One measured point (or a failed one, with `error` set and figures NaN).
@@ -159,7 +179,7 @@ pub fn run_point(
     original: &Mesh,
     codec: &dyn Codec,
     rate: f64,
-    stages: &[Stage],
+    stages: &[&Stage],
     opts: &SweepOptions,
 ) -> Vec<Point> {
     let diagonal = original.diagonal();
@@ -263,11 +283,25 @@ pub fn sweep(
             }
         }
     }
+    // Each codec's own stage list, in the sweep's order.
+    let codec_stages: Vec<Vec<&Stage>> = codecs
+        .iter()
+        .map(|cs| {
+            stages
+                .iter()
+                .filter(|s| {
+                    cs.stages
+                        .as_ref()
+                        .is_none_or(|names| names.contains(&s.name))
+                })
+                .collect()
+        })
+        .collect();
     let results: Vec<Vec<Point>> = jobs
         .par_iter()
         .map(|&(m, c, r)| {
             let (name, mesh) = &meshes[m];
-            let pts = run_point(name, mesh, codecs[c].codec, r, stages, opts);
+            let pts = run_point(name, mesh, codecs[c].codec, r, &codec_stages[c], opts);
             progress();
             pts
         })

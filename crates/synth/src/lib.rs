@@ -22,10 +22,12 @@
 
 mod marching_cubes;
 mod noise;
+mod refine;
 mod shapes;
 
 pub use marching_cubes::{marching_cubes, marching_cubes_fn, Grid};
 pub use noise::{add_noise, SplitMix64};
+pub use refine::{jitter_within_surface, midpoint_subdivide};
 pub use shapes::{Shape, ShapeKind, ShapeParams, TESSELLATION_TOLERANCE};
 
 /// Largest accepted marching-cubes resolution (cells along the longest axis).

@@ -23,10 +23,7 @@ impl Codec for Exact {
 fn tiny_sweep() -> Vec<Point> {
     let mesh = whet_testkit::meshes::icosphere(2);
     let meshes = vec![("ico".to_string(), mesh)];
-    let codecs = [CodecSweep {
-        codec: &Exact,
-        rates: vec![6.0, 10.0, 40.0],
-    }];
+    let codecs = [CodecSweep::new(&Exact, vec![6.0, 10.0, 40.0])];
     let stages = [
         Stage::decoded(),
         Stage::new("failing", |_| Err("always fails".into())),
