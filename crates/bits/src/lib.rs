@@ -30,6 +30,7 @@ mod cost;
 mod models;
 mod range_coder;
 mod raw;
+mod residual;
 
 pub use cost::{CostCounter, COST_FRAC_BITS, COST_ONE};
 pub use models::{
@@ -38,6 +39,7 @@ pub use models::{
 };
 pub use range_coder::{RangeDecoder, RangeEncoder};
 pub use raw::{RawBitReader, RawBitWriter};
+pub use residual::{CdfModel, ResidualModel, CDF_SYMBOLS};
 
 /// Why a stream could not be decoded.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]

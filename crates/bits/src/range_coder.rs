@@ -21,7 +21,7 @@ const TOP: u32 = 1 << 24;
 #[derive(Clone, Debug)]
 pub struct RangeEncoder {
     low: u64,
-    range: u32,
+    pub(crate) range: u32,
     cache: u8,
     cache_size: u64,
     out: Vec<u8>,
@@ -75,6 +75,16 @@ impl RangeEncoder {
             self.range <<= 8;
             self.shift_low();
         }
+    }
+
+    #[inline(always)]
+    pub(crate) fn add_low(&mut self, x: u32) {
+        self.low += x as u64;
+    }
+
+    #[inline(always)]
+    pub(crate) fn normalize_pub(&mut self) {
+        self.normalize()
     }
 
     /// Codes one bit with an adaptive probability, updating the model.
@@ -141,8 +151,8 @@ impl RangeEncoder {
 pub struct RangeDecoder<'a> {
     input: &'a [u8],
     pos: usize,
-    range: u32,
-    code: u32,
+    pub(crate) range: u32,
+    pub(crate) code: u32,
     /// Bytes requested past the end of `input`.
     overrun: usize,
 }
@@ -187,6 +197,11 @@ impl<'a> RangeDecoder<'a> {
             self.range <<= 8;
             self.code = (self.code << 8) | self.next_byte() as u32;
         }
+    }
+
+    #[inline(always)]
+    pub(crate) fn normalize_pub(&mut self) {
+        self.normalize()
     }
 
     /// Decodes one bit coded with `model`, updating it the same way the encoder did.

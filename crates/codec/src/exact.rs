@@ -13,7 +13,7 @@
 //! a vertex badly predicted on one axis is usually badly predicted on the others.
 
 use crate::parallelogram::{average, gate_midpoint, MAX_CANDIDATES};
-use whet_bits::{BitModel, RangeDecoder, SignedIntModel};
+use whet_bits::{BitModel, RangeDecoder, ResidualModel, SignedIntModel};
 use whet_edgebreaker::{Connectivity, TraversalError};
 
 const CLASSES: usize = 4;
@@ -21,7 +21,7 @@ const PREV_BUCKETS: usize = 6;
 
 /// Adaptive models of the position stream.
 pub(crate) struct PositionModels {
-    residual: Vec<SignedIntModel>,
+    residual: Vec<ResidualModel>,
     seed: [SignedIntModel; 3],
     /// "Average all candidates" flag, by candidate count - 1.
     use_all: [BitModel; MAX_CANDIDATES],
@@ -34,7 +34,7 @@ impl PositionModels {
         PositionModels {
             // Predictions are clamped into the grid, so residuals stay below 2^30.
             residual: (0..CLASSES * 3 * PREV_BUCKETS)
-                .map(|_| SignedIntModel::below_2_31())
+                .map(|_| ResidualModel::new())
                 .collect(),
             seed: [(); 3].map(|_| SignedIntModel::below_2_31()),
             use_all: [BitModel::new(); MAX_CANDIDATES],
@@ -160,11 +160,10 @@ impl ResidualIo for ResidualWriter<'_> {
         let mut prev = 0usize;
         for axis in 0..3 {
             let r = q[axis].wrapping_sub(prediction[axis]);
-            let m = match class {
-                Some(cl) => &mut models.residual[model_index(cl, axis, prev)],
-                None => &mut models.seed[axis],
-            };
-            m.encode(self.sink, r);
+            match class {
+                Some(cl) => models.residual[model_index(cl, axis, prev)].encode(self.sink, r),
+                None => models.seed[axis].encode(self.sink, r),
+            }
             prev = bucket(r);
         }
     }
@@ -221,11 +220,10 @@ impl ResidualIo for ResidualReader<'_, '_> {
     ) {
         let mut prev = 0usize;
         for axis in 0..3 {
-            let m = match class {
-                Some(cl) => &mut models.residual[model_index(cl, axis, prev)],
-                None => &mut models.seed[axis],
+            let r = match class {
+                Some(cl) => models.residual[model_index(cl, axis, prev)].decode(self.dec),
+                None => models.seed[axis].decode(self.dec),
             };
-            let r = m.decode(self.dec);
             q[axis] = prediction[axis].wrapping_add(r);
             if q[axis] < 0 || q[axis] > self.max_level {
                 self.invalid = true;
