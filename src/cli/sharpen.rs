@@ -5,7 +5,9 @@ use super::{print_json, read_mesh, write_mesh, CliResult, Failure};
 use clap::Args;
 use std::path::PathBuf;
 use whet::Mesh;
-use whet_sharpen::{sharpen, Method, SharpTags, SharpenOptions, Sharpened};
+use whet_sharpen::{
+    sharpen, sharpen_region, Method, SharpTags, SharpenOptions, Sharpened, VertexSelection,
+};
 
 #[derive(Args, Debug)]
 pub struct SharpenArgs {
@@ -17,10 +19,26 @@ pub struct SharpenArgs {
     /// An edge is smooth when its normal angle is under this factor times the mesh average.
     #[arg(long, default_value_t = 2.0)]
     smooth_factor: f64,
-    /// `extended` (default: whet's extended chamfer detection) or `papers` (the papers'
-    /// six filters only).
+    /// `extended` (default: whet's extended chamfer detection), `papers` (the papers'
+    /// six filters only) or `normal-filter` (seed 002: blends, chamfers with samples, noise).
     #[arg(long, default_value = "extended")]
     method: String,
+    /// normal-filter: neighbourhood radius in mean edge lengths (a little more than the widest
+    /// feature to sharpen).
+    #[arg(long, default_value_t = SharpenOptions::DEFAULT.rho)]
+    rho: f64,
+    /// normal-filter: a face is a feature face when two normals of its neighbourhood have a dot
+    /// product under eta.
+    #[arg(long, default_value_t = SharpenOptions::DEFAULT.eta, allow_negative_numbers = true)]
+    eta: f64,
+    /// normal-filter: the neighbourhood does not cross edges whose normals' dot product is at
+    /// most lambda.
+    #[arg(long, default_value_t = SharpenOptions::DEFAULT.lambda, allow_negative_numbers = true)]
+    lambda: f64,
+    /// normal-filter: change only this region, a file of 0-based vertex indices separated by
+    /// whitespace (`#` starts a comment).
+    #[arg(long)]
+    select: Option<PathBuf>,
     /// Write the sharp-edge tags (for `whet bend --tags`) to this file.
     #[arg(long)]
     tags: Option<PathBuf>,
@@ -43,7 +61,7 @@ pub fn sharpen_options(method: &str, smooth_factor: f64) -> Result<SharpenOption
 pub fn run_sharpen(mesh: &Mesh, opts: &SharpenOptions) -> CliResult<Sharpened> {
     match sharpen(mesh, opts) {
         Ok(s) => Ok(s),
-        Err(whet_sharpen::Error::InvalidInput(e)) => {
+        Err(whet_sharpen::Error::InvalidInput(e)) if e.is_structural() => {
             let mut m = mesh.clone();
             let rep = m.make_manifold();
             eprintln!("whet: the mesh is not an oriented manifold ({e}); make_manifold {rep}");
@@ -55,8 +73,28 @@ pub fn run_sharpen(mesh: &Mesh, opts: &SharpenOptions) -> CliResult<Sharpened> {
 
 pub fn run(args: &SharpenArgs) -> CliResult {
     let mesh = read_mesh(&args.input, None)?;
-    let opts = sharpen_options(&args.method, args.smooth_factor)?;
-    let out = run_sharpen(&mesh, &opts)?;
+    let opts = sharpen_options(&args.method, args.smooth_factor)?
+        .with_rho(args.rho)
+        .with_eta(args.eta)
+        .with_lambda(args.lambda);
+    opts.validate().map_err(Failure::input)?;
+    let out = match &args.select {
+        None => run_sharpen(&mesh, &opts)?,
+        Some(path) => {
+            if opts.method != Method::NormalFilter {
+                return Err(Failure::input(anyhow::anyhow!(
+                    "--select works with --method normal-filter only"
+                )));
+            }
+            // A selection names vertices of this mesh: no make_manifold (it renumbers).
+            let region = VertexSelection::read_path(path, &mesh).map_err(|e| {
+                Failure::input(
+                    anyhow::Error::new(e).context(format!("cannot read {}", path.display())),
+                )
+            })?;
+            sharpen_region(&mesh, &opts, &region).map_err(Failure::input)?
+        }
+    };
     write_mesh(
         &args.output,
         &out.mesh,

@@ -118,3 +118,122 @@ fn decode_sharpen_and_bend() {
     let o = whet(&["decode", s(&stream), "-o", s(&out), "--bend", "1"]);
     assert_eq!(o.status.code(), Some(2), "--bend needs --sharpen");
 }
+
+#[test]
+fn sharpen_normal_filter_on_a_blend() {
+    let dir = scratch_dir("cli-sharpen-nf");
+    let (mc, truth) = (dir.join("blend.off"), dir.join("box.off"));
+    for (shape, out, truth) in [
+        ("blend", &mc, None),
+        ("box", &dir.join("x.off"), Some(&truth)),
+    ] {
+        let mut a = vec![
+            "synth",
+            shape,
+            "-o",
+            s(out),
+            "--resolution",
+            "48",
+            "--rotate",
+            "1,2,3,29",
+        ];
+        if let Some(t) = truth {
+            a.extend(["--truth", s(t)]);
+        }
+        assert!(whet(&a).status.success());
+    }
+    let sharp = dir.join("sharp.off");
+    let j = whet_json(&[
+        "sharpen",
+        s(&mc),
+        "-o",
+        s(&sharp),
+        "--method",
+        "normal-filter",
+        "--rho",
+        "4",
+        "--eta",
+        "0.1",
+        "--lambda",
+        "0",
+        "--json",
+    ]);
+    assert_eq!(j["method"], "normal-filter");
+    for key in [
+        "chamfer_edges",
+        "new_vertices",
+        "time_ms",
+        "feature_faces",
+        "feature_vertices",
+        "absolute_feature_vertices",
+        "filtered_normals",
+        "flips_avoided",
+        "swaps",
+        "collapses",
+        "detection_ms",
+        "filtering_ms",
+        "updating_ms",
+    ] {
+        assert!(!j[key].is_null(), "missing {key}: {j}");
+    }
+    assert!(j["feature_faces"].as_u64().unwrap() > 0);
+    let (_, rms0) = rms_pct(&truth, &mc);
+    let (_, rms1) = rms_pct(&truth, &sharp);
+    assert!(rms1 < rms0 / 3.0, "RMS {rms0} -> {rms1}");
+    assert_eq!(whet_json(&["info", s(&sharp), "--json"])["manifold"], true);
+
+    // --select: a vertex list with comments; an empty region changes nothing.
+    let sel = dir.join("region.txt");
+    std::fs::write(&sel, "# nothing selected\n").unwrap();
+    let j = whet_json(&[
+        "sharpen",
+        s(&mc),
+        "-o",
+        s(&dir.join("same.off")),
+        "--method",
+        "normal-filter",
+        "--select",
+        s(&sel),
+        "--json",
+    ]);
+    assert_eq!(j["feature_faces"], 0);
+    assert_eq!(j["moved_input_vertices"], 0);
+    // Bad selections and options are usage errors (exit 2), never panics.
+    std::fs::write(&sel, "1 2\nthree\n").unwrap();
+    let o = whet(&[
+        "sharpen",
+        s(&mc),
+        "-o",
+        s(&sharp),
+        "--method",
+        "normal-filter",
+        "--select",
+        s(&sel),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("line 2"));
+    let o = whet(&["sharpen", s(&mc), "-o", s(&sharp), "--select", s(&sel)]);
+    assert_eq!(o.status.code(), Some(2), "--select needs normal-filter");
+    let o = whet(&[
+        "sharpen",
+        s(&mc),
+        "-o",
+        s(&sharp),
+        "--method",
+        "normal-filter",
+        "--eta",
+        "-3",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let o = whet(&[
+        "sharpen",
+        s(&mc),
+        "-o",
+        s(&sharp),
+        "--method",
+        "normal-filter",
+        "--rho",
+        "0",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+}

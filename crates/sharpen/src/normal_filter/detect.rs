@@ -5,6 +5,11 @@ use glam::DVec3;
 
 use super::{Geo, NONE};
 
+/// The flood crosses an edge when `n_s . n_k > lambda + LAMBDA_SLACK`: with the paper's
+/// `lambda = 0`, an exactly right-angled crease (dot product 0 up to rounding, either sign)
+/// must stop it.
+const LAMBDA_SLACK: f64 = 1e-9;
+
 /// Breadth-first flood for `NFII`, with a generation-stamped visited mark so nothing is cleared
 /// between faces.
 pub(crate) struct Flood {
@@ -46,7 +51,9 @@ impl Flood {
                 if k == NONE || self.mark[k as usize] == g {
                     continue;
                 }
-                if ns.dot(normals[k as usize]) > lambda && geo.dist2(center, k) < rho2 {
+                if ns.dot(normals[k as usize]) > lambda + LAMBDA_SLACK
+                    && geo.dist2(center, k) < rho2
+                {
                     self.mark[k as usize] = g;
                     self.faces.push(k);
                 }

@@ -72,8 +72,9 @@ impl Rings {
 }
 
 /// `ceil(4 L / rho)` Jacobi steps of Kobbelt's umbrella bilaplacian on the `movable` vertices
-/// (A.3): `p -= U2(p) / nu(p)`. A step that would turn a face by 90 degrees or more, or take
-/// its area to (almost) zero, is undone for that face's vertices. Returns the vertices moved.
+/// (A.3): `p -= U2(p) / nu(p)`. A step that would turn a face by 90 degrees or more (from its
+/// previous or its input normal), or take its area to (almost) zero, is undone for that face's
+/// vertices. Returns the vertices moved.
 pub(crate) fn presmooth(
     positions: &mut [DVec3],
     tris: &[[u32; 3]],
@@ -81,6 +82,7 @@ pub(crate) fn presmooth(
     movable: &[bool],
     iterations: usize,
     min_area2: f64,
+    input_normals: &[DVec3],
 ) -> usize {
     let nv = positions.len();
     let active: Vec<u32> = (0..nv as u32)
@@ -150,7 +152,10 @@ pub(crate) fn presmooth(
                     before(b, positions),
                     before(c, positions),
                 );
-                if now.dot(was) <= 0.0 || now.length_squared() <= min_area2 {
+                if now.dot(was) <= 0.0
+                    || now.dot(input_normals[t]) <= 0.0
+                    || now.length_squared() <= min_area2
+                {
                     undo.extend([a, b, c]);
                 }
             }

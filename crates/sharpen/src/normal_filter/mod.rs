@@ -184,7 +184,15 @@ pub(crate) fn run(
     let iterations = (4.0 / opts.rho).ceil().max(0.0) as usize;
     report.presmooth_iterations = iterations;
     let rings = filter::Rings::new(tris, nv);
-    filter::presmooth(&mut positions, tris, &rings, &smooth, iterations, min_area2);
+    filter::presmooth(
+        &mut positions,
+        tris,
+        &rings,
+        &smooth,
+        iterations,
+        min_area2,
+        &input_normals,
+    );
     let (mut normals, centroids) = normals_and_centroids(&positions, tris);
     for (t, n) in normals.iter_mut().enumerate() {
         if *n == DVec3::ZERO {

@@ -205,7 +205,15 @@ fn presmoothing_flattens_a_spike() {
     movable[c] = true;
     let mut p = m.positions.clone();
     assert_eq!(
-        filter::presmooth(&mut p, &m.triangles, &rings, &movable, 2, 1e-20),
+        filter::presmooth(
+            &mut p,
+            &m.triangles,
+            &rings,
+            &movable,
+            2,
+            1e-20,
+            &m.face_normals()
+        ),
         1
     );
     assert!(p[c].z.abs() < 0.05, "{}", p[c].z);

@@ -4,6 +4,8 @@
 //! - `outputs`: the issue's output guarantees on marching-cubes samplings of the synth shapes;
 //! - `inputs`: refused input, boundaries, components, already-sharp meshes, tags, options;
 //! - `issue6`: the figures of issue 6 at test-suite scale (regression bounds) and noise;
+//! - `normal_filter`: the normal filter of issue 10 (figures as regression bounds, guarantees,
+//!   selection, random damage);
 //! - `robustness`: random noise, holes and options never break the output's guarantees.
 #![allow(clippy::unwrap_used)] // a panic is a test failure
 
@@ -12,6 +14,7 @@ mod support;
 
 mod inputs;
 mod issue6;
+mod normal_filter;
 mod outputs;
 mod ridge;
 mod robustness;
