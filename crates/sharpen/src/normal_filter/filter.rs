@@ -196,14 +196,18 @@ fn key(cost: f64) -> u64 {
 
 /// `C(i)` and `m` (A.4): the smallest `1 - n_i . n_j` over the edge neighbours `j` of `i` that
 /// are not in `FFt`, and the neighbour attaining it; `None` for `+inf`.
-fn cost(i: usize, geo: &Geo, normals: &[DVec3], in_fft: &[bool]) -> Option<(f64, u32)> {
+fn cost(i: usize, geo: &Geo, normals: &[DVec3], in_fft: &[bool], eta: f64) -> Option<(f64, u32)> {
     let ni = normals[i];
     let mut best: Option<(f64, u32)> = None;
     for &j in &geo.nfi[i] {
         if j == NONE || in_fft[j as usize] {
             continue;
         }
-        let c = (1.0 - ni.dot(normals[j as usize])).max(0.0) + 0.0;
+        let d = ni.dot(normals[j as usize]);
+        if d <= eta {
+            continue;
+        }
+        let c = (1.0 - d).max(0.0) + 0.0;
         if best.is_none_or(|(b, bj)| c < b || (c == b && j < bj)) {
             best = Some((c, j));
         }
@@ -236,7 +240,7 @@ pub(crate) fn filter(
     let mut heap: BinaryHeap<Reverse<(u64, u32)>> = BinaryHeap::new();
     for i in 0..nt {
         if in_fft[i] {
-            if let Some((c, _)) = cost(i, geo, normals, in_fft) {
+            if let Some((c, _)) = cost(i, geo, normals, in_fft, eta) {
                 keys[i] = key(c);
                 heap.push(Reverse((keys[i], i as u32)));
             }
@@ -250,7 +254,7 @@ pub(crate) fn filter(
         if !in_fft[i] || keys[i] != k {
             continue;
         }
-        let Some((_, m)) = cost(i, geo, normals, in_fft) else {
+        let Some((_, m)) = cost(i, geo, normals, in_fft, eta) else {
             continue;
         };
         let nm = normals[m as usize];
@@ -275,7 +279,7 @@ pub(crate) fn filter(
             if j == NONE || !in_fft[j as usize] {
                 continue;
             }
-            if let Some((c, _)) = cost(j as usize, geo, normals, in_fft) {
+            if let Some((c, _)) = cost(j as usize, geo, normals, in_fft, eta) {
                 let kj = key(c);
                 if kj != keys[j as usize] {
                     keys[j as usize] = kj;

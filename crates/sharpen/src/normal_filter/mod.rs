@@ -32,6 +32,9 @@ pub(crate) const NONE: u32 = u32::MAX;
 /// Sharp-edge tags: the faces' filtered normals more than this far apart (cos 30 degrees).
 const TAG_COS: f64 = 0.866_025_403_784_438_6;
 
+/// Updating moves no vertex farther than this times `rho` (see `update::update`).
+const REACH: f64 = 0.5;
+
 /// Faces may not get smaller than this fraction of `L^2` (as `|cross|^2`, so squared).
 const MIN_AREA: f64 = 1e-6;
 
@@ -238,7 +241,7 @@ pub(crate) fn run(
         collapses: 0,
     };
     let moving: Vec<u32> = (0..nv as u32).filter(|&v| movable[v as usize]).collect();
-    let up = update::update(&mut dm, &moving, mean_edge);
+    let up = update::update(&mut dm, &moving, mean_edge, REACH * rho);
     report.update_iterations = up.sweeps;
     report.flips_avoided = up.flips_avoided;
     report.swaps = dm.swaps;

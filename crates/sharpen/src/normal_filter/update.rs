@@ -20,9 +20,13 @@ pub(crate) struct Updated {
     pub flips_avoided: usize,
 }
 
-/// Runs the sweeps on `m` over the vertices `moving` (feature vertices that may move).
-pub(crate) fn update(m: &mut DynMesh, moving: &[u32], mean_edge: f64) -> Updated {
+/// Runs the sweeps on `m` over the vertices `moving` (feature vertices that may move). No
+/// vertex ends farther than `reach` from where updating found it: the crease a feature vertex
+/// belongs on is inside the feature, which `rho` bounds; normals that disagree with each other
+/// (noise) would otherwise let Gauss-Seidel sweeps drift without bound.
+pub(crate) fn update(m: &mut DynMesh, moving: &[u32], mean_edge: f64, reach: f64) -> Updated {
     let tol = TOLERANCE * mean_edge;
+    let home: Vec<DVec3> = m.pos.clone();
     let mut flips_avoided = 0;
     let mut sweeps = 0;
     let mut stamp = vec![0u32; m.tris.len()];
@@ -54,7 +58,8 @@ pub(crate) fn update(m: &mut DynMesh, moving: &[u32], mean_edge: f64) -> Updated
             let mut gamma = 1.0;
             let mut accepted = false;
             for _ in 0..=HALVINGS {
-                if m.move_ok(v, x + delta * gamma) {
+                let y = x + delta * gamma;
+                if y.distance_squared(home[v as usize]) <= reach * reach && m.move_ok(v, y) {
                     accepted = true;
                     break;
                 }

@@ -10,7 +10,7 @@
 //! default, which moves the figures by a few percent).
 
 use whet_mesh::Mesh;
-use whet_sharpen::{sharpen, Method, SharpenOptions};
+use whet_sharpen::{sharpen, SharpenOptions};
 use whet_synth::{add_noise, marching_cubes, Shape, ShapeKind, ShapeParams};
 
 use crate::support::{check, error, rotations};
@@ -32,7 +32,7 @@ fn gains(kind: ShapeKind) -> [[f64; 2]; 2] {
     for rot in 0..2 {
         let (truth, input) = sampled(kind, 32, rot);
         let before = error(&truth, &input, SAMPLES);
-        for (m, method) in Method::ALL.into_iter().enumerate() {
+        for (m, method) in crate::EDGE_SHARPENER.into_iter().enumerate() {
             let out = sharpen(&input, &SharpenOptions::DEFAULT.with_method(method)).unwrap();
             g[m][rot] = before.rms_pct / error(&truth, &out.mesh, SAMPLES).rms_pct;
         }

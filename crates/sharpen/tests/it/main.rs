@@ -12,6 +12,10 @@
 #[path = "../../examples/support/mod.rs"]
 mod support;
 
+/// The EdgeSharpener methods (the normal filter has its own guarantees: `normal_filter`).
+pub const EDGE_SHARPENER: [whet_sharpen::Method; 2] =
+    [whet_sharpen::Method::Papers, whet_sharpen::Method::Extended];
+
 mod inputs;
 mod issue6;
 mod normal_filter;

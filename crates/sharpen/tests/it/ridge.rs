@@ -3,7 +3,7 @@
 //! every vertex lies on the true surface, and the expected result is known exactly.
 
 use whet_mesh::{DVec3, Mesh, VertexId};
-use whet_sharpen::{sharpen, Method, SharpenOptions};
+use whet_sharpen::{sharpen, SharpenOptions};
 
 const XS: [f64; 6] = [-2.5, -1.5, -0.5, 0.5, 1.5, 2.5];
 const NY: u32 = 6;
@@ -29,7 +29,7 @@ fn ridge() -> Mesh {
 #[test]
 fn ridge_is_restored_exactly() {
     let input = ridge();
-    for method in Method::ALL {
+    for method in crate::EDGE_SHARPENER {
         let out = sharpen(&input, &SharpenOptions::DEFAULT.with_method(method)).unwrap();
         let r = &out.report;
         // The crossing edges of the strip: 4 interior edges along x (the two on y = 0 and y = 5
