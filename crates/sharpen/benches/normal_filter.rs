@@ -17,6 +17,9 @@ use glam::{DQuat, DVec3};
 use whet_sharpen::{sharpen, Method, SharpenOptions, SharpenReport};
 use whet_synth::{marching_cubes, Shape, ShapeKind, ShapeParams};
 
+/// Reads one phase's time from a report.
+type Phase = fn(&SharpenReport) -> Duration;
+
 fn bench(c: &mut Criterion) {
     let rotation = DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.5);
     let shape = match Shape::new(
@@ -51,7 +54,7 @@ fn bench(c: &mut Criterion) {
     );
     let mut group = c.benchmark_group("normal_filter_160k");
     group.sample_size(10);
-    let phases: [(&str, fn(&SharpenReport) -> Duration); 4] = [
+    let phases: [(&str, Phase); 4] = [
         ("detection", |r| r.detection_time),
         ("filtering", |r| r.filtering_time),
         ("updating", |r| r.updating_time),
