@@ -46,7 +46,7 @@ pub fn run(args: &DemoArgs) -> CliResult {
         // swing is the main codec; exact (Draco's job) is the baseline curve.
         modes: vec!["swing".into(), "exact".into()],
         rates: DEFAULT_SWING_RATES.to_vec(),
-        angle_bits: whet_swing::SwingOptions::DEFAULT_ANGLE_BITS,
+        angle_bits: super::encode::AngleBits::Auto,
         exact_bits: vec![6.0, 7.0, 8.0, 9.0, 10.0, 11.0, 12.0, 14.0],
         subdiv_control: vec![100.0, 200.0, 400.0],
         stages: vec!["decoded".into(), "sharpened".into(), "bent".into()],

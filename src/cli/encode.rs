@@ -21,6 +21,65 @@ pub enum ModeArg {
     Subdiv,
 }
 
+/// `--angle-bits`: a count, or `auto`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AngleBits {
+    /// Fixed bits.
+    Fixed(u32),
+    /// Chosen by measurement.
+    Auto,
+}
+
+impl std::str::FromStr for AngleBits {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        if s.eq_ignore_ascii_case("auto") {
+            return Ok(AngleBits::Auto);
+        }
+        match s.parse::<u32>() {
+            Ok(b)
+                if (whet_codec::swing::MIN_ANGLE_BITS..=whet_codec::swing::MAX_ANGLE_BITS)
+                    .contains(&b) =>
+            {
+                Ok(AngleBits::Fixed(b))
+            }
+            _ => Err(format!(
+                "expected `auto` or angle bits {}..={}, got {s:?}",
+                whet_codec::swing::MIN_ANGLE_BITS,
+                whet_codec::swing::MAX_ANGLE_BITS
+            )),
+        }
+    }
+}
+
+impl AngleBits {
+    /// Applies to swing options.
+    pub fn apply(self, opts: SwingOptions) -> SwingOptions {
+        match self {
+            AngleBits::Fixed(b) => opts.with_angle_bits(b).with_auto_angle_bits(false),
+            AngleBits::Auto => opts.with_auto_angle_bits(true),
+        }
+    }
+}
+
+/// `--optimize-for`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum OptimizeFor {
+    /// The decoded mesh.
+    Decoded,
+    /// The decoded mesh after EdgeSharpener.
+    Sharpened,
+}
+
+impl From<OptimizeFor> for whet_swing::ErrorOf {
+    fn from(o: OptimizeFor) -> Self {
+        match o {
+            OptimizeFor::Decoded => whet_swing::ErrorOf::Decoded,
+            OptimizeFor::Sharpened => whet_swing::ErrorOf::Sharpened,
+        }
+    }
+}
+
 /// Swing mode's default edge length, as a fraction of the bounding-box diagonal, when no
 /// rate option is given.
 const DEFAULT_EDGE_LENGTH: f64 = 0.01;
@@ -54,10 +113,15 @@ pub struct EncodeArgs {
     /// Metro against the input); the cheapest stream found that meets it.
     #[arg(long, value_name = "E")]
     max_error: Option<f64>,
-    /// Swing: bits of a quantized swing angle.
-    #[arg(long, value_name = "B", default_value_t = SwingOptions::DEFAULT_ANGLE_BITS,
-          value_parser = clap::value_parser!(u32).range(3..=14))]
-    angle_bits: u32,
+    /// Swing: bits of a quantized swing angle (3..=14), or `auto`: with --bpv,
+    /// --target-bytes or --max-error, try 5..=10 bits and keep the lowest error (or the
+    /// smallest stream meeting the target), measured on the output of --optimize-for.
+    #[arg(long, value_name = "B|auto", default_value = "6")]
+    angle_bits: AngleBits,
+    /// Swing: which output --max-error and --angle-bits auto measure: the decoded mesh, or
+    /// the decoded mesh after `whet decode --sharpen` (for CAD parts).
+    #[arg(long, value_enum, default_value_t = OptimizeFor::Decoded)]
+    optimize_for: OptimizeFor,
     /// Swing: also write the retiled mesh the stream encodes (byte-identical to what
     /// `whet decode` writes in the same format).
     #[arg(long, value_name = "PATH")]
@@ -201,10 +265,12 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh) -> CliResult {
         Rate::EdgeLength(DEFAULT_EDGE_LENGTH)
     };
     let quant_bits = args.quant_bits.unwrap_or(SwingOptions::DEFAULT.quant_bits);
-    let opts = SwingOptions::DEFAULT
-        .with_rate(rate)
-        .with_angle_bits(args.angle_bits)
-        .with_quant_bits(quant_bits);
+    let opts = args.angle_bits.apply(
+        SwingOptions::DEFAULT
+            .with_rate(rate)
+            .with_quant_bits(quant_bits)
+            .with_error_of(args.optimize_for.into()),
+    );
     let out = whet_swing::encode(mesh, &opts).map_err(|e| {
         let input = e.is_input_error();
         let err = anyhow::Error::new(e).context(format!("cannot encode {}", args.input.display()));
@@ -252,6 +318,12 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh) -> CliResult {
             },
             "rms_error_pct": out.rms_pct,
             "search": out.search.iter().map(|&(f, b)| json!([f, b])).collect::<Vec<_>>(),
+            "angle_trials": out.angle_trials.iter().map(|t| json!({
+                "angle_bits": t.angle_bits,
+                "edge_length": if t.edge_length_fraction.is_finite() { json!(t.edge_length_fraction) } else { json!(null) },
+                "bytes": t.bytes,
+                "rms_error_pct": t.rms_pct,
+            })).collect::<Vec<_>>(),
             "repair": repair_json(r),
             "dropped_unused_vertices": r.dropped_unused_vertices,
         }));

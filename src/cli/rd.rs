@@ -1,5 +1,6 @@
 //! `whet rd` and `whet demo`: rate-distortion sweeps with whet-rd.
 
+use super::encode::AngleBits;
 use super::{read_mesh, CliResult, Failure};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -36,7 +37,8 @@ impl Codec for ExactCodec {
 /// The swing mode (SwingWrapper) as an rd codec; the rate is bits per ORIGINAL vertex, the
 /// papers' unit (the encoder searches the edge length to land within 5 %).
 struct SwingCodec {
-    angle_bits: u32,
+    angle_bits: AngleBits,
+    error_of: whet_swing::ErrorOf,
 }
 
 impl Codec for SwingCodec {
@@ -49,9 +51,11 @@ impl Codec for SwingCodec {
                 "swing rates are bits per original vertex (> 0), got {rate}"
             ));
         }
-        let opts = whet_swing::SwingOptions::DEFAULT
-            .with_rate(whet_swing::Rate::BitsPerVertex(rate))
-            .with_angle_bits(self.angle_bits);
+        let opts = self.angle_bits.apply(
+            whet_swing::SwingOptions::DEFAULT
+                .with_rate(whet_swing::Rate::BitsPerVertex(rate))
+                .with_error_of(self.error_of),
+        );
         whet_swing::encode(mesh, &opts)
             .map(|o| o.bytes)
             .map_err(|e| e.to_string())
@@ -72,9 +76,11 @@ pub struct RdArgs {
     /// Rates of the swing mode, bits per ORIGINAL vertex, comma separated.
     #[arg(long, value_delimiter = ',', default_value = "0.5,1,2,3,4,6")]
     rates: Vec<f64>,
-    /// Swing angle bits of the swing curve.
-    #[arg(long, default_value_t = whet_swing::SwingOptions::DEFAULT_ANGLE_BITS)]
-    angle_bits: u32,
+    /// Swing angle bits of the swing curve, or `auto`: at each rate the encoder tries 5..=10
+    /// bits and keeps the stream whose output measures the lowest RMS error (the sharpened
+    /// output when the stages sharpen, else the decoded one).
+    #[arg(long, value_name = "B|auto", default_value = "auto")]
+    angle_bits: AngleBits,
     /// Quantization bits of the exact mode's baseline curve, comma separated.
     #[arg(
         long,
@@ -114,7 +120,7 @@ pub struct RdArgs {
 pub struct Plan {
     pub modes: Vec<String>,
     pub rates: Vec<f64>,
-    pub angle_bits: u32,
+    pub angle_bits: AngleBits,
     pub exact_bits: Vec<f64>,
     pub subdiv_control: Vec<f64>,
     pub stages: Vec<String>,
@@ -182,8 +188,14 @@ fn stage_by_name(name: &str) -> Result<Stage, Failure> {
 pub fn run_plan(meshes: Vec<(String, Mesh)>, plan: &Plan) -> CliResult<(Vec<Point>, String)> {
     let exact = ExactCodec;
     let subdiv = SubdivCodec;
+    let sharpens = plan.stages.iter().any(|s| s == "sharpened" || s == "bent");
     let swing = SwingCodec {
         angle_bits: plan.angle_bits,
+        error_of: if sharpens {
+            whet_swing::ErrorOf::Sharpened
+        } else {
+            whet_swing::ErrorOf::Decoded
+        },
     };
     let mut codecs: Vec<CodecSweep<'_>> = Vec::new();
     for m in &plan.modes {

@@ -26,6 +26,31 @@ pub enum Rate {
     MaxError(f64),
 }
 
+/// Which output of the decoder an error measurement of the encoder refers to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum ErrorOf {
+    /// The decoded (retiled) mesh itself.
+    #[default]
+    Decoded,
+    /// The decoded mesh after EdgeSharpener with whet-sharpen's defaults (`whet decode
+    /// --sharpen`): the output that matters for CAD parts.
+    Sharpened,
+}
+
+/// One angle quantization tried by the automatic choice ([`SwingOptions::auto_angle_bits`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AngleTrial {
+    /// Angle bits.
+    pub angle_bits: u32,
+    /// Edge length fraction the rate search settled on.
+    pub edge_length_fraction: f64,
+    /// Stream size.
+    pub bytes: usize,
+    /// Measured RMS error (of [`SwingOptions::error_of`]), % of the diagonal; `None` when
+    /// this quantization reached no stream (an error target it cannot meet).
+    pub rms_pct: Option<f64>,
+}
+
 /// Options of [`SwingEncoder`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
@@ -48,11 +73,23 @@ pub struct SwingOptions {
     pub version: Version,
     /// Retiler constants.
     pub tuning: RetileTuning,
+    /// Choose the angle bits too: with a size target, the quantization in
+    /// [`SwingOptions::AUTO_ANGLE_BITS`] whose stream measures the lowest error; with an
+    /// error target, the one with the smallest stream meeting it. Each candidate costs one
+    /// rate search and one Metro measurement. Not available with a fixed edge length.
+    pub auto_angle_bits: bool,
+    /// What the error measurements (error targets, automatic angle bits) refer to.
+    pub error_of: ErrorOf,
 }
 
 impl SwingOptions {
     /// Default angle bits (chosen by measurement on the fixtures: docs/results.md).
     pub const DEFAULT_ANGLE_BITS: u32 = 6;
+
+    /// Range of the automatic angle-bit choice, which climbs from
+    /// [`Self::DEFAULT_ANGLE_BITS`] while the measured error keeps falling (docs/results.md,
+    /// "Angle bits": smooth meshes stay at 5-6, flat CAD parts climb to 9-12).
+    pub const AUTO_ANGLE_BITS: std::ops::RangeInclusive<u32> = 4..=12;
 
     /// `L` = 1 % of the diagonal, default angle bits, 20-bit seeds, 5 % tolerance.
     pub const DEFAULT: SwingOptions = SwingOptions {
@@ -65,6 +102,8 @@ impl SwingOptions {
         repair: true,
         version: Version::CURRENT,
         tuning: RetileTuning::DEFAULT,
+        auto_angle_bits: false,
+        error_of: ErrorOf::Decoded,
     };
 
     /// Sets the rate.
@@ -100,6 +139,18 @@ impl SwingOptions {
     /// Turns manifold repair on or off.
     pub const fn with_repair(mut self, repair: bool) -> Self {
         self.repair = repair;
+        self
+    }
+
+    /// Turns the automatic angle-bit choice on or off.
+    pub const fn with_auto_angle_bits(mut self, auto: bool) -> Self {
+        self.auto_angle_bits = auto;
+        self
+    }
+
+    /// Sets what error measurements refer to.
+    pub const fn with_error_of(mut self, error_of: ErrorOf) -> Self {
+        self.error_of = error_of;
         self
     }
 
@@ -144,6 +195,8 @@ pub struct SwingOutput {
     pub rms_pct: Option<f64>,
     /// The `(edge length fraction, bytes)` of every retiling the search ran.
     pub search: Vec<(f64, usize)>,
+    /// The quantizations the automatic angle-bit choice tried (empty when off).
+    pub angle_trials: Vec<AngleTrial>,
 }
 
 impl SwingOutput {
@@ -235,6 +288,15 @@ impl SwingEncoder {
             dropped: p.dropped_unused_vertices,
             mesh: p.mesh,
         };
+        if o.auto_angle_bits {
+            return self.encode_auto_angle_bits(&prep);
+        }
+        self.encode_prepared(&prep)
+    }
+
+    /// Encodes a prepared mesh at the options' angle bits.
+    fn encode_prepared(&self, prep: &Prepared) -> Result<SwingOutput, Error> {
+        let o = &self.opts;
         match o.rate {
             Rate::EdgeLength(f) => {
                 if !(f > 0.0 && f.is_finite()) {
@@ -242,7 +304,7 @@ impl SwingEncoder {
                         "the edge length must be a positive fraction of the diagonal, got {f}"
                     )));
                 }
-                let mut out = self.encode_near(&prep, f)?;
+                let mut out = self.encode_near(prep, f)?;
                 out.search = vec![(out.edge_length_fraction, out.bytes.len())];
                 Ok(out)
             }
@@ -253,13 +315,13 @@ impl SwingEncoder {
                     )));
                 }
                 let target = (r * prep.mesh.positions.len() as f64 / 8.0).round() as usize;
-                self.search_bytes(&prep, target.max(1))
+                self.search_bytes(prep, target.max(1), None)
             }
             Rate::TargetBytes(n) => {
                 if n == 0 {
                     return Err(Error::Parameter("the target size must be positive".into()));
                 }
-                self.search_bytes(&prep, n)
+                self.search_bytes(prep, n, None)
             }
             Rate::MaxError(e) => {
                 if !(e > 0.0 && e.is_finite()) {
@@ -267,9 +329,119 @@ impl SwingEncoder {
                         "the error target must be a positive percentage, got {e}"
                     )));
                 }
-                self.search_error(&prep, e)
+                self.search_error(prep, e)
             }
         }
+    }
+
+    /// The automatic angle-bit choice: every candidate quantization runs the rate (or error)
+    /// search, and the stream with the lowest measured error (or the smallest one meeting the
+    /// error target) wins. Flat regions predict their swing angles almost exactly, so extra
+    /// bits cost little there and pay off after sharpening; curved ones pay for every bit:
+    /// which wins depends on the mesh and the rate, hence a measurement, not a rule.
+    fn encode_auto_angle_bits(&self, prep: &Prepared) -> Result<SwingOutput, Error> {
+        let o = self.opts;
+        if let Rate::EdgeLength(_) = o.rate {
+            return Err(Error::Parameter(
+                "automatic angle bits need a size or error target (bits per vertex, bytes or \
+                 an RMS error), not a fixed edge length"
+                    .into(),
+            ));
+        }
+        let by_error = matches!(o.rate, Rate::MaxError(_));
+        let mut trials = Vec::new();
+        let mut search = Vec::new();
+        let mut hint: Option<f64> = None;
+        let mut last_err = None;
+        // One candidate: its stream and score (bytes for an error target, error otherwise).
+        let mut run = |bits: u32| -> Result<Option<(f64, SwingOutput)>, Error> {
+            let enc = SwingEncoder::new(o.with_angle_bits(bits).with_auto_angle_bits(false));
+            let result = match o.rate {
+                Rate::BitsPerVertex(r) if r > 0.0 && r.is_finite() => {
+                    let target = (r * prep.mesh.positions.len() as f64 / 8.0).round() as usize;
+                    enc.search_bytes(prep, target.max(1), hint)
+                }
+                Rate::TargetBytes(n) if n > 0 => enc.search_bytes(prep, n, hint),
+                _ => enc.encode_prepared(prep),
+            };
+            let mut out = match result {
+                Ok(out) => out,
+                Err(e @ (Error::Unreachable(_) | Error::Stuck(_))) => {
+                    trials.push(AngleTrial {
+                        angle_bits: bits,
+                        edge_length_fraction: f64::NAN,
+                        bytes: 0,
+                        rms_pct: None,
+                    });
+                    last_err = Some(e);
+                    return Ok(None);
+                }
+                Err(e) => return Err(e),
+            };
+            hint = Some(out.edge_length_fraction);
+            search.extend_from_slice(&out.search);
+            let rms = match out.rms_pct {
+                Some(r) => r,
+                None => enc.measure(prep, &out)?,
+            };
+            out.rms_pct = Some(rms);
+            trials.push(AngleTrial {
+                angle_bits: bits,
+                edge_length_fraction: out.edge_length_fraction,
+                bytes: out.bytes.len(),
+                rms_pct: Some(rms),
+            });
+            let score = if by_error {
+                out.bytes.len() as f64
+            } else {
+                rms
+            };
+            Ok(Some((score, out)))
+        };
+        // Hill climb from the default: upwards while the score improves, else downwards.
+        // Scores are noisy by a few % from one L to the next, so one worse step ends a
+        // direction only when it is worse by more than that.
+        const NOISE: f64 = 1.03;
+        let range = SwingOptions::AUTO_ANGLE_BITS;
+        let start = SwingOptions::DEFAULT_ANGLE_BITS;
+        let mut best: Option<(f64, SwingOutput)> = run(start)?;
+        let mut climbed = false;
+        for dir in [1i32, -1] {
+            if dir == -1 && climbed {
+                break;
+            }
+            let mut bits = start;
+            let mut misses = 0;
+            loop {
+                let next = bits as i32 + dir;
+                if next < *range.start() as i32 || next > *range.end() as i32 {
+                    break;
+                }
+                bits = next as u32;
+                let Some((score, out)) = run(bits)? else {
+                    break;
+                };
+                let best_score = best.as_ref().map_or(f64::INFINITY, |b| b.0);
+                if score < best_score {
+                    best = Some((score, out));
+                    climbed = true;
+                    misses = 0;
+                } else {
+                    misses += 1;
+                    if score > best_score * NOISE || misses >= 2 {
+                        break;
+                    }
+                }
+            }
+        }
+        let Some((_, mut out)) = best else {
+            return Err(
+                last_err.unwrap_or_else(|| Error::Stuck("no angle quantization worked".into()))
+            );
+        };
+        out.search = search;
+        out.angle_trials = trials;
+        Ok(out)
     }
 
     /// Retiles and encodes at edge length `fraction · diagonal`.
@@ -300,6 +472,7 @@ impl SwingEncoder {
             stats: retiled.stats,
             rms_pct: None,
             search: Vec::new(),
+            angle_trials: Vec::new(),
         })
     }
 
@@ -327,14 +500,22 @@ impl SwingEncoder {
         (l / prep.diagonal).clamp(1e-4, 0.5)
     }
 
-    /// Secant search on `log L` for a stream of `target` bytes (within the tolerance).
-    fn search_bytes(&self, prep: &Prepared, target: usize) -> Result<SwingOutput, Error> {
+    /// Secant search on `log L` for a stream of `target` bytes (within the tolerance),
+    /// starting from `start` (an edge length fraction) when given.
+    fn search_bytes(
+        &self,
+        prep: &Prepared,
+        target: usize,
+        start: Option<f64>,
+    ) -> Result<SwingOutput, Error> {
         let tol = self.opts.tolerance;
         let goal = (target as f64).ln();
         let mut search = Vec::new();
         let mut best: Option<SwingOutput> = None;
         let mut prev: Option<(f64, f64)> = None; // (ln L, ln bytes)
-        let mut f = Self::guess_fraction(prep, target);
+        let mut f = start
+            .filter(|f| f.is_finite() && *f > 0.0)
+            .unwrap_or_else(|| Self::guess_fraction(prep, target));
         for _ in 0..self.opts.max_iterations.max(1) {
             let out = self.encode_near(prep, f)?;
             let size = out.bytes.len();
@@ -366,11 +547,28 @@ impl SwingEncoder {
         Ok(out)
     }
 
-    /// Measures the symmetric RMS error of `out` against the original, in % of its diagonal.
+    /// Measures the symmetric RMS error of `out` (decoded, or sharpened: [`ErrorOf`])
+    /// against the original, in % of its diagonal.
     fn measure(&self, prep: &Prepared, out: &SwingOutput) -> Result<f64, Error> {
+        let sharpened;
+        let mesh = match self.opts.error_of {
+            ErrorOf::Decoded => &out.retiled,
+            ErrorOf::Sharpened => {
+                match whet_sharpen::sharpen(&out.retiled, &whet_sharpen::SharpenOptions::DEFAULT) {
+                    Ok(s) => {
+                        sharpened = s.mesh;
+                        &sharpened
+                    }
+                    // A retiled mesh is a valid manifold; should the sharpener refuse one
+                    // anyway, `whet decode --sharpen` would fail the same way, and the
+                    // decoded mesh is what the user keeps.
+                    Err(_) => &out.retiled,
+                }
+            }
+        };
         let r = metro(
             &prep.mesh,
-            &out.retiled,
+            mesh,
             &MetroOptions::DEFAULT.with_samples(self.opts.metro_samples),
         )?;
         Ok(r.symmetric.rms_pct)

@@ -24,7 +24,9 @@ mod holes;
 mod retiler;
 mod surface;
 
-pub use encoder::{encode, valence6_fraction, Rate, SwingEncoder, SwingOptions, SwingOutput};
+pub use encoder::{
+    encode, valence6_fraction, AngleTrial, ErrorOf, Rate, SwingEncoder, SwingOptions, SwingOutput,
+};
 pub use retiler::{retile, RetileStats, RetileTuning, Retiled};
 
 /// Why a mesh could not be encoded in the swing mode.
