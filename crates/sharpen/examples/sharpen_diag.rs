@@ -5,13 +5,16 @@
 //! ```text
 //! cargo run --release -p whet-sharpen --example sharpen_diag -- cube 64 0 extended
 //! cargo run --release -p whet-sharpen --example sharpen_diag -- cad_box_hole.off 0.5 - papers
+//! cargo run --release -p whet-sharpen --example sharpen_diag -- rocker_arm.off 4 6 extended
 //! ```
 //!
 //! A synth shape takes `<shape> <resolution> <rotation 0|1> <method>`; a shared fixture
 //! (`*.off`) takes `<fixture> <vertex ratio> - <method>` and uses the stand-in retiling of
-//! `support::cached_stand_in`.
+//! `support::cached_stand_in`, or `<fixture> <bpv> <angle bits|auto> <method>` and uses the
+//! swing-decoded fixture of `swing_inputs::swing_input` (auto: optimised for sharpening).
 
 mod support;
+mod swing_inputs;
 
 use std::fmt::Display;
 
@@ -36,7 +39,20 @@ where
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let method: Method = arg(&args, 4, Method::Extended);
-    let (reference, input) = if args.get(1).is_some_and(|a| a.ends_with(".off")) {
+    let swing = args.get(3).is_some_and(|a| a != "-");
+    let (reference, input) = if swing {
+        let bpv: f64 = arg(&args, 2, 4.0);
+        let angles = match args[3].as_str() {
+            "auto" => swing_inputs::Angles::AutoSharpened,
+            b => swing_inputs::Angles::Fixed(or_die(b.parse(), "angle bits")),
+        };
+        let s = swing_inputs::swing_input(&args[1], bpv, angles);
+        println!(
+            "{} at {:.2} bpv, {} angle bits",
+            args[1], s.bpv, s.angle_bits
+        );
+        (s.original, s.decoded)
+    } else if args.get(1).is_some_and(|a| a.ends_with(".off")) {
         let ratio: f64 = arg(&args, 2, 1.0);
         let (original, mesh, _) = support::cached_stand_in(&args[1], ratio);
         (original, mesh)
@@ -102,7 +118,11 @@ fn main() {
         } else {
             "new"
         };
-        println!("  {i} ({kind}): {:.3}%", d / diag * 100.0);
+        println!(
+            "  {i} ({kind}): {:.3}% at {:.4}",
+            d / diag * 100.0,
+            out.mesh.positions[*i]
+        );
     }
     // Reference crease points (edges of the reference) farthest from the output.
     let to_out = Bvh::new(&out.mesh);

@@ -7,7 +7,15 @@
 //! cargo run --release -p whet-sharpen --example sharpen_figures -- synth   # marching cubes only
 //! cargo run --release -p whet-sharpen --example sharpen_figures -- retile  # fixtures only
 //! cargo run --release -p whet-sharpen --example sharpen_figures -- noise   # noise sweep
+//! cargo run --release -p whet-sharpen --example sharpen_figures -- swing   # swing-decoded
+//! cargo run --release -p whet-sharpen --example sharpen_figures -- swing rocker  # one fixture
 //! ```
+//!
+//! `swing` encodes the CAD fixtures with whet-swing at 2, 4 and 7 bits per original vertex
+//! (about 0.5x, 1x and 2x the fixture's vertex count at 6 angle bits), once with 6 angle bits
+//! and once with `--angle-bits auto --optimize-for sharpened`, decodes them with whet-codec
+//! (`examples/swing_inputs`) and sharpens the decoded meshes. `retile` is the marching-cubes
+//! stand-in measured before the swing codec existed.
 //!
 //! Errors are symmetric Metro figures (whet-metro, default sampling: at least 10 samples per
 //! face and 1M per direction) in percent of the reference's bounding-box diagonal; the
@@ -17,6 +25,7 @@
 //! input's boundary and no new angle under 1 degree, WORSE if RMS or max grew.
 
 mod support;
+mod swing_inputs;
 
 use std::time::Instant;
 
@@ -25,6 +34,7 @@ use whet_sharpen::{sharpen, Method, SharpenOptions};
 use whet_synth::{add_noise, marching_cubes, Shape, ShapeKind, ShapeParams};
 
 use support::{cached_stand_in, check, error, rotations};
+use swing_inputs::{swing_input, Angles};
 
 /// Face samples per Metro direction: the default rule unless `SHARPEN_FIGURES_SAMPLES` is set
 /// (for quick iterations; the tables in docs/results.md use the default).
@@ -115,6 +125,44 @@ fn retile(only: Option<String>) {
     }
 }
 
+/// The CAD fixtures of the swing table (rocker_arm: mostly smooth blends, a case that must not
+/// get worse).
+const SWING_FIXTURES: [&str; 8] = [
+    "fandisk.off",
+    "cad_box_hole.off",
+    "cad_bracket.off",
+    "cad_cyl_fillet.off",
+    "block.off",
+    "partLp.off",
+    "joint.off",
+    "rocker_arm.off",
+];
+
+fn swing(only: Option<String>) {
+    println!("\n### Swing-decoded fixtures (reference: the original fixture)\n");
+    header("fixture, bpv, angle bits (V ratio)");
+    for name in SWING_FIXTURES {
+        if only.as_deref().is_some_and(|o| !name.starts_with(o)) {
+            continue;
+        }
+        for angles in [Angles::Fixed(6), Angles::AutoSharpened] {
+            for bpv in [2.0, 4.0, 7.0] {
+                let s = swing_input(name, bpv, angles);
+                let ratio = s.decoded.positions.len() as f64 / s.original.positions.len() as f64;
+                let bits = match angles {
+                    Angles::Fixed(b) => b.to_string(),
+                    Angles::AutoSharpened => format!("auto {}", s.angle_bits),
+                };
+                row(
+                    &format!("{name} {:.2} {bits} ({ratio:.2}x)", s.bpv),
+                    &s.original,
+                    &s.decoded,
+                );
+            }
+        }
+    }
+}
+
 fn noise() {
     println!("\n### Normal noise (percent of the longest edge) on marching cubes at 64\n");
     header("shape, noise");
@@ -143,5 +191,8 @@ fn main() {
     }
     if what.is_empty() || what == "noise" {
         noise();
+    }
+    if what.is_empty() || what == "swing" {
+        swing(std::env::args().nth(2));
     }
 }

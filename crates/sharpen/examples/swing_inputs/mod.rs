@@ -1,0 +1,92 @@
+//! Swing-decoded inputs of the EdgeSharpener figures: a shared fixture encoded by whet-swing
+//! (the SwingWrapper retiler) at a rate in bits per original vertex, with fixed or automatic
+//! angle bits, and decoded by whet-codec, exactly what `whet encode --bpv R [--angle-bits B |
+//! --angle-bits auto --optimize-for sharpened]` then `whet decode` produce.
+//!
+//! whet-swing depends on whet-sharpen (its automatic angle-bit choice measures the sharpened
+//! output), so it is a dev-dependency of whet-sharpen: a cycle cargo allows, and which keeps
+//! the figures a library call (no dependence on a CLI binary being built and current).
+//! Encodings are cached under `target/sharpen-swing/`: a rate search runs several retilings.
+//! With automatic angle bits optimised for the sharpened output, the encoder measures with the
+//! sharpener it was linked with, so the choice can change with the sharpener: delete the cache
+//! to re-run it.
+#![allow(dead_code)]
+
+use whet_mesh::Mesh;
+use whet_swing::{ErrorOf, Rate, SwingOptions};
+
+/// The angle quantization of a swing input.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Angles {
+    /// Fixed angle bits (`--angle-bits B`).
+    Fixed(u32),
+    /// `--angle-bits auto --optimize-for sharpened`.
+    AutoSharpened,
+}
+
+impl Angles {
+    pub fn tag(self) -> String {
+        match self {
+            Angles::Fixed(b) => b.to_string(),
+            Angles::AutoSharpened => "auto".to_string(),
+        }
+    }
+}
+
+/// One swing-decoded input and how it was made.
+pub struct SwingInput {
+    /// The fixture.
+    pub original: Mesh,
+    /// The decoded mesh.
+    pub decoded: Mesh,
+    /// Whole-stream bits per original vertex.
+    pub bpv: f64,
+    /// Angle bits the stream uses.
+    pub angle_bits: u32,
+}
+
+/// Encodes the shared fixture `name` at `bpv` bits per original vertex and decodes it.
+pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
+    let original = whet_io::read_path(&whet_testkit::shared_fixture(name), None)
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+    let dir = whet_testkit::workspace_root().join("target/sharpen-swing");
+    let _ = std::fs::create_dir_all(&dir);
+    let path = dir.join(format!("v1-{name}-{bpv}-{}.off", angles.tag()));
+    let meta = path.with_extension("meta");
+    if let (Ok(decoded), Ok(m)) = (
+        whet_io::read_path(&path, None),
+        std::fs::read_to_string(&meta),
+    ) {
+        let mut w = m.split_whitespace();
+        let got_bpv = w.next().and_then(|s| s.parse().ok());
+        let bits = w.next().and_then(|s| s.parse().ok());
+        if let (Some(bpv), Some(angle_bits)) = (got_bpv, bits) {
+            return SwingInput {
+                original,
+                decoded,
+                bpv,
+                angle_bits,
+            };
+        }
+    }
+    let mut opts = SwingOptions::DEFAULT.with_rate(Rate::BitsPerVertex(bpv));
+    opts = match angles {
+        Angles::Fixed(b) => opts.with_angle_bits(b),
+        Angles::AutoSharpened => opts
+            .with_auto_angle_bits(true)
+            .with_error_of(ErrorOf::Sharpened),
+    };
+    let out = whet_swing::encode(&original, &opts)
+        .unwrap_or_else(|e| panic!("{name} at {bpv} bpv: encode: {e}"));
+    let decoded = whet_codec::decode(&out.bytes, &whet_codec::DecodeOptions::DEFAULT)
+        .unwrap_or_else(|e| panic!("{name} at {bpv} bpv: decode: {e}"));
+    let got = out.bits_per_original_vertex();
+    let _ = whet_io::write_path(&path, &decoded, None, &whet_io::WriteOptions::DEFAULT);
+    let _ = std::fs::write(&meta, format!("{got} {}\n", out.angle_bits));
+    SwingInput {
+        original,
+        decoded,
+        bpv: got,
+        angle_bits: out.angle_bits,
+    }
+}
