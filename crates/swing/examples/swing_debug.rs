@@ -84,6 +84,30 @@ fn main() {
                     }
                 }
             }
+            // Triangles far off the original (a wrap defect or a cut): creation index, label.
+            let bvh = whet_metro::Bvh::new(&mesh);
+            let mut far = Vec::new();
+            for (t, tri) in m.triangles.iter().enumerate() {
+                let [a, b, c] = tri.map(|v| m.positions[v as usize]);
+                let d = [
+                    (a + b + c) / 3.0,
+                    (a + b) / 2.0,
+                    (b + c) / 2.0,
+                    (c + a) / 2.0,
+                ]
+                .iter()
+                .map(|&p| (bvh.closest_point(p).point - p).length())
+                .fold(0.0, f64::max);
+                if d > 0.3 * l {
+                    let label = r.mesh.labels.get(t.wrapping_sub(1)).map(|l| l.letter());
+                    far.push((t, label, (d / l * 100.0).round() / 100.0));
+                }
+            }
+            println!(
+                "{} triangles farther than 0.3 L: {:?}",
+                far.len(),
+                &far[..far.len().min(60)]
+            );
             println!(
                 "{} folds > 90 deg: {:?}",
                 folds.len(),

@@ -4,15 +4,24 @@ use whet_swing::{encode, Rate, SwingOptions};
 fn main() {
     let a: Vec<String> = std::env::args().skip(1).collect();
     let mesh = whet_io::read_path(&whet_testkit::shared_fixture(&a[0]), None).unwrap();
-    let f: f64 = a[1].parse().unwrap();
+    // `0.01` is L as a fraction of the diagonal, `bpv:1.5` a rate in bits per original vertex.
+    let rate = match a[1].strip_prefix("bpv:") {
+        Some(r) => Rate::BitsPerVertex(r.parse().unwrap()),
+        None => Rate::EdgeLength(a[1].parse().unwrap()),
+    };
     let bits: u32 = a.get(2).map_or(8, |x| x.parse().unwrap());
     let out = encode(
         &mesh,
-        &SwingOptions::DEFAULT
-            .with_rate(Rate::EdgeLength(f))
-            .with_angle_bits(bits),
+        &SwingOptions::DEFAULT.with_rate(rate).with_angle_bits(bits),
     )
     .unwrap();
+    println!(
+        "L {} of the diagonal, {} bytes, T' {}, {:?}",
+        out.edge_length_fraction,
+        out.bytes.len(),
+        out.retiled.triangles.len(),
+        out.stats
+    );
     let diag = mesh.diagonal();
     let bvh = whet_metro::Bvh::new(&out.retiled);
     let mut d = whet_metro::vertex_distances(&mesh, &bvh);

@@ -31,6 +31,9 @@ fn main() {
                 tuning = tuning
                     .with_close_angle(args.next().unwrap().parse::<f64>().unwrap().to_radians())
             }
+            "--off-surface" => {
+                tuning = tuning.with_off_surface(args.next().unwrap().parse().unwrap())
+            }
             "--snap" => tuning = tuning.with_snap(args.next().unwrap().parse().unwrap()),
             m => meshes.push(m.to_string()),
         }

@@ -82,6 +82,10 @@ pub struct RetileTuning {
     /// Where the swing circle misses the surface (a hole smaller than `L`), a point of it
     /// within this fraction of `L` of the surface is still a regular new vertex.
     pub bridge: f64,
+    /// A triangle joining existing front vertices (R, L, E, S) whose centroid or new edge
+    /// midpoints lie farther than this fraction of `L` from the original spans a gap or
+    /// cuts a thin part off: the regular rules do not take it (the fallback may, at a cost).
+    pub off_surface: f64,
 }
 
 impl RetileTuning {
@@ -97,6 +101,7 @@ impl RetileTuning {
         budget_factor: 2.5,
         max_edge: 1.7,
         bridge: 0.35,
+        off_surface: 0.35,
     };
 }
 
@@ -104,6 +109,13 @@ impl RetileTuning {
     /// Sets the wedge-closing angle (radians).
     pub const fn with_close_angle(mut self, angle: f64) -> Self {
         self.close_angle = angle;
+        self
+    }
+
+    /// Sets the off-surface limit of closing triangles (fraction of `L`; 1 or more turns the
+    /// test off).
+    pub const fn with_off_surface(mut self, off: f64) -> Self {
+        self.off_surface = off;
         self
     }
 
@@ -1097,6 +1109,32 @@ impl Retiler<'_, '_> {
         }
     }
 
+    /// How far (fraction of `L`, at most 1) triangle `(w, a, b)` strays from the original:
+    /// the largest distance to `M` of its centroid and the midpoints of its new edges
+    /// `w a`, `w b`. A closing triangle far off `M` bridges a gap or cuts off a part
+    /// thinner than `L` (an ear, a finger) that the front should climb instead.
+    fn off_surface(&mut self, pa: DVec3, pb: DVec3, pw: DVec3) -> f64 {
+        let l = self.l;
+        let mut worst: f64 = 0.0;
+        for p in [(pa + pb + pw) / 3.0, (pa + pw) * 0.5, (pb + pw) * 0.5] {
+            let d = match self.surf.closest_in_component(p, self.comp, l) {
+                Some((x, _)) => (x - p).length() / l,
+                None => 1.0,
+            };
+            worst = worst.max(d);
+            if worst >= self.tune.off_surface {
+                break;
+            }
+        }
+        worst
+    }
+
+    /// Is closing gate `an -> bn` with existing node `wn` a triangle on the surface?
+    fn on_surface(&mut self, an: u32, bn: u32, wn: u32) -> bool {
+        let [pa, pb, pw] = [an, bn, wn].map(|n| self.pos[self.nodes[n as usize].v as usize]);
+        self.off_surface(pa, pb, pw) < self.tune.off_surface
+    }
+
     /// Does a triangle with unit normal `nt` and corners `pa, pb, pw` face outwards? Judged
     /// against the original's face nearest to its centroid (smoothed vertex normals,
     /// `vertex_sum`, mislead across creases and thin edges; they are the fallback when no
@@ -1252,7 +1290,11 @@ impl Retiler<'_, '_> {
         let open_a = self.wedge(an);
         let close = self.tune.close_angle;
         // Rule 2: a small loop of three closes.
-        if three && (open_a < close || open_b < close) && self.valid_existing(an, bn, xn, true) {
+        if three
+            && (open_a < close || open_b < close)
+            && self.valid_existing(an, bn, xn, true)
+            && self.on_surface(an, bn, xn)
+        {
             return self.apply(an, Tip::Existing(xn));
         }
         // Rule 3: close a small wedge.
@@ -1262,7 +1304,10 @@ impl Retiler<'_, '_> {
                 cands.swap(0, 1);
             }
             for (angle, n) in cands {
-                if angle < close && self.valid_existing(an, bn, n, true) {
+                if angle < close
+                    && self.valid_existing(an, bn, n, true)
+                    && self.on_surface(an, bn, n)
+                {
                     return self.apply(an, Tip::Existing(n));
                 }
             }
@@ -1300,7 +1345,8 @@ impl Retiler<'_, '_> {
                     if let Some(w) = near {
                         // Rule 4: the tip falls on the front: connect to it.
                         for wn in self.nodes_of(w, xn, pn) {
-                            if self.valid_existing(an, bn, wn, true) {
+                            if self.valid_existing(an, bn, wn, true) && self.on_surface(an, bn, wn)
+                            {
                                 return self.apply(an, Tip::Existing(wn));
                             }
                         }
@@ -1452,7 +1498,10 @@ impl Retiler<'_, '_> {
         let mut best: Option<(f64, Option<u32>)> = None;
         for wn in nodes {
             if self.valid_existing(an, bn, wn, false) {
-                let c = self.existing_cost(an, bn, wn);
+                let [pa, pb, pw] =
+                    [an, bn, wn].map(|n| self.pos[self.nodes[n as usize].v as usize]);
+                let off = (self.off_surface(pa, pb, pw) - self.tune.off_surface).max(0.0);
+                let c = self.existing_cost(an, bn, wn) + 2.0 * off;
                 if best.is_none_or(|(bc, _)| c < bc) {
                     best = Some((c, Some(wn)));
                 }
