@@ -1,4 +1,10 @@
-//! Measurement: cost of the swing indices under several context schemes.
+//! Measurement: cost of the swing indices under several context schemes (bits per index),
+//! among them order 0 (stream kinds 0 and 2) and the shipped fan-normal prediction (kinds 3
+//! and 4).
+//!
+//! ```text
+//! cargo run --release -p whet-swing --example swing_ctx -- x BITS L/diag mesh.off...
+//! ```
 #![allow(clippy::unwrap_used, clippy::type_complexity)] // a measurement tool
 use whet_bits::{BitSink, BitTree, CostCounter};
 use whet_codec::{SwingParams, VertexSource};
@@ -61,19 +67,9 @@ fn main() {
                     let fr = params
                         .frame(pos[a.index()], pos[b.index()], pos[c.index()])
                         .unwrap();
-                    let nn = (acc[a.index()] + acc[b.index()]).normalize();
-                    let th = (-(fr.e1.dot(nn))).atan2(fr.e2.dot(nn));
-                    // two solutions th and th+pi: take the one nearer 0
-                    let th = if th.abs() > std::f64::consts::FRAC_PI_2 {
-                        if th > 0.0 {
-                            th - std::f64::consts::PI
-                        } else {
-                            th + std::f64::consts::PI
-                        }
-                    } else {
-                        th
-                    };
-                    preds.push(params.angles.quantize(th));
+                    // The shipped prediction (kinds 3 and 4 of the stream).
+                    let nn = acc[a.index()] + acc[b.index()];
+                    preds.push(whet_codec::swing::predict_swing(&fr, nn, &params.angles));
                     tri_q[tip.face().index()] = Some(q);
                     last_q = q;
                 }
@@ -111,6 +107,9 @@ fn main() {
         let lastq = run(&|r| (1 + bl(zz(r.3)).min(7), 0), 9);
         let lastres = run(&|r| (0, r.3), 1);
         let normpred_b = run(&|r| (1 + bl(zz(r.3)).min(7), r.3), 9);
+        // What the stream codes (kinds 3 and 4): the residual, one tree per bucket of the
+        // prediction.
+        let shipped = run(&|r| (bl(zz(r.3)).min(7), r.3), 8);
         let avg = run(
             &|r| {
                 let p = match (r.1, r.4) {
@@ -131,6 +130,6 @@ fn main() {
             },
             45,
         );
-        println!("{name} B={bits} f={f}: n={} order0 {o0:.3} parent-bucket {pbucket:.3} parent-resid {pres:.3} parent-resid+bucket {pres_b:.3} last-bucket {lastq:.3} NORMAL-PRED {lastres:.3} normpred+bucket {normpred_b:.3} avg-pred {avg:.3} pbucket+label {pb_label:.3}", rows.len());
+        println!("{name} B={bits} f={f}: n={} order0 {o0:.3} parent-bucket {pbucket:.3} parent-resid {pres:.3} parent-resid+bucket {pres_b:.3} last-bucket {lastq:.3} NORMAL-PRED {lastres:.3} normpred+bucket {normpred_b:.3} SHIPPED {shipped:.3} ({:+.1} %) avg-pred {avg:.3} pbucket+label {pb_label:.3}", rows.len(), 100.0 * (shipped / o0 - 1.0));
     }
 }

@@ -1495,22 +1495,25 @@ impl Retiler<'_, '_> {
                 }
             }
         }
-        let mut best: Option<(f64, Option<u32>)> = None;
+        // (cost, cost without the off-surface term, choice): a move that only strays from
+        // the surface is not "forced" (the count that makes the retiler give up).
+        let mut best: Option<(f64, f64, Option<u32>)> = None;
         for wn in nodes {
             if self.valid_existing(an, bn, wn, false) {
                 let [pa, pb, pw] =
                     [an, bn, wn].map(|n| self.pos[self.nodes[n as usize].v as usize]);
                 let off = (self.off_surface(pa, pb, pw) - self.tune.off_surface).max(0.0);
-                let c = self.existing_cost(an, bn, wn) + 2.0 * off;
-                if best.is_none_or(|(bc, _)| c < bc) {
-                    best = Some((c, Some(wn)));
+                let base = self.existing_cost(an, bn, wn);
+                let c = base + 2.0 * off;
+                if best.is_none_or(|(bc, ..)| c < bc) {
+                    best = Some((c, base, Some(wn)));
                 }
             }
         }
         if let Some(sp) = &spare {
             let c = 0.5 + sp.penalty + self.new_cost(an, bn, sp.pos, sp.normal);
-            if best.is_none_or(|(bc, _)| c < bc) {
-                best = Some((c, None));
+            if best.is_none_or(|(bc, ..)| c < bc) {
+                best = Some((c, c, None));
             }
         }
         if trace_var("WHET_SWING_TRACE").is_some() {
@@ -1537,8 +1540,8 @@ impl Retiler<'_, '_> {
             );
         }
         match best {
-            Some((c, choice)) => {
-                if c > 2.0 {
+            Some((_, base, choice)) => {
+                if base > 2.0 {
                     self.stats.forced += 1;
                 }
                 match (choice, spare) {
