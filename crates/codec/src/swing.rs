@@ -155,6 +155,12 @@ impl AngleTable {
         Self::step_of(self.bits)
     }
 
+    /// `1 / Δ` (the prediction multiplies by it).
+    #[inline]
+    pub fn inverse_step(&self) -> f64 {
+        (1u64 << self.bits) as f64 / (2.0 * std::f64::consts::PI)
+    }
+
     /// Smallest swing index.
     #[inline]
     pub fn min_index(&self) -> i32 {
@@ -459,14 +465,21 @@ pub fn predict_swing(frame: &SwingFrame, normal: DVec3, table: &AngleTable) -> i
     };
     let theta = if y < 0.0 { -t } else { t };
     // |θ| ≤ π/2: the index is within the range for every table (at least 3 bits).
-    (theta / table.step()).round() as i32
+    (theta * table.inverse_step()).round() as i32
 }
 
 /// `x` wrapped into the index range of `bits` angle bits.
 #[inline]
 fn wrap_index(x: i32, bits: u32) -> i32 {
+    // Callers pass the sum or difference of two indices: one step of wrapping suffices.
     let half = 1i32 << (bits - 1);
-    (x + half).rem_euclid(2 * half) - half
+    if x >= half {
+        x - 2 * half
+    } else if x < -half {
+        x + 2 * half
+    } else {
+        x
+    }
 }
 
 #[inline]
