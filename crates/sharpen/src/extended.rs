@@ -533,7 +533,8 @@ fn surfaces(run: &Run, planes: &[LabelPlane]) -> usize {
 /// more than the smooth threshold) or are parallel (different regions of one plane).
 #[inline]
 fn same_surface(run: &Run, a: &LabelPlane, b: &LabelPlane) -> bool {
-    a.label == b.label || parallel(run, &a.plane, &b.plane)
+    (a.label == b.label && a.plane.normal.dot(b.plane.normal) >= run.limits.same_region_cos)
+        || parallel(run, &a.plane, &b.plane)
 }
 
 #[inline]
@@ -602,6 +603,7 @@ pub(crate) fn edge_snap(
                 Ok(p) => {
                     if !consistent(run, p, &[(a, x.label), (b, y.label)], scale)
                         || !supported(run, p, &[a, b])
+                        || strip_offset(run, a, b, x, y) > STRIP_TOLERANCE * scale
                     {
                         reason = UnmovedReason::Curved;
                         continue;
@@ -680,6 +682,61 @@ fn consistent(run: &Run, p: DVec3, sources: &[(u32, u32)], scale: f64) -> bool {
     true
 }
 
+/// Snapping assumes that the strip it sharpens lies between the planes it intersects: a
+/// sampler (SwingWrapper, marching cubes) puts its samples on the surface, so across a
+/// chamfered sharp crease every vertex of the strip lies on one of the two faces. Across a
+/// blend a few samples wide the strip's vertices lie on the blend, between the planes, and the
+/// planes meet far above it. An edge snap is refused (reason `curved`) when a vertex opposite
+/// the chamfer edge (with no label of a third surface) lies farther than this fraction of the
+/// chamfer edge from both planes; a corner snap when a vertex of the corner triangle lies
+/// farther than twice this from its own plane (a marching-cubes corner's gray vertices carry
+/// their neighbours' planes, up to [`GRAY_TOLERANCE`] away). Measured on swing-decoded
+/// meshes (docs/results.md): on fandisk and the CAD parts 95 % of the edge snaps are under
+/// 0.1, the snaps that made rocker_arm's blends worse 0.3-0.5; 0.15 costs fandisk some of its
+/// best snaps. Testing the chamfer edge's own ends against their planes too breaks the corners
+/// of marching-cubes samplings (cube 32: max gain 2.6x -> 1.7x).
+pub(crate) const STRIP_TOLERANCE: f64 = 0.25;
+
+/// Largest distance of the vertices opposite edge `a`-`b` from the nearer of planes `x`, `y`
+/// (a vertex with a label plane of a third surface counts as on it).
+fn strip_offset(run: &Run, a: u32, b: u32, x: &LabelPlane, y: &LabelPlane) -> f64 {
+    let mut m = 0.0f64;
+    for c in run.table.vertex_corners(VertexId(a)) {
+        let i = c.index();
+        let (u, w) = (run.cv(next(i)), run.cv(crate::edge_sharpener::prev(i)));
+        let opp = if u == b {
+            w
+        } else if w == b {
+            u
+        } else {
+            continue;
+        };
+        let third = planes_of(run, opp)
+            .iter()
+            .any(|lp| !same_surface(run, lp, x) && !same_surface(run, lp, y));
+        if third {
+            continue;
+        }
+        let q = run.positions[opp as usize];
+        let d = ((q - x.plane.point).dot(x.plane.normal).abs())
+            .min((q - y.plane.point).dot(y.plane.normal).abs());
+        m = m.max(d);
+    }
+    m
+}
+
+/// Largest distance of each vertex from its own plane.
+fn off_planes(run: &Run, pairs: &[(u32, &LabelPlane)]) -> f64 {
+    pairs
+        .iter()
+        .map(|(v, lp)| {
+            (run.positions[*v as usize] - lp.plane.point)
+                .dot(lp.plane.normal)
+                .abs()
+        })
+        .fold(0.0, f64::max)
+}
+
 /// Snaps the new vertex of a corner triangle: the three-plane point of the best combination of
 /// its vertices' planes, else the best line point of two of them.
 pub(crate) fn corner_snap(
@@ -705,6 +762,8 @@ pub(crate) fn corner_snap(
                             &[(tri[0], x.label), (tri[1], y.label), (tri[2], z.label)],
                             2.0 * scale,
                         ) || !supported(run, q, &tri)
+                            || off_planes(run, &[(tri[0], x), (tri[1], y), (tri[2], z)])
+                                > 2.0 * STRIP_TOLERANCE * scale
                         {
                             reason = UnmovedReason::Curved;
                             continue;
@@ -736,6 +795,7 @@ pub(crate) fn corner_snap(
                         run.positions[tri[i] as usize].distance(run.positions[tri[j] as usize]);
                     if !consistent(run, q, &[(tri[i], x.label), (tri[j], y.label)], scale)
                         || !supported(run, q, &tri)
+                        || off_planes(run, &[(tri[i], x), (tri[j], y)]) > STRIP_TOLERANCE * scale
                     {
                         continue;
                     }

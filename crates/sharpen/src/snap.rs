@@ -24,6 +24,9 @@ pub(crate) struct SnapLimits {
     pub parallel_cos: f64,
     /// `sin^2` of the smooth threshold: a triple product under it means dependent normals.
     pub dependent_det: f64,
+    /// Cosine of twice the smooth threshold (at most 90 degrees): two label planes of one
+    /// smooth region turned further apart than that are different surfaces (extended method).
+    pub same_region_cos: f64,
 }
 
 impl SnapLimits {
@@ -36,6 +39,7 @@ impl SnapLimits {
             threshold: t,
             parallel_cos: t.cos(),
             dependent_det: t.sin() * t.sin(),
+            same_region_cos: (2.0 * t).min(90f64.to_radians()).cos(),
         }
     }
 }
