@@ -54,7 +54,10 @@ impl Codec for SwingCodec {
         let opts = self.angle_bits.apply(
             whet_swing::SwingOptions::DEFAULT
                 .with_rate(whet_swing::Rate::BitsPerVertex(rate))
-                .with_error_of(self.error_of),
+                .with_error_of(self.error_of)
+                // Enough to rank angle quantizations whose errors differ by > 3 %; the
+                // sweep's own measurement uses --samples.
+                .with_metro_samples(100_000),
         );
         whet_swing::encode(mesh, &opts)
             .map(|o| o.bytes)

@@ -102,6 +102,44 @@ impl Cells {
     }
 }
 
+impl Cells {
+    /// The keys of the cells overlapping the ball of radius `r` around `p`, with the squared
+    /// distance from `p` to each cell, nearest first (so a nearest-item search can stop as
+    /// soon as the next cell lies farther than the best item found).
+    pub fn by_distance(&self, p: DVec3, r: f64, out: &mut Vec<(f64, u64)>) {
+        out.clear();
+        let d = DVec3::splat(r);
+        let a = self.cell(p - d);
+        let b = self.cell(p + d);
+        let size = 1.0 / self.inv;
+        let gap = |x: f64, o: f64, c: i64| {
+            let lo = o + c as f64 * size;
+            let hi = lo + size;
+            if x < lo {
+                lo - x
+            } else if x > hi {
+                x - hi
+            } else {
+                0.0
+            }
+        };
+        for i in a[0]..=b[0] {
+            let gx = gap(p.x, self.origin.x, i);
+            for j in a[1]..=b[1] {
+                let gy = gap(p.y, self.origin.y, j);
+                for k in a[2]..=b[2] {
+                    let gz = gap(p.z, self.origin.z, k);
+                    let d2 = gx * gx + gy * gy + gz * gz;
+                    if d2 <= r * r {
+                        out.push((d2, Self::key([i, j, k])));
+                    }
+                }
+            }
+        }
+        out.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+    }
+}
+
 /// A static grid: for each non-empty cell the items whose boxes overlap it.
 pub(crate) struct StaticGrid {
     pub cells: Cells,

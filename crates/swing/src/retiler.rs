@@ -330,7 +330,7 @@ pub fn retile(
             continue;
         }
         // Expected triangles: 2.4 · area / L² (algorithms.md 1.9).
-        let budget = (tune.budget_factor * 2.4 * area[c] / (l * l)) as usize + 1000;
+        let budget = (tune.budget_factor * 2.4 * area[c] / (l * l)) as usize + 200;
         let mark = r.mark();
         match r.component(first[c], budget) {
             Ok(()) => r.stats.components += 1,
@@ -711,7 +711,7 @@ impl Retiler<'_, '_> {
             // Fail fast when the front degenerates (a cascade of fallbacks feeds itself):
             // the encoder retries at a slightly different L.
             let built = self.tris.len() - start;
-            if self.stats.forced - forced_before > 100 + built / 50 {
+            if self.stats.forced - forced_before > 30 + built / 50 {
                 return Err(Error::Stuck(format!(
                     "component {} needed {} forced moves in {built} triangles at L = {}",
                     self.comp,

@@ -37,6 +37,8 @@ pub(crate) struct Surface<'m> {
     /// Scratch: the query stamp of each triangle (dedupes triangles seen in several cells).
     stamp: Vec<u32>,
     query: u32,
+    /// Scratch of [`Self::nearest`]: the cells of a query, nearest first.
+    cell_scratch: std::cell::RefCell<Vec<(f64, u64)>>,
 }
 
 impl<'m> Surface<'m> {
@@ -103,6 +105,7 @@ impl<'m> Surface<'m> {
             grid,
             stamp: vec![0; nt],
             query: 0,
+            cell_scratch: Default::default(),
         }
     }
 
@@ -282,30 +285,56 @@ impl<'m> Surface<'m> {
         });
     }
 
-    /// The face normal of the triangle of component `comp` closest to `p`, if one lies
-    /// within `radius` (no scratch state: usable from shared references).
-    pub fn closest_face_normal(&self, p: DVec3, comp: u32, radius: f64) -> Option<DVec3> {
-        let d = DVec3::splat(radius);
+    /// The triangle of component `comp` closest to `p` within `radius`: squared distance,
+    /// closest point, triangle. Cells are visited nearest first and the search stops at the
+    /// first cell farther than the best triangle so far; a triangle whose bounding box is
+    /// farther is skipped without the exact test. Ties go to the lowest triangle index, so
+    /// the answer does not depend on the visiting order.
+    fn nearest(&self, p: DVec3, comp: u32, radius: f64) -> Option<(f64, DVec3, u32)> {
         let mesh = self.mesh;
-        let mut best: Option<(f64, u32)> = None;
-        self.grid.cells.for_box(p - d, p + d, |key| {
+        let mut cells = std::mem::take(&mut *self.cell_scratch.borrow_mut());
+        self.grid.cells.by_distance(p, radius, &mut cells);
+        let mut best: Option<(f64, DVec3, u32)> = None;
+        let limit = radius * radius;
+        for &(cell_d2, key) in &cells {
+            let bound = best.map_or(limit, |b| b.0);
+            if cell_d2 > bound {
+                break;
+            }
             for &t in self.grid.cell_items(key) {
                 let ti = t as usize;
                 if self.component[ti] != comp {
                     continue;
                 }
                 let [a, b, c] = mesh.triangles[ti].map(|v| mesh.positions[v as usize]);
+                let bound = best.map_or(limit, |b| b.0);
+                let gap = (a.min(b).min(c) - p)
+                    .max(p - a.max(b).max(c))
+                    .max(DVec3::ZERO);
+                if gap.length_squared() > bound {
+                    continue;
+                }
                 let x = closest_point_on_triangle(p, a, b, c);
                 let dist = (x - p).length_squared();
-                if best.is_none_or(|(bd, _)| dist < bd) {
-                    best = Some((dist, t));
+                let better = match best {
+                    None => dist <= limit,
+                    Some((bd, _, bt)) => dist < bd || (dist == bd && t < bt),
+                };
+                if better {
+                    best = Some((dist, x, t));
                 }
             }
-        });
-        best.and_then(|(d2, t)| {
-            let n = self.face_normal[t as usize];
-            (d2 <= radius * radius && n != DVec3::ZERO).then_some(n)
-        })
+        }
+        *self.cell_scratch.borrow_mut() = cells;
+        best
+    }
+
+    /// The face normal of the triangle of component `comp` closest to `p`, if one lies
+    /// within `radius` (no scratch state: usable from shared references).
+    pub fn closest_face_normal(&self, p: DVec3, comp: u32, radius: f64) -> Option<DVec3> {
+        let (_, _, t) = self.nearest(p, comp, radius)?;
+        let n = self.face_normal[t as usize];
+        (n != DVec3::ZERO).then_some(n)
     }
 
     /// The closest point to `p` on component `comp` within distance `radius`, with its
@@ -316,28 +345,6 @@ impl<'m> Surface<'m> {
         comp: u32,
         radius: f64,
     ) -> Option<(DVec3, u32)> {
-        let q = self.next_query();
-        let d = DVec3::splat(radius);
-        let mesh = self.mesh;
-        let grid = &self.grid;
-        let stamp = &mut self.stamp;
-        let component = &self.component;
-        let mut best: Option<(f64, DVec3, u32)> = None;
-        grid.cells.for_box(p - d, p + d, |key| {
-            for &t in grid.cell_items(key) {
-                let ti = t as usize;
-                if stamp[ti] == q || component[ti] != comp {
-                    continue;
-                }
-                stamp[ti] = q;
-                let [a, b, c] = mesh.triangles[ti].map(|v| mesh.positions[v as usize]);
-                let x = closest_point_on_triangle(p, a, b, c);
-                let dist = (x - p).length_squared();
-                if best.is_none_or(|(bd, _, _)| dist < bd) {
-                    best = Some((dist, x, t));
-                }
-            }
-        });
-        best.and_then(|(d2, x, t)| (d2 <= radius * radius).then_some((x, t)))
+        self.nearest(p, comp, radius).map(|(_, x, t)| (x, t))
     }
 }
