@@ -12,6 +12,7 @@
 //! (`*.off`) takes `<fixture> <vertex ratio> - <method>` and uses the stand-in retiling of
 //! `support::cached_stand_in`, or `<fixture> <bpv> <angle bits|auto> <method>` and uses the
 //! swing-decoded fixture of `swing_inputs::swing_input` (auto: optimised for sharpening).
+//! Any mesh file (a path with a `/`) takes `<input> <reference> - <method>`.
 
 mod support;
 mod swing_inputs;
@@ -39,8 +40,14 @@ where
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let method: Method = arg(&args, 4, Method::Extended);
-    let swing = args.get(3).is_some_and(|a| a != "-");
-    let (reference, input) = if swing {
+    let files = args.get(1).is_some_and(|a| a.contains('/'));
+    let swing = !files
+        && args.get(1).is_some_and(|a| a.ends_with(".off"))
+        && args.get(3).is_some_and(|a| a != "-");
+    let (reference, input) = if files {
+        let read = |p: &str| or_die(whet_io::read_path(std::path::Path::new(p), None), p);
+        (read(&args[2]), read(&args[1]))
+    } else if swing {
         let bpv: f64 = arg(&args, 2, 4.0);
         let angles = match args[3].as_str() {
             "auto" => swing_inputs::Angles::AutoSharpened,

@@ -216,6 +216,7 @@ impl EdgeSharpener {
             limits: SnapLimits::new(0.0),
             ref_normals: std::collections::HashMap::new(),
             snap_cache: std::collections::HashMap::new(),
+            surface_samples: false,
         };
         let (out, parents, tags) = run.run();
         let mut report = run.report;
@@ -245,6 +246,9 @@ pub(crate) struct Run<'a> {
     pub ref_normals: std::collections::HashMap<u32, DVec3>,
     /// Edge snaps computed while dropping idle splits, by the lower corner of their edge.
     pub snap_cache: std::collections::HashMap<u32, Result<(DVec3, Planes), UnmovedReason>>,
+    /// Extended method: the input is a regular tiling whose vertices are surface samples
+    /// (`crate::extended::is_surface_sampling`).
+    pub surface_samples: bool,
 }
 
 #[inline]

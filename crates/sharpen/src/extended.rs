@@ -65,11 +65,50 @@ pub(crate) struct LabelPlane {
 
 /// Labels regions and border vertices, then classifies the gray vertices.
 pub(crate) fn classify(run: &mut Run) {
+    run.surface_samples = is_surface_sampling(run.mesh);
     demote_corridors(run);
     border_planes(run);
-    gray_vertices(run);
+    if !run.surface_samples {
+        gray_vertices(run);
+    }
     crease_vertices(run);
     snap_chamfer_vertices(run);
+}
+
+/// An input is a *surface sampling* when fewer than this fraction of its triangles have an
+/// angle under [`THIN_ANGLE_DEGREES`] (see [`is_surface_sampling`]). Measured: swing-decoded
+/// fixtures 0-0.1 % (6 and automatic angle bits, 0.4x-3.3x the vertex count), marching cubes
+/// of the synth shapes 14-27 %, the marching-cubes stand-ins of the fixtures 14-16 %.
+pub(crate) const SURFACE_SAMPLING_THIN_FRACTION: f64 = 0.02;
+
+/// See [`SURFACE_SAMPLING_THIN_FRACTION`].
+pub(crate) const THIN_ANGLE_DEGREES: f64 = 20.0;
+
+/// Whether `mesh` looks like a regular retiling (SwingWrapper, isotropic remeshers) rather
+/// than an interpolating grid sampler (marching cubes): almost no thin triangle. A retiler
+/// puts every vertex on the surface and makes near-equilateral triangles, so a vertex with no
+/// smooth triangle around it lies on a blend rather than inside a chamfer, every vertex of a
+/// chamfer strip lies on one of the two faces, and the planes of a curved face are those of
+/// its own samples. Marching cubes puts vertices inside the chamfers it cuts (interpolation
+/// along grid edges) and makes slivers wherever a cell is cut near a crease.
+///
+/// On a surface sampling the extended method (docs/sharpen.md, "Surface samplings") skips the
+/// labelling of gray vertices (on swing-decoded rocker_arm it reached into blends and made
+/// them worse; on the swing-decoded CAD parts it gained nothing) and the consistency test (it
+/// refused good snaps on every swing-decoded CAD part), counts the planes of one region that
+/// turn by more than twice the smooth threshold as two surfaces, and refuses snaps across a
+/// strip that holds a vertex on neither plane ([`STRIP_TOLERANCE`]). Everything else, and
+/// marching-cubes input, is unchanged.
+pub(crate) fn is_surface_sampling(mesh: &whet_mesh::Mesh) -> bool {
+    let nt = mesh.triangles.len();
+    if nt == 0 {
+        return false;
+    }
+    let limit = THIN_ANGLE_DEGREES.to_radians();
+    let thin = (0..nt)
+        .filter(|&t| crate::edge_sharpener::min_angle(&mesh.triangle_positions(t)) < limit)
+        .count();
+    (thin as f64) < SURFACE_SAMPLING_THIN_FRACTION * nt as f64
 }
 
 /// A chamfer vertex moves onto its crease or corner only when that is within this fraction of
@@ -531,9 +570,16 @@ fn surfaces(run: &Run, planes: &[LabelPlane]) -> usize {
 /// Two label planes belong to the same surface when they come from the same smooth region
 /// (whose planes turn along a curved surface: a cylinder's planes two edges apart may differ by
 /// more than the smooth threshold) or are parallel (different regions of one plane).
+///
+/// On a surface sampling, two planes of one region that turn by more than twice the smooth
+/// threshold are different surfaces: a region that wraps around the end of a crease holds
+/// both of its sides, whose chamfer would otherwise never be split (swing-decoded fandisk,
+/// docs/results.md). Marching cubes keeps the region rule (it costs the synth pyramid there).
 #[inline]
 fn same_surface(run: &Run, a: &LabelPlane, b: &LabelPlane) -> bool {
-    (a.label == b.label && a.plane.normal.dot(b.plane.normal) >= run.limits.same_region_cos)
+    (a.label == b.label
+        && (!run.surface_samples
+            || a.plane.normal.dot(b.plane.normal) >= run.limits.same_region_cos))
         || parallel(run, &a.plane, &b.plane)
 }
 
@@ -603,7 +649,8 @@ pub(crate) fn edge_snap(
                 Ok(p) => {
                     if !consistent(run, p, &[(a, x.label), (b, y.label)], scale)
                         || !supported(run, p, &[a, b])
-                        || strip_offset(run, a, b, x, y) > STRIP_TOLERANCE * scale
+                        || (run.surface_samples
+                            && strip_offset(run, a, b, x, y) > STRIP_TOLERANCE * scale)
                     {
                         reason = UnmovedReason::Curved;
                         continue;
@@ -667,7 +714,14 @@ pub(crate) const CURVED_TOLERANCE: f64 = 0.3;
 /// neighbours. Where the surfaces are flat at the scale of the sampling every such plane holds
 /// the point; on a surface curved at that scale (a coarse sampling of a cylinder or cone) the
 /// extrapolated point is off the surface by about the disagreement.
+///
+/// Not applied to surface samplings ([`is_surface_sampling`]), whose curved faces are
+/// sampled by their own vertices: on the swing-decoded CAD parts it refused snaps that the
+/// papers' method makes with profit (docs/results.md).
 fn consistent(run: &Run, p: DVec3, sources: &[(u32, u32)], scale: f64) -> bool {
+    if run.surface_samples {
+        return true;
+    }
     let tol = CURVED_TOLERANCE * scale;
     for &(v, label) in sources {
         for c in run.table.vertex_corners(VertexId(v)) {
@@ -682,20 +736,17 @@ fn consistent(run: &Run, p: DVec3, sources: &[(u32, u32)], scale: f64) -> bool {
     true
 }
 
-/// Snapping assumes that the strip it sharpens lies between the planes it intersects: a
-/// sampler (SwingWrapper, marching cubes) puts its samples on the surface, so across a
-/// chamfered sharp crease every vertex of the strip lies on one of the two faces. Across a
-/// blend a few samples wide the strip's vertices lie on the blend, between the planes, and the
-/// planes meet far above it. An edge snap is refused (reason `curved`) when a vertex opposite
-/// the chamfer edge (with no label of a third surface) lies farther than this fraction of the
-/// chamfer edge from both planes; a corner snap when a vertex of the corner triangle lies
-/// farther than twice this from its own plane (a marching-cubes corner's gray vertices carry
-/// their neighbours' planes, up to [`GRAY_TOLERANCE`] away). Measured on swing-decoded
-/// meshes (docs/results.md): on fandisk and the CAD parts 95 % of the edge snaps are under
-/// 0.1, the snaps that made rocker_arm's blends worse 0.3-0.5; 0.15 costs fandisk some of its
-/// best snaps. Testing the chamfer edge's own ends against their planes too breaks the corners
-/// of marching-cubes samplings (cube 32: max gain 2.6x -> 1.7x).
-pub(crate) const STRIP_TOLERANCE: f64 = 0.25;
+/// On a surface sampling ([`is_surface_sampling`]) every vertex of a chamfer strip across a
+/// sharp crease lies on one of the two faces; across a blend a few samples wide the strip's
+/// vertices lie on the blend, between the planes, which meet far above it. An edge snap is
+/// refused (reason `curved`) when a vertex opposite the chamfer edge (with no label of a third
+/// surface) lies farther than this fraction of the chamfer edge from both planes. Measured on
+/// swing-decoded meshes (docs/results.md): 95 % of the snaps on fandisk and the CAD parts are
+/// under 0.1 (6 angle bits: 0.09), those that made rocker_arm's blends worse 0.3-0.5; 0.25
+/// leaves rocker_arm 2-5 % worse in RMS, 0.15 costs fandisk 2-4 % RMS. Not applied to
+/// marching cubes, which interpolates vertices inside the chamfers (the synth pyramid loses a
+/// fifth of its RMS gain).
+pub(crate) const STRIP_TOLERANCE: f64 = 0.15;
 
 /// Largest distance of the vertices opposite edge `a`-`b` from the nearer of planes `x`, `y`
 /// (a vertex with a label plane of a third surface counts as on it).
@@ -725,18 +776,6 @@ fn strip_offset(run: &Run, a: u32, b: u32, x: &LabelPlane, y: &LabelPlane) -> f6
     m
 }
 
-/// Largest distance of each vertex from its own plane.
-fn off_planes(run: &Run, pairs: &[(u32, &LabelPlane)]) -> f64 {
-    pairs
-        .iter()
-        .map(|(v, lp)| {
-            (run.positions[*v as usize] - lp.plane.point)
-                .dot(lp.plane.normal)
-                .abs()
-        })
-        .fold(0.0, f64::max)
-}
-
 /// Snaps the new vertex of a corner triangle: the three-plane point of the best combination of
 /// its vertices' planes, else the best line point of two of them.
 pub(crate) fn corner_snap(
@@ -762,8 +801,6 @@ pub(crate) fn corner_snap(
                             &[(tri[0], x.label), (tri[1], y.label), (tri[2], z.label)],
                             2.0 * scale,
                         ) || !supported(run, q, &tri)
-                            || off_planes(run, &[(tri[0], x), (tri[1], y), (tri[2], z)])
-                                > 2.0 * STRIP_TOLERANCE * scale
                         {
                             reason = UnmovedReason::Curved;
                             continue;
@@ -795,7 +832,6 @@ pub(crate) fn corner_snap(
                         run.positions[tri[i] as usize].distance(run.positions[tri[j] as usize]);
                     if !consistent(run, q, &[(tri[i], x.label), (tri[j], y.label)], scale)
                         || !supported(run, q, &tri)
-                        || off_planes(run, &[(tri[i], x), (tri[j], y)]) > STRIP_TOLERANCE * scale
                     {
                         continue;
                     }

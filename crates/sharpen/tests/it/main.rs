@@ -7,6 +7,7 @@
 //! - `normal_filter`: the normal filter of issue 10 (figures as regression bounds, guarantees,
 //!   selection, random damage);
 //! - `robustness`: random noise, holes and options never break the output's guarantees.
+//! - `swing`: swing-decoded fixtures (whet-swing, whet-codec as dev-dependencies).
 #![allow(clippy::unwrap_used)] // a panic is a test failure
 
 #[path = "../../examples/support/mod.rs"]
@@ -22,3 +23,4 @@ mod normal_filter;
 mod outputs;
 mod ridge;
 mod robustness;
+mod swing;
