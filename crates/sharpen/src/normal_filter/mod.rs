@@ -3,12 +3,15 @@
 //! `shared/docs/sharpening-extras.md` Part A. Phases, one file each (docs/sharpen.md, "The
 //! normal-filtering sharpener"):
 //!
+//! 0. `denoise` (not in the paper): non-uniform samplings are refused, noisy meshes are denoised
+//!    first (Sun et al. 2007's bilateral normal filter and vertex updates);
 //! 1. `detect`: feature faces by bounded normal variation (A.1-A.2);
 //! 2. `filter`: bilaplacian pre-smoothing of the absolute feature vertices, greedy normal
 //!    filtering from the outside of each feature inwards, normal rectifying (A.3-A.5);
 //! 3. `update` and `remesh`: least-squares vertex updating with flip avoidance, caps swapped and
 //!    needles collapsed (A.6).
 
+mod denoise;
 mod detect;
 mod filter;
 mod remesh;
@@ -143,12 +146,51 @@ pub(crate) fn run(
         .map(|v| table.is_boundary_vertex(VertexId(v as u32)))
         .collect();
 
-    // 1. Detection.
+    // Not in the paper: a mesh of a few large faces and strips of needles (rho in mean edge
+    // lengths means nothing there, and the cap/needle pass collapses the strips) is refused
+    // rather than made worse (docs/sharpen.md, "Noise and non-uniform samplings").
+    let coarse = denoise::coarse_share(&mesh.positions, tris, mean_edge);
+    if coarse > denoise::COARSE_SHARE {
+        return Err(Error::Parameter(format!(
+            "--method normal-filter needs a roughly uniform sampling, and this mesh is not one: \
+             faces with an edge longer than {} mean edge lengths (L = {mean_edge:.3e}) cover \
+             {:.0} % of its surface (at most {:.0} % accepted), so rho (in units of L) and the \
+             needle removal would make it worse; remesh it uniformly first (e.g. `whet synth` \
+             marching cubes, an isotropic remesher) or use --method extended",
+            denoise::COARSE_EDGE,
+            100.0 * coarse,
+            100.0 * denoise::COARSE_SHARE
+        )));
+    }
+
+    // 1. Detection (after denoising a noisy mesh).
     let t0 = Instant::now();
     let mut positions = mesh.positions.clone();
-    let (normals, centroids) = (input_normals.clone(), {
-        normals_and_centroids(&positions, tris).1
-    });
+    let rings = filter::Rings::new(tris, nv);
+    // Not in the paper: a noisy mesh is denoised first, and detection and filtering read the
+    // denoised normals.
+    let denoised = if denoise::noisy_share(&input_normals, &nfi) > denoise::NOISY_SHARE {
+        let movable: Vec<bool> = (0..nv).map(|v| selected[v] && !boundary[v]).collect();
+        Some(denoise::denoise(
+            &mut positions,
+            tris,
+            &rings,
+            &movable,
+            &input_normals,
+            min_area2,
+        ))
+    } else {
+        None
+    };
+    let (mut normals, centroids) = normals_and_centroids(&positions, tris);
+    if let Some(d) = &denoised {
+        normals.clone_from(&d.normals);
+    }
+    for (t, n) in normals.iter_mut().enumerate() {
+        if *n == DVec3::ZERO {
+            *n = input_normals[t];
+        }
+    }
     let eligible: Vec<bool> = tris
         .iter()
         .map(|t| t.iter().all(|&v| selected[v as usize]))
@@ -186,7 +228,6 @@ pub(crate) fn run(
     let smooth: Vec<bool> = (0..nv).map(|v| faft[v] && movable[v]).collect();
     let iterations = (4.0 / opts.rho).ceil().max(0.0) as usize;
     report.presmooth_iterations = iterations;
-    let rings = filter::Rings::new(tris, nv);
     filter::presmooth(
         &mut positions,
         tris,
@@ -197,6 +238,9 @@ pub(crate) fn run(
         &input_normals,
     );
     let (mut normals, centroids) = normals_and_centroids(&positions, tris);
+    if let Some(d) = &denoised {
+        normals.clone_from(&d.normals);
+    }
     for (t, n) in normals.iter_mut().enumerate() {
         if *n == DVec3::ZERO {
             *n = input_normals[t];

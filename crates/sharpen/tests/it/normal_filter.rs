@@ -90,6 +90,50 @@ fn chamfered_box_sampling_gains_at_least_twice() {
 }
 
 #[test]
+fn noisy_box_sampling_is_denoised_then_sharpened() {
+    // Marching cubes of the box at 32 with `--noise 0.3` (seed 7): measured 2.27x (r0) and
+    // 2.15x (r1) RMS with 100k Metro samples (0.38x and 0.36x before the denoising pass). The
+    // bound sits under the measurement by the spread of the sampling, not 25 %: the target
+    // itself is 2x.
+    for rot in 0..2 {
+        let truth = shape(ShapeKind::Box, rot).truth_mesh();
+        let input = add_noise(
+            &marching_cubes(&shape(ShapeKind::Box, rot), 32).unwrap(),
+            0.3,
+            7,
+        );
+        let out = sharpen(&input, &nf()).unwrap();
+        assert_valid(&input, &out);
+        let (e0, e1) = (
+            error(&truth, &input, Some(100_000)),
+            error(&truth, &out.mesh, Some(100_000)),
+        );
+        assert!(e0.rms_pct / e1.rms_pct > 2.0, "r{rot}: {e0:?} -> {e1:?}");
+        let c = check(&truth, &input, &out);
+        assert!(c.reversed <= 12, "r{rot}: {} reversed", c.reversed);
+    }
+}
+
+#[test]
+fn non_uniform_samplings_are_refused() {
+    // The exact blend mesh: two triangles per flat side, strips of needles on the fillets
+    // (faces with an edge over 8 L cover 98-99 % of it). The method made it 3-4x worse before
+    // it refused it.
+    for rot in 0..2 {
+        let input = shape(ShapeKind::Blend, rot).truth_mesh();
+        match sharpen(&input, &nf()) {
+            Err(whet_sharpen::Error::Parameter(m)) => {
+                assert!(m.contains("roughly uniform sampling"), "{m}")
+            }
+            other => panic!("r{rot}: {:?}", other.map(|s| s.report)),
+        }
+    }
+    // A clean sampling of the same shape is accepted.
+    let mc = marching_cubes(&shape(ShapeKind::Blend, 0), 24).unwrap();
+    assert!(sharpen(&mc, &nf()).is_ok());
+}
+
+#[test]
 fn already_sharp_meshes_are_left_alone() {
     // The box truth mesh: every edge is a true crease, which lambda keeps out of every
     // neighbourhood, so nothing is a feature.
