@@ -104,11 +104,37 @@ pub(crate) fn is_surface_sampling(mesh: &whet_mesh::Mesh) -> bool {
     if nt == 0 {
         return false;
     }
-    let limit = THIN_ANGLE_DEGREES.to_radians();
-    let thin = (0..nt)
-        .filter(|&t| crate::edge_sharpener::min_angle(&mesh.triangle_positions(t)) < limit)
-        .count();
-    (thin as f64) < SURFACE_SAMPLING_THIN_FRACTION * nt as f64
+    // One pass without trigonometry (the smallest angle is opposite the shortest edge; it is
+    // under the limit when its cosine is above the limit's), stopping as soon as the count
+    // decides: marching cubes is decided within its first tenth.
+    let cos2 = THIN_ANGLE_DEGREES.to_radians().cos().powi(2);
+    let allowed = (SURFACE_SAMPLING_THIN_FRACTION * nt as f64).ceil() as usize;
+    let mut thin = 0usize;
+    for t in 0..nt {
+        let p = mesh.triangle_positions(t);
+        let l = [
+            p[1].distance_squared(p[2]),
+            p[2].distance_squared(p[0]),
+            p[0].distance_squared(p[1]),
+        ];
+        let k = if l[0] <= l[1] && l[0] <= l[2] {
+            0
+        } else if l[1] <= l[2] {
+            1
+        } else {
+            2
+        };
+        let (a, b) = (l[(k + 2) % 3], l[(k + 1) % 3]);
+        let d = (p[(k + 1) % 3] - p[k]).dot(p[(k + 2) % 3] - p[k]);
+        // Degenerate triangles (a zero side: a * b == 0) count as thin.
+        if a * b == 0.0 || (d > 0.0 && d * d > cos2 * a * b) {
+            thin += 1;
+            if thin >= allowed {
+                return false;
+            }
+        }
+    }
+    true
 }
 
 /// A chamfer vertex moves onto its crease or corner only when that is within this fraction of
