@@ -218,3 +218,76 @@ fn presmoothing_flattens_a_spike() {
     );
     assert!(p[c].z.abs() < 0.05, "{}", p[c].z);
 }
+
+#[test]
+fn a_noisy_roof_is_denoised_and_its_crease_kept() {
+    // The roof (crease at x = 0.5, sides at +-45 degrees) with noise along z on the interior
+    // vertices: more than half of the faces are noisy, so the denoising pass runs; the sides
+    // come out flatter (distance to the true roof) and the boundary stays put.
+    let clean = roof(16, 1.0);
+    let mut rng = whet_synth::SplitMix64::new(3);
+    let mut noisy = clean.clone();
+    for (v, p) in noisy.positions.iter_mut().enumerate() {
+        let (i, j) = (v % 17, v / 17);
+        if i > 0 && i < 16 && j > 0 && j < 16 {
+            p.z += 0.02 * rng.next_signed();
+        }
+    }
+    let dist = |m: &Mesh| -> f64 {
+        m.positions
+            .iter()
+            .map(|p| (p.z - 0.5 + (p.x - 0.5).abs()).abs() / 2f64.sqrt())
+            .sum::<f64>()
+            / m.positions.len() as f64
+    };
+    let table = CornerTable::new(&noisy).unwrap();
+    let nfi: Vec<[u32; 3]> = (0..noisy.triangles.len())
+        .map(|t| {
+            [0, 1, 2].map(|k| {
+                table
+                    .opposite(CornerId((3 * t + k) as u32))
+                    .map_or(NONE, |o| o.0 / 3)
+            })
+        })
+        .collect();
+    let (normals, _) = normals_and_centroids(&noisy.positions, &noisy.triangles);
+    assert!(denoise::noisy_share(&normals, &nfi) > denoise::NOISY_SHARE);
+    let (clean_normals, _) = normals_and_centroids(&clean.positions, &clean.triangles);
+    assert_eq!(denoise::noisy_share(&clean_normals, &nfi), 0.0);
+    let out = sharpen(&noisy, &nf()).unwrap();
+    assert!(
+        dist(&out.mesh) < dist(&noisy) / 2.0,
+        "{} -> {}",
+        dist(&noisy),
+        dist(&out.mesh)
+    );
+    for (v, p) in noisy.positions.iter().enumerate() {
+        let (i, j) = (v % 17, v / 17);
+        if i == 0 || i == 16 || j == 0 || j == 16 {
+            assert_eq!(out.mesh.positions[v], *p);
+        }
+    }
+}
+
+#[test]
+fn uniform_samplings_have_no_coarse_faces() {
+    let m = roof(8, 1.0);
+    assert_eq!(
+        denoise::coarse_share(&m.positions, &m.triangles, m.mean_edge_length()),
+        0.0
+    );
+    // One large triangle fan around many tiny ones: the large faces cover most of the area.
+    let mut positions = vec![
+        DVec3::new(0.0, 0.0, 0.0),
+        DVec3::new(10.0, 0.0, 0.0),
+        DVec3::new(0.0, 10.0, 0.0),
+    ];
+    let mut triangles = vec![[0, 1, 2]];
+    for k in 0..200u32 {
+        let o = DVec3::new(20.0 + 0.01 * k as f64, 0.0, 0.0);
+        positions.extend([o, o + DVec3::X * 0.01, o + DVec3::Y * 0.01]);
+        triangles.push([3 + 3 * k, 4 + 3 * k, 5 + 3 * k]);
+    }
+    let m = Mesh::new(positions, triangles);
+    assert!(denoise::coarse_share(&m.positions, &m.triangles, m.mean_edge_length()) > 0.99);
+}
