@@ -245,6 +245,13 @@ pub struct FitReport {
     pub rms_distance: f64,
     /// Largest such distance.
     pub max_distance: f64,
+    /// Root mean square distance from the limit vertices of the fitted surface to the input
+    /// (the other direction; it catches surface parts no input vertex is near).
+    pub reverse_rms_distance: f64,
+    /// Largest such distance.
+    pub reverse_max_distance: f64,
+    /// Whether the returned surface is not the last iterate (see [`FitFallback`]).
+    pub fallback: FitFallback,
     /// `sum |M p - t|^2` of the sharpness subproblem before and after each h-step (unit
     /// diagonal), for the solver comparison.
     pub h_objective: Vec<(f64, f64)>,
@@ -254,6 +261,104 @@ pub struct FitReport {
     pub fit_ms: f64,
     /// Milliseconds of the fit spent in the sharpness subproblem.
     pub sharpness_ms: f64,
+}
+
+/// What [`fit_control`] returned when the last iterate of the augmented Lagrangian was not
+/// the best surface it measured. Every candidate is scored by its symmetric RMS distance to
+/// the input (input vertices to the limit surface, limit vertices to the input).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum FitFallback {
+    /// The last iterate was the best.
+    None,
+    /// An earlier iterate was better (0: the control mesh's points with the initial
+    /// sharpness); the fit drifted after it.
+    Iteration(u32),
+    /// Continuous mode only: the control mesh itself, every edge fully sharp (the
+    /// subdivision then reproduces the piecewise-linear control mesh), was better than any
+    /// smooth or semi-sharp iterate (polyhedral inputs).
+    Polyhedral,
+}
+
+/// One candidate result of the fit and its error against the input (unit-diagonal units).
+struct Snapshot {
+    p: Vec<DVec3>,
+    h: Vec<f64>,
+    error: SurfaceError,
+    iteration: u32,
+}
+
+impl Snapshot {
+    fn evaluate(
+        hier: &Hierarchy,
+        p: &[DVec3],
+        h: &[f64],
+        depth: usize,
+        data: &[DVec3],
+        input_bvh: &Bvh,
+        iteration: u32,
+    ) -> Snapshot {
+        let c = compose(hier, h, depth);
+        let x = c.apply(p);
+        let fine = Mesh::new(x.clone(), hier.finest().triangles.clone());
+        let bvh = Bvh::new(&fine);
+        let feet: Vec<DVec3> = data
+            .par_iter()
+            .map(|&v| bvh.closest_point(v).point)
+            .collect();
+        let rev: Vec<DVec3> = x
+            .par_iter()
+            .map(|&xj| input_bvh.closest_point(xj).point)
+            .collect();
+        Snapshot {
+            p: p.to_vec(),
+            h: h.to_vec(),
+            error: SurfaceError::measure(data, &feet, &x, &rev),
+            iteration,
+        }
+    }
+}
+
+/// Distances between the input and a surface, both ways.
+#[derive(Clone, Copy, Debug)]
+struct SurfaceError {
+    rms_forward: f64,
+    max_forward: f64,
+    rms_reverse: f64,
+    max_reverse: f64,
+}
+
+impl SurfaceError {
+    /// `data[i]` against its foot `feet[i]` on the surface, limit vertex `x[j]` against its
+    /// closest input point `rev[j]`.
+    fn measure(data: &[DVec3], feet: &[DVec3], x: &[DVec3], rev: &[DVec3]) -> SurfaceError {
+        let stats = |a: &[DVec3], b: &[DVec3]| {
+            let (sum, max) = a
+                .iter()
+                .zip(b)
+                .map(|(p, q)| (*p - *q).length())
+                .fold((0.0, 0.0f64), |(s, m), d| (s + d * d, m.max(d)));
+            ((sum / a.len().max(1) as f64).sqrt(), max)
+        };
+        let (rms_forward, max_forward) = stats(data, feet);
+        let (rms_reverse, max_reverse) = stats(x, rev);
+        SurfaceError {
+            rms_forward,
+            max_forward,
+            rms_reverse,
+            max_reverse,
+        }
+    }
+
+    /// Symmetric RMS distance; NaN (a broken iterate) scores worst.
+    fn score(&self) -> f64 {
+        let s = (0.5 * (self.rms_forward.powi(2) + self.rms_reverse.powi(2))).sqrt();
+        if s.is_nan() {
+            f64::INFINITY
+        } else {
+            s
+        }
+    }
 }
 
 /// A fitted surface: control mesh, sharpness, and the report.
@@ -390,6 +495,7 @@ pub fn fit_control(
     let mut h_objective = Vec::new();
     let mut iterations = 0;
     let eps0 = 1e-12 * m as f64;
+    let mut best: Option<Snapshot> = None;
     for outer in 0..opts.iterations {
         iterations = outer + 1;
         let p_old = p.clone();
@@ -399,14 +505,26 @@ pub fn fit_control(
         let foot: Vec<[u32; 3]> = foot_t.iter().map(|&t| fine_tris[t as usize]).collect();
         let mut mm = feet_matrix(&c, &foot, &bary);
         // Reverse correspondences: each limit vertex and its closest input point.
-        let rev_target: Vec<DVec3> = if w_rev > 0.0 {
-            let x = c.apply(&p);
-            x.par_iter()
-                .map(|&xj| input_bvh.closest_point(xj).point)
-                .collect()
-        } else {
-            Vec::new()
-        };
+        let x = c.apply(&p);
+        let rev_target: Vec<DVec3> = x
+            .par_iter()
+            .map(|&xj| input_bvh.closest_point(xj).point)
+            .collect();
+        // The surface this iteration starts from (the control mesh's own surface first),
+        // measured both ways; the fit returns the best one it saw.
+        let error = SurfaceError::measure(&data, &mm.apply(&p), &x, &rev_target);
+        if best
+            .as_ref()
+            .is_none_or(|b| error.score() < b.error.score())
+        {
+            best = Some(Snapshot {
+                p: p.clone(),
+                h: h.clone(),
+                error,
+                iteration: outer,
+            });
+        }
+        let rev_target = if w_rev > 0.0 { rev_target } else { Vec::new() };
         for _ in 0..opts.inner_iterations.max(1) {
             // p-step.
             let rhs_l: Vec<DVec3> = (0..m).map(|i| q[i] + lq[i] / aq).collect();
@@ -513,17 +631,53 @@ pub fn fit_control(
             break;
         }
     }
-    // Report: distances of the data to the final surface.
-    let c = compose(&hier, &h, depth);
-    let x = c.apply(&p);
-    let fine = Mesh::new(x, hier.finest().triangles.clone());
-    let bvh = Bvh::new(&fine);
-    let d: Vec<f64> = data
-        .par_iter()
-        .map(|&v| bvh.closest_point(v).distance)
-        .collect();
-    let rms = (d.iter().map(|x| x * x).sum::<f64>() / n.max(1) as f64).sqrt() / scale;
-    let max = d.iter().copied().fold(0.0, f64::max) / scale;
+    // Safeguard: the final iterate against the best one seen (iteration 0 is the control
+    // mesh's own surface), and in continuous mode against the control mesh itself (every edge
+    // sharp reproduces it exactly). An augmented Lagrangian that drifts (ill-shaped control
+    // triangles, surface parts no data point projects onto) can then never return a surface
+    // worse than what it started from.
+    let mut candidates_final = vec![Snapshot::evaluate(
+        &hier, &p, &h, depth, &data, &input_bvh, iterations,
+    )];
+    if let Some(b) = best {
+        candidates_final.push(b);
+    }
+    if opts.mode == SharpnessMode::Continuous {
+        let p0: Vec<DVec3> = control.positions.iter().map(|&x| to_unit(x)).collect();
+        let ones = vec![1.0; h.len()];
+        candidates_final.push(Snapshot::evaluate(
+            &hier, &p0, &ones, depth, &data, &input_bvh, 0,
+        ));
+    }
+    // Ties go to the earliest candidate: the final iterate.
+    let chosen = candidates_final
+        .into_iter()
+        .reduce(|a, b| {
+            if b.error.score() < a.error.score() {
+                b
+            } else {
+                a
+            }
+        })
+        .expect("at least the final iterate");
+    let fallback = if chosen.iteration == iterations {
+        FitFallback::None
+    } else if chosen.h.iter().all(|&x| x == 1.0)
+        && opts.mode == SharpnessMode::Continuous
+        && chosen.iteration == 0
+        && chosen
+            .p
+            .iter()
+            .zip(&control.positions)
+            .all(|(a, b)| *a == to_unit(*b))
+    {
+        FitFallback::Polyhedral
+    } else {
+        FitFallback::Iteration(chosen.iteration)
+    };
+    let Snapshot { p, h, error, .. } = chosen;
+    let rms = error.rms_forward / scale;
+    let max = error.max_forward / scale;
     let positions: Vec<DVec3> = p.iter().map(|&x| x / scale + centre).collect();
     let control_mesh = Mesh::new(positions, control.triangles.clone());
     let sharpness = EdgeSharpness::from_parts(initial.edges().to_vec(), h);
@@ -534,6 +688,9 @@ pub fn fit_control(
         iterations,
         rms_distance: rms,
         max_distance: max,
+        reverse_rms_distance: error.rms_reverse / scale,
+        reverse_max_distance: error.max_reverse / scale,
+        fallback,
         h_objective,
         simplify_ms: 0.0,
         fit_ms: start.elapsed().as_secs_f64() * 1e3,

@@ -39,7 +39,7 @@ mod topology;
 
 pub use denoise::bilateral_denoise;
 pub use fit::{
-    fit, fit_control, initial_sharpness, FitOptions, FitReport, Fitted, SharpnessMode,
+    fit, fit_control, initial_sharpness, FitFallback, FitOptions, FitReport, Fitted, SharpnessMode,
     SharpnessSolver,
 };
 pub use qem::{simplify, Simplified, SimplifyOptions};

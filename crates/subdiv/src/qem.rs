@@ -15,7 +15,10 @@
 //! is singular). A collapse is refused when it breaks the link condition (it would change
 //! the topology), joins two boundary vertices through the interior, leaves a vertex with
 //! fewer than three neighbours, turns a triangle by more than about 72 degrees or makes it a
-//! needle. So the output is an oriented manifold of the input's genus whenever the input is
+//! needle (quality below 0.02, or below the worst triangle already around the edge: inputs
+//! meshed in long strips, such as midpoint subdivisions of CAD facets, are full of needles,
+//! and an absolute threshold stalled them far above the target with a folded control mesh).
+//! Refused collapses are retried when the heap runs dry above the target. So the output is an oriented manifold of the input's genus whenever the input is
 //! one. Not handled: non-manifold input (refused), attribute seams, volume preservation.
 
 use crate::sharpness::dihedral_angles;
@@ -324,8 +327,28 @@ pub fn simplify(mesh: &Mesh, opts: &SimplifyOptions) -> Result<Simplified, Error
     let mut max_error: f64 = 0.0;
     let mut nbrs_u: Vec<u32> = Vec::new();
     let mut nbrs_v: Vec<u32> = Vec::new();
+    // A refused collapse leaves the heap; it comes back only when one of its endpoints
+    // changes, although a collapse next to it can make it valid. So when the heap runs dry
+    // above the target, every live edge is queued again, until a pass collapses nothing.
+    let mut collapsed_this_pass = 0usize;
     while alive_vertices > opts.target_vertices {
-        let Some(c) = heap.pop() else { break };
+        let Some(c) = heap.pop() else {
+            if collapsed_this_pass == 0 {
+                break;
+            }
+            collapsed_this_pass = 0;
+            for (t, f) in faces.iter().enumerate() {
+                if alive_face[t] {
+                    for k in 0..3 {
+                        let (a, b) = (f[k], f[(k + 1) % 3]);
+                        if a < b || !faces_have_edge(&vfaces[b as usize], &faces, b, a) {
+                            heap.push(candidate(a, b, &quad, &pos, &stamp));
+                        }
+                    }
+                }
+            }
+            continue;
+        };
         let (u, v) = (c.u as usize, c.v as usize);
         if stamp[u] != c.stamp_u || stamp[v] != c.stamp_v || !used[u] || !used[v] {
             continue;
@@ -362,38 +385,11 @@ pub fn simplify(mesh: &Mesh, opts: &SimplifyOptions) -> Result<Simplified, Error
                 neighbours(x as usize, &vfaces, &faces, &mut n);
                 n.len() > 3
             });
-        let ok_geometry = ok_link
+        if !(ok_link
             && ok_boundary
             && ok_valence
-            && [u, v].iter().all(|&w| {
-                vfaces[w].iter().all(|&t| {
-                    let f = faces[t as usize];
-                    if f.contains(&(u as u32)) && f.contains(&(v as u32)) {
-                        return true;
-                    }
-                    let old = f.map(|i| pos[i as usize]);
-                    let new = f.map(|i| {
-                        if i as usize == u || i as usize == v {
-                            c.target
-                        } else {
-                            pos[i as usize]
-                        }
-                    });
-                    let n0 = (old[1] - old[0]).cross(old[2] - old[0]);
-                    let n1 = (new[1] - new[0]).cross(new[2] - new[0]);
-                    let l0 = n0.length();
-                    let l1 = n1.length();
-                    if l0 == 0.0 || l1 == 0.0 {
-                        return l1 > 0.0;
-                    }
-                    let sum2 = (new[1] - new[0]).length_squared()
-                        + (new[2] - new[1]).length_squared()
-                        + (new[0] - new[2]).length_squared();
-                    let quality = 2.0 * 3f64.sqrt() * l1 / sum2;
-                    n0.dot(n1) >= MIN_NORMAL_COS * l0 * l1 && quality >= MIN_QUALITY
-                })
-            });
-        if !ok_geometry {
+            && geometry_ok(u, v, c.target, &vfaces, &faces, &pos))
+        {
             refused += 1;
             continue;
         }
@@ -420,6 +416,7 @@ pub fn simplify(mesh: &Mesh, opts: &SimplifyOptions) -> Result<Simplified, Error
         }
         used[v] = false;
         alive_vertices -= 1;
+        collapsed_this_pass += 1;
         stamp[u] = stamp[u].wrapping_add(1);
         stamp[v] = stamp[v].wrapping_add(1);
         neighbours(u, &vfaces, &faces, &mut nbrs_u);
@@ -452,6 +449,72 @@ pub fn simplify(mesh: &Mesh, opts: &SimplifyOptions) -> Result<Simplified, Error
         crease_edges,
         refused,
         max_error,
+    })
+}
+
+/// Whether moving `u` and `v` to `target` keeps every surviving triangle around them from
+/// turning by more than about 72 degrees or becoming a needle.
+fn geometry_ok(
+    u: usize,
+    v: usize,
+    target: DVec3,
+    vfaces: &[Vec<u32>],
+    faces: &[[u32; 3]],
+    pos: &[DVec3],
+) -> bool {
+    // Needles already there (inputs meshed in long strips have many) are no reason to refuse
+    // a collapse, as long as it does not make the worst triangle around worse.
+    let min_quality = [u, v]
+        .iter()
+        .flat_map(|&w| vfaces[w].iter())
+        .map(|&t| quality(faces[t as usize].map(|i| pos[i as usize])))
+        .fold(MIN_QUALITY, f64::min);
+    [u, v].iter().all(|&w| {
+        vfaces[w].iter().all(|&t| {
+            let f = faces[t as usize];
+            if f.contains(&(u as u32)) && f.contains(&(v as u32)) {
+                return true;
+            }
+            let old = f.map(|i| pos[i as usize]);
+            let new = f.map(|i| {
+                if i as usize == u || i as usize == v {
+                    target
+                } else {
+                    pos[i as usize]
+                }
+            });
+            let n0 = (old[1] - old[0]).cross(old[2] - old[0]);
+            let n1 = (new[1] - new[0]).cross(new[2] - new[0]);
+            let l0 = n0.length();
+            let l1 = n1.length();
+            if l0 == 0.0 || l1 == 0.0 {
+                return l1 > 0.0;
+            }
+            n0.dot(n1) >= MIN_NORMAL_COS * l0 * l1 && quality(new) >= min_quality
+        })
+    })
+}
+
+/// `4 sqrt 3 area / sum of squared edges`: 1 for an equilateral triangle, 0 for a degenerate.
+fn quality(p: [DVec3; 3]) -> f64 {
+    let sum2 = (p[1] - p[0]).length_squared()
+        + (p[2] - p[1]).length_squared()
+        + (p[0] - p[2]).length_squared();
+    let q = 2.0 * 3f64.sqrt() * (p[1] - p[0]).cross(p[2] - p[0]).length() / sum2;
+    if q.is_finite() {
+        q
+    } else {
+        0.0
+    }
+}
+
+/// Whether a live triangle of `b` (listed in `b_faces`) has the directed edge `b -> a`; an
+/// undirected edge is queued once, from its lower id, unless it is a boundary edge seen only
+/// in the other direction.
+fn faces_have_edge(b_faces: &[u32], faces: &[[u32; 3]], b: u32, a: u32) -> bool {
+    b_faces.iter().any(|&t| {
+        let f = faces[t as usize];
+        (0..3).any(|k| f[k] == b && f[(k + 1) % 3] == a)
     })
 }
 
