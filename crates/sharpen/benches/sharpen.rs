@@ -5,6 +5,9 @@
 //! elements (input triangles) per second.
 //!
 //! The sharpener itself is single-threaded; marching cubes (setup only) uses rayon.
+//!
+//! Also the real input: fandisk and joint encoded by whet-swing (6 angle bits, at about 2x
+//! their vertex count: 28k and 77k triangles) and decoded by whet-codec, named `*_swing_*`.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use glam::{DQuat, DVec3};
@@ -29,6 +32,34 @@ fn bench(c: &mut Criterion) {
         let mesh = match marching_cubes(&shape, resolution) {
             Ok(m) => m,
             Err(e) => panic!("marching cubes failed: {e}"),
+        };
+        group.throughput(Throughput::Elements(mesh.triangles.len() as u64));
+        for method in [Method::Papers, Method::Extended] {
+            let mut sharpener = EdgeSharpener::new(SharpenOptions::DEFAULT.with_method(method));
+            group.bench_function(format!("{}_{name}", method.name()), |b| {
+                b.iter(|| sharpener.sharpen(&mesh))
+            });
+        }
+    }
+    for (name, fixture, bpv) in [
+        ("swing_fandisk_28k", "fandisk.off", 6.4),
+        ("swing_joint_77k", "joint.off", 4.3),
+    ] {
+        let original = match whet_io::read_path(&whet_testkit::shared_fixture(fixture), None) {
+            Ok(m) => m,
+            Err(e) => panic!("{fixture}: {e}"),
+        };
+        let opts = whet_swing::SwingOptions::DEFAULT
+            .with_rate(whet_swing::Rate::BitsPerVertex(bpv))
+            .with_angle_bits(6);
+        let mesh = match whet_swing::encode(&original, &opts)
+            .map_err(|e| e.to_string())
+            .and_then(|out| {
+                whet_codec::decode(&out.bytes, &whet_codec::DecodeOptions::DEFAULT)
+                    .map_err(|e| e.to_string())
+            }) {
+            Ok(m) => m,
+            Err(e) => panic!("{fixture}: {e}"),
         };
         group.throughput(Throughput::Elements(mesh.triangles.len() as u64));
         for method in [Method::Papers, Method::Extended] {

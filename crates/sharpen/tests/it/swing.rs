@@ -23,7 +23,8 @@ fn swing_decoded(name: &str, bpv: f64) -> (Mesh, Mesh) {
 
 #[test]
 fn swing_decoded_fandisk_is_sharpened_and_rocker_arm_not_made_worse() {
-    // docs/results.md, "Swing-decoded CAD fixtures", 4 bpv at 6 angle bits: fandisk RMS
+    // docs/results.md, "Swing-decoded CAD fixtures", the first run's rows at 4 bpv and 6 angle
+    // bits (sharpen_figures, 1M Metro samples; here 200k): fandisk RMS
     // 0.091 % -> 0.038 % (2.4x), max 1.03 % -> 0.58 % (1.8x); rocker_arm (smooth blends)
     // RMS 0.0376 % -> 0.0374 %, max unchanged. Before the surface-sampling rules rocker_arm
     // went to 0.0409 % and 0.47 %.
