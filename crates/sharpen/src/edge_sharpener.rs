@@ -1221,6 +1221,19 @@ fn normal_angle(a: DVec3, b: DVec3) -> f64 {
 /// below anything the 1-degree sliver test or a quality comparison resolves).
 #[inline]
 pub(crate) fn min_angle(p: &[DVec3; 3]) -> f64 {
+    let (k, _) = smallest_angle_corner(p);
+    let e1 = p[(k + 1) % 3] - p[k];
+    let e2 = p[(k + 2) % 3] - p[k];
+    if e1 == DVec3::ZERO || e2 == DVec3::ZERO {
+        return 0.0;
+    }
+    fast_angle(e1, e2)
+}
+
+/// The corner with the smallest angle of triangle `p` (the one opposite its shortest side;
+/// ties to the lower index) and the squared side lengths `[|p1 p2|², |p2 p0|², |p0 p1|²]`.
+#[inline]
+pub(crate) fn smallest_angle_corner(p: &[DVec3; 3]) -> (usize, [f64; 3]) {
     let l = [
         p[1].distance_squared(p[2]),
         p[2].distance_squared(p[0]),
@@ -1233,12 +1246,7 @@ pub(crate) fn min_angle(p: &[DVec3; 3]) -> f64 {
     } else {
         2
     };
-    let e1 = p[(k + 1) % 3] - p[k];
-    let e2 = p[(k + 2) % 3] - p[k];
-    if e1 == DVec3::ZERO || e2 == DVec3::ZERO {
-        return 0.0;
-    }
-    fast_angle(e1, e2)
+    (k, l)
 }
 
 /// Angle between two vectors with an absolute error under 2e-5 rad: `atan2` by a minimax

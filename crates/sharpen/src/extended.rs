@@ -115,18 +115,7 @@ pub(crate) fn is_surface_sampling(mesh: &whet_mesh::Mesh) -> bool {
     let mut thin = 0usize;
     for t in 0..nt {
         let p = mesh.triangle_positions(t);
-        let l = [
-            p[1].distance_squared(p[2]),
-            p[2].distance_squared(p[0]),
-            p[0].distance_squared(p[1]),
-        ];
-        let k = if l[0] <= l[1] && l[0] <= l[2] {
-            0
-        } else if l[1] <= l[2] {
-            1
-        } else {
-            2
-        };
+        let (k, l) = crate::edge_sharpener::smallest_angle_corner(&p);
         let (a, b) = (l[(k + 2) % 3], l[(k + 1) % 3]);
         let d = (p[(k + 1) % 3] - p[k]).dot(p[(k + 2) % 3] - p[k]);
         // Degenerate triangles (a zero side: a * b == 0) count as thin.

@@ -102,14 +102,7 @@ pub(crate) fn denoise(
 ) -> Denoised {
     let nv = positions.len();
     let nt = tris.len();
-    let mut vf: Vec<Vec<u32>> = (0..nv)
-        .map(|v| Vec::with_capacity(rings.of(v).len()))
-        .collect();
-    for (t, tri) in tris.iter().enumerate() {
-        for &v in tri {
-            vf[v as usize].push(t as u32);
-        }
-    }
+    let vf = rings.vertex_faces(nv, tris);
     // Faces sharing a vertex with each face (itself included).
     let mut around: Vec<Vec<u32>> = Vec::with_capacity(nt);
     for tri in tris {

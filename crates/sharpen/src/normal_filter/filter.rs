@@ -69,6 +69,19 @@ impl Rings {
     pub fn of(&self, v: usize) -> &[u32] {
         &self.list[self.start[v] as usize..self.start[v + 1] as usize]
     }
+
+    /// The triangles around each vertex (for the vertex updates), sized by the rings.
+    pub fn vertex_faces(&self, nv: usize, tris: &[[u32; 3]]) -> Vec<Vec<u32>> {
+        let mut vf: Vec<Vec<u32>> = (0..nv)
+            .map(|v| Vec::with_capacity(self.of(v).len()))
+            .collect();
+        for (t, tri) in tris.iter().enumerate() {
+            for &v in tri {
+                vf[v as usize].push(t as u32);
+            }
+        }
+        vf
+    }
 }
 
 /// `ceil(4 L / rho)` Jacobi steps of Kobbelt's umbrella bilaplacian on the `movable` vertices

@@ -260,14 +260,7 @@ pub(crate) fn run(
 
     // 3. Updating.
     let t2 = Instant::now();
-    let mut vf: Vec<Vec<u32>> = (0..nv)
-        .map(|v| Vec::with_capacity(rings.of(v).len()))
-        .collect();
-    for (t, tri) in tris.iter().enumerate() {
-        for &v in tri {
-            vf[v as usize].push(t as u32);
-        }
-    }
+    let vf = rings.vertex_faces(nv, tris);
     let mut dm = remesh::DynMesh {
         pos: positions,
         tris: tris.clone(),
