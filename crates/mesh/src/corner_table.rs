@@ -108,14 +108,19 @@ impl CornerTable {
         }
         let mut fill = offsets.clone();
         let mut bucket = vec![(0u32, 0u32); nc];
+        // One bit per corner: its edge runs from the lower vertex up. Read back when pairing
+        // (twins must differ), it saves a random access to the corner vertices per edge.
+        let mut upward = vec![0u64; nc.div_ceil(64)];
         for c in 0..nc {
             let a = corner_vertex[next_raw(c)];
             let b = corner_vertex[prev_raw(c)];
             let lo = a.min(b) as usize;
             bucket[fill[lo] as usize] = (a.max(b), c as u32);
             fill[lo] += 1;
+            upward[c / 64] |= ((a < b) as u64) << (c % 64);
         }
         drop(fill);
+        let is_upward = |c: usize| upward[c / 64] >> (c % 64) & 1 == 1;
         let mut opposite = vec![NONE; nc];
         for v in 0..vertex_count {
             let s = &mut bucket[offsets[v] as usize..offsets[v + 1] as usize];
@@ -133,7 +138,7 @@ impl CornerTable {
                     2 => {
                         let (c1, c2) = (s[i].1 as usize, s[i + 1].1 as usize);
                         // Twins run in opposite directions: c1's edge starts where c2's ends.
-                        if corner_vertex[next_raw(c1)] != corner_vertex[prev_raw(c2)] {
+                        if is_upward(c1) == is_upward(c2) {
                             return Err(MeshError::InconsistentOrientation {
                                 a: corner_vertex[next_raw(c1)],
                                 b: corner_vertex[prev_raw(c1)],
@@ -185,54 +190,64 @@ impl CornerTable {
                 count: vertex_count,
             });
         }
-        for c in 0..nc {
-            let v = corner_vertex[c];
-            if v as usize >= vertex_count {
+        // One pass over the triangles: vertex indices, repeated vertices, and each corner's
+        // opposite (mutual, facing the same edge reversed); without the fan check the start
+        // corners are picked on the way.
+        let mut vertex_corner = if check_fans {
+            Vec::new()
+        } else {
+            vec![NONE; vertex_count]
+        };
+        for (t, (tv, to)) in corner_vertex
+            .chunks_exact(3)
+            .zip(opposite.chunks_exact(3))
+            .enumerate()
+        {
+            let tv: [u32; 3] = [tv[0], tv[1], tv[2]];
+            if let Some(&v) = tv.iter().find(|&&v| v as usize >= vertex_count) {
                 return Err(MeshError::IndexOutOfRange {
-                    triangle: (c / 3) as u32,
+                    triangle: t as u32,
                     index: v,
                     vertex_count: vertex_count as u32,
                 });
             }
-            let o = opposite[c];
-            if o == NONE {
-                continue;
-            }
-            let oi = o as usize;
-            if oi >= nc
-                || opposite[oi] != c as u32
-                || corner_vertex[next_raw(c)] != corner_vertex[prev_raw(oi)]
-                || corner_vertex[prev_raw(c)] != corner_vertex[next_raw(oi)]
-            {
-                let (a, b) = (corner_vertex[next_raw(c)], corner_vertex[prev_raw(c)]);
-                return Err(MeshError::NonManifoldEdge {
-                    a: a.min(b),
-                    b: a.max(b),
-                    count: 3,
-                });
-            }
-        }
-        for t in 0..nc / 3 {
-            let [a, b, c] = [
-                corner_vertex[3 * t],
-                corner_vertex[3 * t + 1],
-                corner_vertex[3 * t + 2],
-            ];
+            let [a, b, c] = tv;
             if a == b || b == c || a == c {
                 return Err(MeshError::RepeatedVertex {
                     triangle: t as u32,
                     vertex: if a == b || a == c { a } else { b },
                 });
             }
-        }
-        if !check_fans {
-            let mut vertex_corner = vec![NONE; vertex_count];
-            for (c, &v) in corner_vertex.iter().enumerate() {
-                let slot = &mut vertex_corner[v as usize];
-                if *slot == NONE || opposite[prev_raw(c)] == NONE {
-                    *slot = c as u32;
+            for j in 0..3 {
+                let o = to[j];
+                if o == NONE {
+                    continue;
+                }
+                let oi = o as usize;
+                let (x, y) = (tv[(j + 1) % 3], tv[(j + 2) % 3]);
+                let base = oi - oi % 3;
+                let consistent = oi < nc
+                    && opposite[oi] == (3 * t + j) as u32
+                    && corner_vertex[base + (oi + 2) % 3] == x
+                    && corner_vertex[base + (oi + 1) % 3] == y;
+                if !consistent {
+                    return Err(MeshError::NonManifoldEdge {
+                        a: x.min(y),
+                        b: x.max(y),
+                        count: 3,
+                    });
                 }
             }
+            if !check_fans {
+                for j in 0..3 {
+                    let slot = &mut vertex_corner[tv[j] as usize];
+                    if *slot == NONE || to[(j + 2) % 3] == NONE {
+                        *slot = (3 * t + j) as u32;
+                    }
+                }
+            }
+        }
+        if !check_fans {
             return Ok(CornerTable {
                 corner_vertex,
                 opposite,
