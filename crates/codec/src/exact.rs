@@ -12,7 +12,7 @@
 //! x bit length of the previous axis's residual of the same vertex (0..=5), which captures that
 //! a vertex badly predicted on one axis is usually badly predicted on the others.
 
-use crate::parallelogram::{average, gate_midpoint, MAX_CANDIDATES};
+use crate::parallelogram::{average, gate_midpoint, mean, MAX_CANDIDATES};
 use whet_bits::{BitModel, RangeDecoder, ResidualModel, SignedIntModel};
 use whet_edgebreaker::{Connectivity, TraversalError};
 
@@ -169,6 +169,71 @@ impl ResidualIo for ResidualWriter<'_> {
     }
 }
 
+/// Both of the encoder's strategies in one walk (the coding order depends only on the
+/// connectivity, and the encoder's coordinates are the same in both): averaging every
+/// parallelogram into `all`, choosing subsets into `subsets` with its own models. Each
+/// vertex's prediction and class for `subsets` are fixed by [`ResidualIo::select`] and used
+/// by the [`ResidualIo::residual`] call that follows it.
+pub(crate) struct DualWriter<'a> {
+    pub all: ResidualWriter<'a>,
+    pub subsets: ResidualWriter<'a>,
+    pub subset_models: PositionModels,
+    pub max_level: i32,
+    chosen: Option<(usize, [i32; 3])>,
+}
+
+impl<'a> DualWriter<'a> {
+    pub(crate) fn new(
+        all: &'a mut whet_bits::RangeEncoder,
+        subsets: &'a mut whet_bits::RangeEncoder,
+        max_level: i32,
+    ) -> Self {
+        DualWriter {
+            all: ResidualWriter {
+                sink: all,
+                constrained: false,
+                budget: usize::MAX,
+            },
+            subsets: ResidualWriter {
+                sink: subsets,
+                constrained: true,
+                budget: usize::MAX,
+            },
+            subset_models: PositionModels::new(),
+            max_level,
+            chosen: None,
+        }
+    }
+}
+
+impl ResidualIo for DualWriter<'_> {
+    fn select(&mut self, models: &mut PositionModels, cands: &[[i64; 3]], q: &[i32; 3]) -> u32 {
+        let mask = self.subsets.select(&mut self.subset_models, cands, q);
+        let p = average(cands, mask).map(|c| c.clamp(0, self.max_level));
+        self.chosen = Some((class_of(mask), p));
+        self.all.select(models, cands, q)
+    }
+    fn raw(&mut self, bits: u32, q: &mut [i32; 3]) {
+        self.all.raw(bits, q);
+        self.subsets.raw(bits, q);
+    }
+    fn residual(
+        &mut self,
+        models: &mut PositionModels,
+        class: Option<usize>,
+        prediction: [i32; 3],
+        q: &mut [i32; 3],
+    ) {
+        self.all.residual(models, class, prediction, q);
+        let (class, prediction) = match (self.chosen.take(), class) {
+            (Some((c, p)), Some(_)) => (Some(c), p),
+            _ => (class, prediction),
+        };
+        self.subsets
+            .residual(&mut self.subset_models, class, prediction, q);
+    }
+}
+
 /// Reads residuals from a range decoder.
 pub(crate) struct ResidualReader<'a, 'b> {
     pub dec: &'a mut RangeDecoder<'b>,
@@ -274,42 +339,63 @@ fn prev_corner(c: usize) -> usize {
 }
 
 impl DegreeOrder<'_> {
-    /// Raises the degree of unknown neighbour `x` of a known vertex across the triangle
-    /// whose third vertex is `y`, and queues it.
+    /// Anchors unknown neighbour `x` of a known vertex (at corner `cx`) and raises its degree
+    /// across the triangle whose third vertex is `y`. True when `x` is unknown, so must be
+    /// queued.
     #[inline(always)]
-    fn raise_one(&mut self, x: usize, y: usize, cx: usize) {
+    fn raise(&mut self, x: usize, y: usize, cx: usize) -> bool {
         if self.anchor[x] == u32::MAX {
             self.anchor[x] = cx as u32;
         }
-        if self.state[x] == UNKNOWN {
-            if self.state[y] == KNOWN {
-                self.degree[x] = self.degree[x].saturating_add(1);
-            }
-            let d = (self.degree[x] as usize).min(MAX_DEGREE);
-            self.buckets[d].push(x as u32);
+        if self.state[x] != UNKNOWN {
+            return false;
         }
+        if self.state[y] == KNOWN {
+            self.degree[x] = self.degree[x].saturating_add(1);
+        }
+        true
+    }
+
+    /// Queues `x` at its current degree.
+    #[inline(always)]
+    fn push(&mut self, x: usize) {
+        let d = (self.degree[x] as usize).min(MAX_DEGREE);
+        self.buckets[d].push(x as u32);
     }
 
     /// One walk around the fan of vertex `v` from its anchor: with `cands`, collects the
     /// parallelogram predictions of `v` (as [`crate::parallelogram::candidates`] does, in
     /// the same order) before `v` is known; and raises the degree of `v`'s unknown
     /// neighbours as if `v` were known (the raise reads only the neighbours' states, so
-    /// both fit in one walk). Returns the number of candidates.
+    /// both fit in one walk). Returns the number of candidates and their sum.
+    ///
+    /// Each neighbour is queued once per walk, after both its raises: the second vertex of
+    /// one fan triangle is the first of the next, and the first triangle's first vertex is
+    /// the last triangle's second. An entry queued just before another entry of the same
+    /// vertex at the same or a higher degree is never the one popped (the later one sits
+    /// above it in its bucket or the earlier one is stale), so the pop order is the same as
+    /// queueing at every raise.
     #[inline(always)]
     fn walk(
         &mut self,
         v: usize,
         q: &[[i32; 3]],
         mut cands: Option<&mut [[i64; 3]; MAX_CANDIDATES]>,
-    ) -> usize {
+    ) -> (usize, [i64; 3]) {
         let nc = self.cv.len();
         let start = self.anchor[v] as usize;
+        let mut sum = [0i64; 3];
         if start >= nc {
-            return 0;
+            return (0, sum);
         }
         let mut count = 0usize;
         let mut c = start;
         let mut guard = 0usize;
+        // The first triangle's first vertex (queued at the end) and the previous triangle's
+        // second vertex (queued with the next triangle's first raise, normally itself).
+        let first = self.cv[next_corner(start)] as usize;
+        let mut first_queued = false;
+        let mut pending = usize::MAX;
         loop {
             let (ca, cb) = (next_corner(c), prev_corner(c));
             let a = self.cv[ca] as usize;
@@ -321,21 +407,32 @@ impl DegreeOrder<'_> {
                         let w = self.cv[o] as usize;
                         if self.state[w] == KNOWN && w != v {
                             let (qa, qb, qw) = (q[a], q[b], q[w]);
-                            out[count] =
-                                [0, 1, 2].map(|k| qa[k] as i64 + qb[k] as i64 - qw[k] as i64);
+                            let p = [
+                                qa[0] as i64 + qb[0] as i64 - qw[0] as i64,
+                                qa[1] as i64 + qb[1] as i64 - qw[1] as i64,
+                                qa[2] as i64 + qb[2] as i64 - qw[2] as i64,
+                            ];
+                            out[count] = p;
+                            sum = [sum[0] + p[0], sum[1] + p[1], sum[2] + p[2]];
                             count += 1;
                         }
                     }
                 }
             }
-            self.raise_one(a, b, ca);
-            self.raise_one(b, a, cb);
+            if pending != a && pending != usize::MAX {
+                self.push(pending);
+            }
+            if self.raise(a, b, ca) && c != start {
+                self.push(a);
+            }
+            pending = if self.raise(b, a, cb) { b } else { usize::MAX };
             let o = self.opp[ca] as usize;
             if o >= nc {
                 break;
             }
             let n = next_corner(o);
             if n == start {
+                first_queued = pending == first;
                 break;
             }
             c = n;
@@ -344,7 +441,13 @@ impl DegreeOrder<'_> {
                 break;
             }
         }
-        count
+        if pending != usize::MAX {
+            self.push(pending);
+        }
+        if !first_queued && self.state[first] == UNKNOWN {
+            self.push(first);
+        }
+        (count, sum)
     }
 
     /// Pops the vertex with the highest degree; stale entries (already known, or queued at
@@ -446,14 +549,14 @@ pub(crate) fn code_positions<I: ResidualIo>(
                 st.walk(vi, q, None);
             }
         }
+        let mut cands = [[0i64; 3]; MAX_CANDIDATES];
         while let Some(v) = st.pop() {
             // v was queued by a neighbour, so it has an anchor.
             let corner = st.anchor[v];
             if corner as usize >= table.corner_count() {
                 continue;
             }
-            let mut cands = [[0i64; 3]; MAX_CANDIDATES];
-            let k = st.walk(v, q, Some(&mut cands));
+            let (k, sum) = st.walk(v, q, Some(&mut cands));
             let mut value = q[v];
             let (class, prediction) = if k == 0 {
                 let known: &[u8] = &st.state;
@@ -463,11 +566,20 @@ pub(crate) fn code_positions<I: ResidualIo>(
                 )
             } else {
                 let mask = io.select(&mut models, &cands[..k], &value);
-                (class_of(mask), average(&cands[..k], mask))
+                let prediction = if mask == (1u32 << k) - 1 {
+                    mean(sum, k as i64)
+                } else {
+                    average(&cands[..k], mask)
+                };
+                (class_of(mask), prediction)
             };
             // A prediction off the grid is never better than the nearest grid point, and
             // clamping keeps residuals below 2^30.
-            let prediction = prediction.map(|c| c.clamp(0, max_level));
+            let prediction = [
+                prediction[0].clamp(0, max_level),
+                prediction[1].clamp(0, max_level),
+                prediction[2].clamp(0, max_level),
+            ];
             io.residual(&mut models, Some(class), prediction, &mut value);
             q[v] = value;
             st.state[v] = KNOWN;
@@ -561,29 +673,21 @@ pub(crate) fn encode_exact(
         }
     }
     // Per mesh, keep the cheaper of the two prediction strategies: averaging every
-    // parallelogram suits smooth surfaces, choosing subsets suits creased CAD parts.
-    // The second pass stops as soon as it is larger than the first.
-    let mut geometry: Vec<u8> = Vec::new();
-    for constrained in [false, true] {
-        let mut qq = q.clone();
-        let mut range = whet_bits::RangeEncoder::new();
-        range.encode_direct(constrained as u32, 1);
-        let mut io = ResidualWriter {
-            sink: &mut range,
-            constrained,
-            budget: if geometry.is_empty() {
-                usize::MAX
-            } else {
-                geometry.len()
-            },
-        };
-        code_positions(&conn, bits, &mut qq, &mut io).map_err(whet_edgebreaker::Error::from)?;
-        let exhausted = io.exhausted();
-        let bytes = range.finish();
-        if !exhausted && (geometry.is_empty() || bytes.len() < geometry.len()) {
-            geometry = bytes;
-        }
-    }
+    // parallelogram suits smooth surfaces, choosing subsets suits creased CAD parts. Both
+    // are coded in one walk; subsets win only when strictly smaller.
+    let max_level = ((1u64 << bits.clamp(1, 30)) - 1) as i32;
+    let mut all = whet_bits::RangeEncoder::new();
+    let mut subsets = whet_bits::RangeEncoder::new();
+    all.encode_direct(0, 1);
+    subsets.encode_direct(1, 1);
+    let mut io = DualWriter::new(&mut all, &mut subsets, max_level);
+    code_positions(&conn, bits, &mut q, &mut io).map_err(whet_edgebreaker::Error::from)?;
+    let (all, subsets) = (all.finish(), subsets.finish());
+    let geometry = if subsets.len() < all.len() {
+        subsets
+    } else {
+        all
+    };
     Ok(ExactPayloads {
         connectivity: enc.bytes,
         geometry,

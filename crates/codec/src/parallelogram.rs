@@ -75,10 +75,29 @@ pub fn average(cands: &[[i64; 3]], mask: u32) -> [i32; 3] {
             n += 1;
         }
     }
-    if n == 0 {
+    mean(sum, n)
+}
+
+/// `sum / n` per axis rounded half away from zero and clamped to `i32`, as [`average`]
+/// computes it (`[0; 3]` for `n == 0`).
+#[inline(always)]
+pub(crate) fn mean(sum: [i64; 3], n: i64) -> [i32; 3] {
+    if n <= 0 {
         return [0; 3];
     }
-    sum.map(|s| div_round(s, n).clamp(i32::MIN as i64, i32::MAX as i64) as i32)
+    #[inline(always)]
+    fn by(sum: [i64; 3], n: i64) -> [i32; 3] {
+        let one = |s: i64| div_round(s, n).clamp(i32::MIN as i64, i32::MAX as i64) as i32;
+        [one(sum[0]), one(sum[1]), one(sum[2])]
+    }
+    // Constant divisors for the usual counts: multiplications instead of divisions.
+    match n {
+        1 => by(sum, 1),
+        2 => by(sum, 2),
+        3 => by(sum, 3),
+        4 => by(sum, 4),
+        _ => by(sum, n),
+    }
 }
 
 /// The prediction when no parallelogram is available: the midpoint of the known gate
@@ -107,7 +126,7 @@ pub(crate) fn gate_midpoint(a: [i32; 3], b: [i32; 3]) -> [i32; 3] {
 }
 
 /// `s / n` rounded half away from zero (n > 0), identical on every machine.
-#[inline]
+#[inline(always)]
 fn div_round(s: i64, n: i64) -> i64 {
     if s >= 0 {
         (s + n / 2) / n
