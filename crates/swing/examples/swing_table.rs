@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! cargo run --release -p whet-swing --example swing_table -- [--bpv R | --fraction F | --bytes N]
-//!     [--angle-bits B] [--samples S] mesh.off...
+//!     [--angle-bits B] [--samples S] [--valence-bias DEG] mesh.off...
 //! ```
 //! Mesh names without a slash are looked up in the shared fixtures.
 #![allow(clippy::unwrap_used)] // a measurement tool: a failure is a crash with a message
@@ -33,6 +33,10 @@ fn main() {
             }
             "--off-surface" => {
                 tuning = tuning.with_off_surface(args.next().unwrap().parse().unwrap())
+            }
+            "--valence-bias" => {
+                tuning = tuning
+                    .with_valence_bias(args.next().unwrap().parse::<f64>().unwrap().to_radians())
             }
             "--snap" => tuning = tuning.with_snap(args.next().unwrap().parse().unwrap()),
             m => meshes.push(m.to_string()),

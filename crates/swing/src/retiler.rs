@@ -86,6 +86,10 @@ pub struct RetileTuning {
     /// midpoints lie farther than this fraction of `L` from the original spans a gap or
     /// cuts a thin part off: the regular rules do not take it (the fallback may, at a cost).
     pub off_surface: f64,
+    /// The closing angle of a wedge (rule 2) grows by this (radians) when closing makes
+    /// its vertex's valence 6 or more, and shrinks by it when the valence would stay
+    /// under 6.
+    pub valence_bias: f64,
 }
 
 impl RetileTuning {
@@ -102,6 +106,7 @@ impl RetileTuning {
         max_edge: 1.7,
         bridge: 0.35,
         off_surface: 0.35,
+        valence_bias: 45.0 * PI / 180.0,
     };
 }
 
@@ -116,6 +121,12 @@ impl RetileTuning {
     /// test off).
     pub const fn with_off_surface(mut self, off: f64) -> Self {
         self.off_surface = off;
+        self
+    }
+
+    /// Sets the valence bias of the closing angle (radians).
+    pub const fn with_valence_bias(mut self, bias: f64) -> Self {
+        self.valence_bias = bias;
         self
     }
 
@@ -1129,6 +1140,34 @@ impl Retiler<'_, '_> {
         worst
     }
 
+    /// Triangles incident to vertex `v` so far.
+    fn triangle_count(&self, v: u32) -> u32 {
+        let mut c = self.vcorner[v as usize];
+        let mut k = 0;
+        while c != NONE {
+            k += 1;
+            c = self.corner_next[c as usize];
+        }
+        k
+    }
+
+    /// Adjustment of the closing angle of node `n`'s wedge by the valence its vertex would
+    /// end with: `+valence_bias` when one more triangle makes it 6 or more (closing now
+    /// is regular, or keeps an already high valence from growing), `-valence_bias` when it
+    /// would stay under 6 (one more swing fills the wedge better). Only for a vertex with
+    /// one live node (closing its wedge makes it interior).
+    fn valence_bias(&self, n: u32) -> f64 {
+        let v = self.nodes[n as usize].v;
+        if self.vlive[v as usize] != 1 || self.tune.valence_bias == 0.0 {
+            return 0.0;
+        }
+        if self.triangle_count(v) + 1 >= 6 {
+            self.tune.valence_bias
+        } else {
+            -self.tune.valence_bias
+        }
+    }
+
     /// Is closing gate `an -> bn` with existing node `wn` a triangle on the surface?
     fn on_surface(&mut self, an: u32, bn: u32, wn: u32) -> bool {
         let [pa, pb, pw] = [an, bn, wn].map(|n| self.pos[self.nodes[n as usize].v as usize]);
@@ -1304,7 +1343,10 @@ impl Retiler<'_, '_> {
                 cands.swap(0, 1);
             }
             for (angle, n) in cands {
-                if angle < close
+                // The vertex whose wedge closes (b for R, a for L) becomes interior with
+                // one more triangle: lean towards closing when that makes it regular.
+                let closing = if n == xn { bn } else { an };
+                if angle < close + self.valence_bias(closing)
                     && self.valid_existing(an, bn, n, true)
                     && self.on_surface(an, bn, n)
                 {

@@ -63,3 +63,35 @@ fn every_fixture_retiles_regularly() {
     }
     assert!(failures.is_empty(), "{failures:?}");
 }
+
+/// The valence-aware closing rule (`RetileTuning::valence_bias`, docs/swing.md section 3):
+/// closing a wedge when that makes its vertex regular, swinging once more when it would not,
+/// makes the retiling markedly more regular and its connectivity cheaper, at an unchanged
+/// error per byte. Measured by this test on spot at L = 2 %: valence 6 0.887 with the
+/// bias, 0.773 without; C+R 0.976 vs 0.956; 0.351 vs 0.578 connectivity bits per
+/// triangle. The tolerances leave room for retiler changes that keep the effect.
+#[test]
+fn valence_bias_makes_the_retiling_regular_and_cheaper() {
+    use whet_swing::{Rate, RetileTuning, SwingOptions};
+    let mesh = load("spot.off");
+    let run = |bias: f64| {
+        let out = crate::round_trip_with(
+            &mesh,
+            &SwingOptions::DEFAULT
+                .with_rate(Rate::EdgeLength(0.02))
+                .with_tuning(RetileTuning::DEFAULT.with_valence_bias(bias)),
+        );
+        assert_swing(&out);
+        assert_eq!(out.retiled.topology_report().genus, Some(0));
+        regularity(&out)
+    };
+    let (cr0, v0, bpt0) = run(0.0);
+    let (cr, v, bpt) = run(RetileTuning::DEFAULT.valence_bias);
+    eprintln!("no bias: C+R {cr0:.3} v6 {v0:.3} {bpt0:.3} bpt; bias: {cr:.3} {v:.3} {bpt:.3}");
+    assert!(v >= 0.85 && v >= v0 + 0.05, "valence 6: {v} vs {v0}");
+    assert!(cr >= 0.95 && cr >= cr0, "C+R: {cr} vs {cr0}");
+    assert!(
+        bpt <= 0.4 && bpt <= 0.7 * bpt0,
+        "bits per triangle: {bpt} vs {bpt0}"
+    );
+}
