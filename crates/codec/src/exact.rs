@@ -150,6 +150,7 @@ impl ResidualIo for ResidualWriter<'_> {
             self.sink.encode_direct(*c as u32, bits);
         }
     }
+    #[inline(always)]
     fn residual(
         &mut self,
         models: &mut PositionModels,
@@ -276,6 +277,7 @@ impl ResidualIo for ResidualReader<'_, '_> {
             *c = self.dec.decode_direct(bits) as i32;
         }
     }
+    #[inline(always)]
     fn residual(
         &mut self,
         models: &mut PositionModels,
@@ -558,28 +560,36 @@ pub(crate) fn code_positions<I: ResidualIo>(
             }
             let (k, sum) = st.walk(v, q, Some(&mut cands));
             let mut value = q[v];
+            // A prediction off the grid is never better than the nearest grid point, and
+            // clamping keeps residuals below 2^30. (Clamped in each branch, so that the
+            // merged prediction is read back lane by lane, as it was stored.)
+            let grid = |p: [i32; 3]| {
+                [
+                    p[0].clamp(0, max_level),
+                    p[1].clamp(0, max_level),
+                    p[2].clamp(0, max_level),
+                ]
+            };
             let (class, prediction) = if k == 0 {
                 let known: &[u8] = &st.state;
                 (
                     0,
-                    neighbour_fallback(table, whet_mesh::CornerId(corner), q, known),
+                    grid(neighbour_fallback(
+                        table,
+                        whet_mesh::CornerId(corner),
+                        q,
+                        known,
+                    )),
                 )
             } else {
                 let mask = io.select(&mut models, &cands[..k], &value);
                 let prediction = if mask == (1u32 << k) - 1 {
-                    mean(sum, k as i64)
+                    grid(mean(sum, k as i64))
                 } else {
-                    average(&cands[..k], mask)
+                    grid(average(&cands[..k], mask))
                 };
                 (class_of(mask), prediction)
             };
-            // A prediction off the grid is never better than the nearest grid point, and
-            // clamping keeps residuals below 2^30.
-            let prediction = [
-                prediction[0].clamp(0, max_level),
-                prediction[1].clamp(0, max_level),
-                prediction[2].clamp(0, max_level),
-            ];
             io.residual(&mut models, Some(class), prediction, &mut value);
             q[v] = value;
             st.state[v] = KNOWN;
@@ -651,7 +661,7 @@ pub(crate) fn encode_exact(
 ) -> Result<ExactPayloads, crate::Error> {
     let bbox = mesh.bounding_box();
     let quantizer = crate::Quantizer::new(&bbox, bits);
-    let enc = whet_edgebreaker::encode_connectivity_with_table(
+    let mut enc = whet_edgebreaker::encode_connectivity_with_table(
         table,
         &mesh.triangles,
         mesh.positions.len(),
@@ -727,16 +737,25 @@ pub(crate) fn decode_exact(
         return Err(crate::Error::Truncated("geometry"));
     }
     let max = quantizer.max_level();
-    let order = conn.output_vertices();
-    let mut positions = Vec::with_capacity(order.len());
-    for v in &order {
-        let g = q[v.index()];
-        if !known[v.index()] || g.iter().any(|&c| c < 0 || c > max) {
+    // Output vertices in traversal order (dummies skipped), their ranks, then the triangles.
+    let mut rank = vec![u32::MAX; conn.table.vertex_count()];
+    let mut positions = Vec::with_capacity(conn.summary.vertex_order.len());
+    for v in &conn.summary.vertex_order {
+        let i = v.index();
+        if conn.is_dummy[i] {
+            continue;
+        }
+        let g = q[i];
+        if !known[i] || g.iter().any(|&c| c < 0 || c > max) {
             return Err(crate::Error::Corrupt(
                 "a decoded position falls outside the quantization grid".into(),
             ));
         }
+        rank[i] = positions.len() as u32;
         positions.push(quantizer.dequantize(g));
     }
-    Ok(whet_mesh::Mesh::new(positions, conn.output_triangles()))
+    Ok(whet_mesh::Mesh::new(
+        positions,
+        conn.output_triangles_ranked(&rank),
+    ))
 }

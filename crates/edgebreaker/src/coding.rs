@@ -104,19 +104,20 @@ impl Connectivity {
     /// The real triangles (dummy fans removed) with vertices renumbered in traversal order
     /// (dummies skipped): the triangle list a decoder outputs.
     pub fn output_triangles(&self) -> Vec<[u32; 3]> {
-        let rank = self.output_rank();
+        self.output_triangles_ranked(&self.output_rank())
+    }
+
+    /// [`Connectivity::output_triangles`] given [`Connectivity::output_rank`]: a triangle
+    /// with a vertex without rank (a dummy) is left out.
+    pub fn output_triangles_ranked(&self, rank: &[u32]) -> Vec<[u32; 3]> {
         let mut out = Vec::with_capacity(self.table.triangle_count());
-        for t in 0..self.table.triangle_count() {
-            let c = CornerId((3 * t) as u32);
-            let vs = [
-                self.table.vertex(c),
-                self.table.vertex(self.table.next(c)),
-                self.table.vertex(self.table.prev(c)),
-            ];
-            if vs.iter().any(|v| self.is_dummy[v.index()]) {
+        let r = |v: u32| rank.get(v as usize).copied().unwrap_or(u32::MAX);
+        for t in self.table.corner_vertices().chunks_exact(3) {
+            let vs = [r(t[0]), r(t[1]), r(t[2])];
+            if vs.contains(&u32::MAX) {
                 continue;
             }
-            out.push(vs.map(|v| rank[v.index()]));
+            out.push(vs);
         }
         out
     }
@@ -155,6 +156,9 @@ pub struct EncodedConnectivity {
     pub connectivity: Connectivity,
     /// Face of each triangle in traversal order (start triangles included).
     face_order: Vec<u32>,
+    /// Corner vertices and opposites of the table relabelled in traversal order, built
+    /// during the traversal (taken by the first [`EncodedConnectivity::traversal_ordered`]).
+    ordered: Option<Relabelled>,
 }
 
 impl EncodedConnectivity {
@@ -174,7 +178,40 @@ impl EncodedConnectivity {
     /// and it is the same mesh corner for corner, so every order fixed by the traversal
     /// itself (the geometry coders') is unchanged. Returns it and, per new vertex id, the
     /// old one.
-    pub fn traversal_ordered(&self) -> Result<(Connectivity, Vec<u32>), Error> {
+    ///
+    /// The first call takes the relabelled arrays the encoder built while traversing (the
+    /// triangles' lines are in cache then); later calls rebuild them.
+    pub fn traversal_ordered(&mut self) -> Result<(Connectivity, Vec<u32>), Error> {
+        let (v, o, starts) = match self.ordered.take() {
+            Some(r) => r,
+            None => self.relabel()?,
+        };
+        let conn = &self.connectivity;
+        let order = &conn.summary.vertex_order;
+        let new_table = CornerTable::from_raw(v, o, order.len(), false)
+            .map_err(|_| Error::Corrupt("relabelled table is inconsistent"))?;
+        let starts: Vec<CornerId> = starts.into_iter().map(CornerId).collect();
+        let is_dummy = order.iter().map(|v| conn.is_dummy[v.index()]).collect();
+        let summary = TraversalSummary {
+            labels: conn.summary.labels.clone(),
+            splits: conn.summary.splits.clone(),
+            starts: starts.clone(),
+            vertex_order: (0..order.len() as u32).map(VertexId).collect(),
+        };
+        let old = order.iter().map(|v| v.0).collect();
+        Ok((
+            Connectivity {
+                table: new_table,
+                starts,
+                is_dummy,
+                summary,
+            },
+            old,
+        ))
+    }
+
+    /// The corner vertices and opposites of the table relabelled in traversal order.
+    fn relabel(&self) -> Result<Relabelled, Error> {
         let conn = &self.connectivity;
         let table = &conn.table;
         let nt = table.triangle_count();
@@ -205,36 +242,14 @@ impl EncodedConnectivity {
                 }
             }
         }
-        let new_table = CornerTable::from_raw(v, o, order.len(), false)
-            .map_err(|_| Error::Corrupt("relabelled table is inconsistent"))?;
-        let starts = conn
-            .starts
-            .iter()
-            .map(|c| CornerId(map_corner(c.0)))
-            .collect();
-        let is_dummy = order.iter().map(|v| conn.is_dummy[v.index()]).collect();
-        let summary = TraversalSummary {
-            labels: conn.summary.labels.clone(),
-            splits: conn.summary.splits.clone(),
-            starts: conn
-                .starts
-                .iter()
-                .map(|c| CornerId(map_corner(c.0)))
-                .collect(),
-            vertex_order: (0..order.len() as u32).map(VertexId).collect(),
-        };
-        let old = order.iter().map(|v| v.0).collect();
-        Ok((
-            Connectivity {
-                table: new_table,
-                starts,
-                is_dummy,
-                summary,
-            },
-            old,
-        ))
+        let starts = conn.starts.iter().map(|c| map_corner(c.0)).collect();
+        Ok((v, o, starts))
     }
 }
+
+/// Corner vertices, opposites and component start corners of a table relabelled in
+/// traversal order.
+type Relabelled = (Vec<u32>, Vec<u32>, Vec<u32>);
 
 fn write_varint(out: &mut Vec<u8>, mut v: u64) {
     loop {
@@ -322,13 +337,57 @@ pub fn encode_connectivity_with_table(
         (open, 0)
     };
     let total_vertices = vertex_count + dummies;
-    let mut face_order = Vec::with_capacity(table.triangle_count());
+    let nt = table.triangle_count();
+    let mut face_order = Vec::with_capacity(nt);
+    // The table relabelled in traversal order (see `EncodedConnectivity::traversal_ordered`),
+    // built as each triangle is visited: its corners are in cache then, and so are most of
+    // its neighbours' ranks.
+    let (cv, opp) = (table.corner_vertices(), table.opposites());
+    let mut vertex_rank = vec![u32::MAX; table.vertex_count()];
+    let mut face_rank = vec![u32::MAX; nt];
+    let mut next_vertex = 0u32;
+    let mut ov = vec![0u32; 3 * nt];
+    let mut oo = vec![u32::MAX; 3 * nt];
+    let mut new_starts = Vec::new();
     let summary = traverse(&table, None, |step| {
-        face_order.push(match step {
-            Step::Start { corner } => corner.0 / 3,
-            Step::Triangle { tip, .. } => tip.0 / 3,
-        })
+        let f = match step {
+            Step::Start { corner } => {
+                new_starts.push(3 * face_order.len() as u32 + corner.0 % 3);
+                for c in [corner, table.next(corner), table.prev(corner)] {
+                    vertex_rank[table.vertex(c).index()] = next_vertex;
+                    next_vertex += 1;
+                }
+                corner.0 / 3
+            }
+            Step::Triangle { tip, label, .. } => {
+                if label == Clers::C {
+                    vertex_rank[table.vertex(tip).index()] = next_vertex;
+                    next_vertex += 1;
+                }
+                tip.0 / 3
+            }
+        } as usize;
+        let i = face_order.len();
+        face_order.push(f as u32);
+        face_rank[f] = i as u32;
+        for j in 0..3 {
+            let c = 3 * f + j;
+            ov[3 * i + j] = vertex_rank[cv[c] as usize];
+            let o = opp[c];
+            if o != u32::MAX {
+                let g = face_rank[o as usize / 3];
+                if g != u32::MAX {
+                    let no = 3 * g + o % 3;
+                    oo[3 * i + j] = no;
+                    oo[no as usize] = (3 * i + j) as u32;
+                }
+            }
+        }
     })?;
+    drop((vertex_rank, face_rank));
+    if face_order.len() != nt {
+        return Err(Error::Corrupt("the traversal did not visit every triangle"));
+    }
     let starts = summary.starts.clone();
     let mut is_dummy = vec![false; total_vertices];
     for d in is_dummy.iter_mut().skip(vertex_count) {
@@ -369,6 +428,7 @@ pub fn encode_connectivity_with_table(
             summary,
         },
         face_order,
+        ordered: Some((ov, oo, new_starts)),
     })
 }
 

@@ -40,6 +40,22 @@ fn round_trip(mesh: &Mesh) -> (f64, [usize; 5]) {
     input.sort_unstable();
     mapped.sort_unstable();
     assert_eq!(mapped, input, "vertex order does not map back to the input");
+    // The relabelled table built during the traversal equals the one rebuilt afterwards,
+    // and it is the decoder's mesh under the same vertex order.
+    let mut enc = enc;
+    let (first, old_first) = enc.traversal_ordered().expect("relabels");
+    let (again, old_again) = enc.traversal_ordered().expect("relabels again");
+    assert_eq!(first.table, again.table);
+    assert_eq!(first.starts, again.starts);
+    assert_eq!(first.is_dummy, again.is_dummy);
+    assert_eq!(old_first, old_again);
+    let mut relabelled: Vec<[u32; 3]> = first
+        .output_triangles()
+        .into_iter()
+        .map(canonical)
+        .collect();
+    relabelled.sort_unstable();
+    assert_eq!(relabelled, want, "relabelled table differs");
     (
         enc.bytes.len() as f64 * 8.0 / mesh.triangles.len() as f64,
         enc.histogram(),
