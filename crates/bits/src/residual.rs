@@ -59,14 +59,17 @@ impl CdfModel {
     }
 
     /// Moves the estimate towards `s`.
-    #[inline]
+    #[inline(always)]
     pub fn update(&mut self, s: usize) {
         let rate = RATE_MIN + (self.count / RATE_STEP) as u32;
         if (self.count as u32) < RATE_STEP as u32 * RATE_STEPS {
             self.count += 1;
         }
-        // Branch-free so that it vectorises: entries above s rise, the rest fall.
-        for (i, x) in self.c.iter_mut().enumerate().take(CDF_SYMBOLS).skip(1) {
+        // Branch-free over a whole number of vectors so that it vectorises wherever it is
+        // inlined: entries above s rise, the rest fall. c[0] = 0 stays 0 (it falls by
+        // 0 >> rate); c[32] = CDF_SPAN is left alone (it would rise by 0).
+        let (head, _) = self.c.split_at_mut(CDF_SYMBOLS);
+        for (i, x) in head.iter_mut().enumerate() {
             let up = (CDF_SPAN - *x) >> rate;
             let down = *x >> rate;
             *x = if i > s { *x + up } else { *x - down };
