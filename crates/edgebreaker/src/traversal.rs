@@ -158,6 +158,9 @@ pub fn traverse(
     let mut visited_count = 0usize;
     let mut next_auto = 0usize;
     let mut given = starts.map(|s| s.iter());
+    let (corner_vertices, opposites) = (table.corner_vertices(), table.opposites());
+    // Sum of values read only to bring the next triangle's lines into the cache early.
+    let mut touched = 0u32;
 
     loop {
         let start = match given.as_mut() {
@@ -207,6 +210,14 @@ pub fn traverse(
                 let v = table.vertex(c);
                 let right = opposite(table, table.next(c));
                 let left = opposite(table, table.prev(c));
+                // The traversal goes on at `right` or `left`: start loading both triangles
+                // now, while the marks that decide which are still on their way (on a
+                // table in random memory order every step is a cache miss).
+                touched = touched
+                    .wrapping_add(corner_vertices[right.index()])
+                    .wrapping_add(opposites[right.index()])
+                    .wrapping_add(corner_vertices[left.index()])
+                    .wrapping_add(opposites[left.index()]);
                 let right_mark = tri_mark[right.face().index()];
                 let left_mark = tri_mark[left.face().index()];
                 let label = if !vertex_seen[v.index()] {
@@ -259,6 +270,7 @@ pub fn traverse(
             }
         }
     }
+    std::hint::black_box(touched);
     if visited_count != nt {
         return Err(TraversalError::Unreached(nt - visited_count));
     }
