@@ -148,9 +148,20 @@ impl Encoder {
                 opts.version
             )));
         }
-        let prepared = prepare(mesh, opts.repair)?;
+        if opts.mode == Mode::Exact {
+            // Fast path: the input's table skips the walk around closed fans (random
+            // accesses on an input in random memory order); the encoder walks them on its
+            // traversal-ordered copy instead. Any failure takes the path that checks
+            // everything up front (and repairs or reports exactly as it always did).
+            let fast =
+                prepare_with(mesh, opts.repair, false).and_then(|p| self.encode_exact(p, true));
+            return match fast {
+                Ok(encoded) => Ok(encoded),
+                Err(_) => self.encode_exact(prepare(mesh, opts.repair)?, false),
+            };
+        }
+        let _prepared = prepare(mesh, opts.repair)?;
         match opts.mode {
-            Mode::Exact => self.encode_exact(prepared),
             Mode::Swing => Err(Error::Parameter(
                 "the swing mode's encoder (the retiler) is whet_swing::SwingEncoder; \
                  whet-codec only writes and reads swing streams"
@@ -162,9 +173,10 @@ impl Encoder {
         }
     }
 
-    fn encode_exact(&self, p: Prepared) -> Result<Encoded, Error> {
+    /// `check_fans`: `p.table` was built without the closed-fan walk, check on the way.
+    fn encode_exact(&self, p: Prepared, check_fans: bool) -> Result<Encoded, Error> {
         let bits = self.opts.quant_bits;
-        let payloads = encode_exact(&p.mesh, p.table, bits)?;
+        let payloads = encode_exact(&p.mesh, p.table, bits, check_fans)?;
         let bbox = p.mesh.bounding_box();
         let (min, max) = if bbox.is_empty() {
             ([0.0; 3], [0.0; 3])
@@ -247,6 +259,14 @@ pub(crate) struct Prepared {
 }
 
 pub(crate) fn prepare(mesh: &Mesh, repair: bool) -> Result<Prepared, Error> {
+    prepare_with(mesh, repair, true)
+}
+
+/// [`prepare`]; without `walk_fans` the input's table is built with
+/// `CornerTable::from_triangles_deferring_fans` (a vertex pinching closed fans is not
+/// detected, nor repaired: the caller must check the fans later and fall back to
+/// [`prepare`]).
+fn prepare_with(mesh: &Mesh, repair: bool, walk_fans: bool) -> Result<Prepared, Error> {
     if let Some(v) = mesh.positions.iter().position(|p| !p.is_finite()) {
         return Err(Error::InvalidInput(
             whet_mesh::MeshError::NonFiniteCoordinate { vertex: v as u32 },
@@ -256,7 +276,12 @@ pub(crate) fn prepare(mesh: &Mesh, repair: bool) -> Result<Prepared, Error> {
     let input_vertices = work.positions.len();
     let mut rep = ManifoldRepair::default();
     // The table of a valid input is built once and kept unless vertices are dropped below.
-    let mut table = match whet_mesh::CornerTable::new(&work) {
+    let built = if walk_fans {
+        whet_mesh::CornerTable::new(&work)
+    } else {
+        whet_mesh::CornerTable::from_triangles_deferring_fans(&work.triangles, work.positions.len())
+    };
+    let mut table = match built {
         Ok(t) => Some(t),
         Err(e) => {
             if !repair {

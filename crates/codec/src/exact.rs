@@ -658,6 +658,7 @@ pub(crate) fn encode_exact(
     mesh: &whet_mesh::Mesh,
     table: whet_mesh::CornerTable,
     bits: u32,
+    check_fans: bool,
 ) -> Result<ExactPayloads, crate::Error> {
     let bbox = mesh.bounding_box();
     let quantizer = crate::Quantizer::new(&bbox, bits);
@@ -670,6 +671,13 @@ pub(crate) fn encode_exact(
     // The geometry passes walk a copy of the table relabelled in traversal order: the same
     // corners, so the same coding order, but walked roughly in memory order.
     let (conn, old_id) = enc.traversal_ordered()?;
+    if check_fans {
+        // The input's table was built without walking its closed fans: walk them here, in
+        // memory order. (The relabelled table is the same mesh, closed.)
+        conn.table
+            .check_fans()
+            .map_err(crate::Error::InvalidInput)?;
+    }
     let vertex_order = enc
         .connectivity
         .output_vertices()

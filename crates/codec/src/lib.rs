@@ -96,7 +96,7 @@ impl Error {
 #[doc(hidden)]
 pub fn encode_exact_payloads(mesh: &whet_mesh::Mesh, bits: u32) -> Result<ExactPayloads, Error> {
     let table = whet_mesh::CornerTable::new(mesh).map_err(Error::InvalidInput)?;
-    exact::encode_exact(mesh, table, bits)
+    exact::encode_exact(mesh, table, bits, false)
 }
 
 #[doc(hidden)]

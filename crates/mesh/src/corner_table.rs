@@ -53,6 +53,38 @@ impl CornerTable {
         triangles: &[[u32; 3]],
         vertex_count: usize,
     ) -> Result<CornerTable, MeshError> {
+        CornerTable::build(triangles, vertex_count, true)
+    }
+
+    /// [`CornerTable::from_triangles`] without the walk around closed fans: it checks
+    /// indices, edges, orientation and that no vertex starts two open fans, but a vertex
+    /// whose corners form several closed fans (two closed surfaces pinched at it) is not
+    /// refused, so the table may break the single-fan invariant until
+    /// [`CornerTable::check_fans`] passes. The walk is the costliest part of building on
+    /// a mesh in random memory order; a caller that relabels the table in a cache-friendly
+    /// order first can check there.
+    pub fn from_triangles_deferring_fans(
+        triangles: &[[u32; 3]],
+        vertex_count: usize,
+    ) -> Result<CornerTable, MeshError> {
+        CornerTable::build(triangles, vertex_count, false)
+    }
+
+    /// Checks that every used vertex has a single fan (the check
+    /// [`CornerTable::from_triangles`] makes; tables built otherwise may need it).
+    pub fn check_fans(&self) -> Result<(), MeshError> {
+        let (valence, open_fans) = self.fan_counts();
+        for v in 0..self.vertex_corner.len() {
+            self.check_fan(v, &valence, &open_fans)?;
+        }
+        Ok(())
+    }
+
+    fn build(
+        triangles: &[[u32; 3]],
+        vertex_count: usize,
+        walk_fans: bool,
+    ) -> Result<CornerTable, MeshError> {
         let nt = triangles.len();
         if nt > (u32::MAX as usize - 3) / 3 {
             return Err(MeshError::TooLarge {
@@ -162,7 +194,7 @@ impl CornerTable {
         }
         drop(bucket);
         drop(offsets);
-        CornerTable::from_parts(corner_vertex, opposite, vertex_count)
+        CornerTable::from_parts(corner_vertex, opposite, vertex_count, walk_fans)
     }
 
     /// Builds the table from corner vertices and opposites that are already paired (a
@@ -254,7 +286,7 @@ impl CornerTable {
                 vertex_corner,
             });
         }
-        CornerTable::from_parts(corner_vertex, opposite, vertex_count)
+        CornerTable::from_parts(corner_vertex, opposite, vertex_count, true)
     }
 
     /// Finishes a table whose opposites are paired: picks each vertex's start corner (the
@@ -264,6 +296,7 @@ impl CornerTable {
         corner_vertex: Vec<u32>,
         opposite: Vec<u32>,
         vertex_count: usize,
+        walk_fans: bool,
     ) -> Result<CornerTable, MeshError> {
         let nc = corner_vertex.len();
         let mut table = CornerTable {
@@ -285,28 +318,9 @@ impl CornerTable {
             }
         }
         for v in 0..vertex_count {
-            let start = table.vertex_corner[v];
-            if start == NONE {
-                continue;
-            }
-            if open_fans[v] > 1 {
-                return Err(MeshError::NonManifoldVertex {
-                    vertex: v as u32,
-                    fans: table.count_fans(VertexId(v as u32)),
-                });
-            }
-            // Open fans start at their clockwise end; a closed fan anywhere. Count the fan.
-            let start = CornerId(start);
-            let mut seen = 1u32;
-            let mut c = start;
-            while let Some(n) = table.swing(c) {
-                if n == start || seen > valence[v] {
-                    break;
-                }
-                seen += 1;
-                c = n;
-            }
-            if seen != valence[v] {
+            if walk_fans {
+                table.check_fan(v, &valence, &open_fans)?;
+            } else if open_fans[v] > 1 {
                 return Err(MeshError::NonManifoldVertex {
                     vertex: v as u32,
                     fans: table.count_fans(VertexId(v as u32)),
@@ -314,6 +328,51 @@ impl CornerTable {
             }
         }
         Ok(table)
+    }
+
+    /// Per vertex: corners, and corners that start an open fan.
+    fn fan_counts(&self) -> (Vec<u32>, Vec<u8>) {
+        let mut valence = vec![0u32; self.vertex_corner.len()];
+        let mut open_fans = vec![0u8; self.vertex_corner.len()];
+        for (c, &v) in self.corner_vertex.iter().enumerate() {
+            let v = v as usize;
+            valence[v] += 1;
+            if self.opposite[prev_raw(c)] == NONE {
+                open_fans[v] = open_fans[v].saturating_add(1);
+            }
+        }
+        (valence, open_fans)
+    }
+
+    /// Checks that `v` (if used) has at most one open fan and that swinging from its start
+    /// corner meets all its corners.
+    fn check_fan(&self, v: usize, valence: &[u32], open_fans: &[u8]) -> Result<(), MeshError> {
+        let start = self.vertex_corner[v];
+        if start == NONE {
+            return Ok(());
+        }
+        let fail = || MeshError::NonManifoldVertex {
+            vertex: v as u32,
+            fans: self.count_fans(VertexId(v as u32)),
+        };
+        if open_fans[v] > 1 {
+            return Err(fail());
+        }
+        // Open fans start at their clockwise end; a closed fan anywhere. Count the fan.
+        let start = CornerId(start);
+        let mut seen = 1u32;
+        let mut c = start;
+        while let Some(n) = self.swing(c) {
+            if n == start || seen > valence[v] {
+                break;
+            }
+            seen += 1;
+            c = n;
+        }
+        if seen != valence[v] {
+            return Err(fail());
+        }
+        Ok(())
     }
 
     // Error path only: the number of separate fans around `v` (a linear scan).
@@ -582,6 +641,32 @@ mod tests {
                 count: 3
             })
         );
+    }
+
+    #[test]
+    fn deferred_fan_check_finds_pinched_closed_fans() {
+        // Two tetrahedra sharing vertex 0: two closed fans around it.
+        let t = tetrahedron();
+        let mut triangles = t.triangles.clone();
+        triangles.extend(
+            t.triangles
+                .iter()
+                .map(|tri| tri.map(|v| if v == 0 { 0 } else { v + 3 })),
+        );
+        let positions = vec![DVec3::ZERO; 7];
+        let m = Mesh::new(positions, triangles);
+        assert!(matches!(
+            CornerTable::new(&m),
+            Err(MeshError::NonManifoldVertex { vertex: 0, .. })
+        ));
+        let table = CornerTable::from_triangles_deferring_fans(&m.triangles, 7).unwrap();
+        assert!(matches!(
+            table.check_fans(),
+            Err(MeshError::NonManifoldVertex { vertex: 0, .. })
+        ));
+        let ok = CornerTable::from_triangles_deferring_fans(&t.triangles, 4).unwrap();
+        assert_eq!(ok.check_fans(), Ok(()));
+        assert_eq!(ok, CornerTable::new(&t).unwrap());
     }
 
     #[test]

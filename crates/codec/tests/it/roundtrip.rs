@@ -97,6 +97,40 @@ fn non_manifold_input_is_repaired_and_unused_vertices_dropped() {
 }
 
 #[test]
+fn closed_surfaces_pinched_at_a_vertex_are_repaired_or_refused() {
+    // Two icospheres sharing one vertex: two closed fans there, which the encoder's fast
+    // path only detects on its relabelled table.
+    let a = icosphere(2);
+    let off = a.positions.len() as u32;
+    let mut m = a.clone();
+    m.positions
+        .extend(a.positions[1..].iter().map(|p| *p + DVec3::X * 2.0));
+    m.triangles.extend(
+        a.triangles
+            .iter()
+            .map(|t| t.map(|v| if v == 0 { 0 } else { off + v - 1 })),
+    );
+    let m = shuffle(&m, 3);
+    let enc = encode(&m, &EncodeOptions::DEFAULT).unwrap();
+    assert!(
+        enc.report.repair != Default::default(),
+        "{:?}",
+        enc.report.repair
+    );
+    assert_eq!(enc.report.dropped_unused_vertices, 0);
+    let dec = decode(&enc.bytes, &DecodeOptions::DEFAULT).unwrap();
+    assert_eq!(dec.triangles.len(), m.triangles.len());
+    let refuse = encode(&m, &EncodeOptions::DEFAULT.with_repair(false)).unwrap_err();
+    assert!(
+        matches!(
+            refuse,
+            whet_codec::Error::InvalidInput(whet_mesh::MeshError::NonManifoldVertex { .. })
+        ),
+        "{refuse}"
+    );
+}
+
+#[test]
 fn nan_input_is_refused() {
     let mut m = icosphere(0);
     m.positions[3].y = f64::NAN;
