@@ -684,12 +684,21 @@ pub(crate) fn encode_exact(
         .iter()
         .map(|v| v.0)
         .collect();
+    // Quantize in input order and scatter to the traversal order: on an input in random
+    // order, scattered stores overlap where gathered loads would wait one by one.
+    let mut new_id = vec![u32::MAX; mesh.positions.len()];
+    for (new, &old) in old_id.iter().enumerate() {
+        if let Some(slot) = new_id.get_mut(old as usize) {
+            *slot = new as u32;
+        }
+    }
     let mut q: Vec<[i32; 3]> = vec![[0; 3]; conn.table.vertex_count()];
-    for (qi, &old) in q.iter_mut().zip(&old_id) {
-        if let Some(p) = mesh.positions.get(old as usize) {
+    for (p, &new) in mesh.positions.iter().zip(&new_id) {
+        if let Some(qi) = q.get_mut(new as usize) {
             *qi = quantizer.quantize(*p);
         }
     }
+    drop(new_id);
     // Per mesh, keep the cheaper of the two prediction strategies: averaging every
     // parallelogram suits smooth surfaces, choosing subsets suits creased CAD parts. Both
     // are coded in one walk; subsets win only when strictly smaller.
