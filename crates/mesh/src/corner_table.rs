@@ -256,12 +256,16 @@ impl CornerTable {
                     continue;
                 }
                 let oi = o as usize;
+                let c = 3 * t + j;
                 let (x, y) = (tv[(j + 1) % 3], tv[(j + 2) % 3]);
                 let base = oi - oi % 3;
+                // A pair is checked in full from its first corner; from the second, that
+                // it is mutual is enough (the first then checked this very pair).
                 let consistent = oi < nc
-                    && opposite[oi] == (3 * t + j) as u32
-                    && corner_vertex[base + (oi + 2) % 3] == x
-                    && corner_vertex[base + (oi + 1) % 3] == y;
+                    && opposite[oi] == c as u32
+                    && (oi < c
+                        || (corner_vertex[base + (oi + 2) % 3] == x
+                            && corner_vertex[base + (oi + 1) % 3] == y));
                 if !consistent {
                     return Err(MeshError::NonManifoldEdge {
                         a: x.min(y),
