@@ -509,6 +509,8 @@ pub fn decode_connectivity(
     let mut rev = ReverseDecoder::new(n32, &splits, (triangles as usize).min(1 << 22));
     let mut models = LabelModels::new();
     let mut prev = Clers::E;
+    // Labels in decoding order (the reverse of the encoder's).
+    let mut decoded: Vec<Clers> = Vec::with_capacity((n as usize).min(1 << 22));
     for i in 0..n32 {
         let sym = if rev.next_is_forced_e() {
             Clers::E
@@ -518,6 +520,7 @@ pub fn decode_connectivity(
             Clers::from_index(s).ok_or(Error::Corrupt("label out of range"))?
         };
         rev.apply(sym)?;
+        decoded.push(sym);
         prev = sym;
         // A stream cut short decodes zeros forever; stop early rather than building a
         // huge garbage mesh.
@@ -528,6 +531,7 @@ pub fn decode_connectivity(
     let consumed = pos + dec.position();
     dec.finish()?;
     let starts = rev.finish(k as usize)?;
+    let steps = rev.component_steps()?;
     let vertex_ids = rev.vertex_ids();
     let v = std::mem::take(&mut rev.v);
     let o = std::mem::take(&mut rev.o);
@@ -537,7 +541,46 @@ pub fn decode_connectivity(
     let table = CornerTable::from_raw(v, o, vertex_ids, false)
         .map_err(|_| Error::Corrupt("the decoded mesh is not a manifold"))?;
     let starts: Vec<CornerId> = starts.into_iter().map(CornerId).collect();
-    let summary = traverse(&table, Some(&starts), |_| {})?;
+    // The traversal's vertex order without traversing again: per component, the start
+    // triangle's vertices, then the tip of each C in encoding order; decoder step i made
+    // triangle i, whose corner 3 i is its tip.
+    let mut vertex_order = Vec::with_capacity(vertex_ids);
+    for (s, range) in starts.iter().zip(&steps) {
+        for c in [*s, table.next(*s), table.prev(*s)] {
+            vertex_order.push(table.vertex(c));
+        }
+        for i in range.clone().rev() {
+            if decoded[i as usize] == Clers::C {
+                vertex_order.push(table.vertex(CornerId(3 * i)));
+            }
+        }
+    }
+    // Every vertex of the table exactly once (what the traversal guarantees; a corrupt
+    // stream may break it).
+    let mut seen = vec![false; vertex_ids];
+    for x in &vertex_order {
+        let slot = &mut seen[x.index()];
+        if *slot || table.vertex_corner(*x).is_none() {
+            return Err(Error::Corrupt(
+                "the decoded vertex order is not a permutation",
+            ));
+        }
+        *slot = true;
+    }
+    let used = (0..vertex_ids as u32)
+        .filter(|&x| table.vertex_corner(VertexId(x)).is_some())
+        .count();
+    if used != vertex_order.len() {
+        return Err(Error::Corrupt("the decoded vertex order misses vertices"));
+    }
+    drop(seen);
+    decoded.reverse();
+    let summary = TraversalSummary {
+        labels: decoded,
+        splits,
+        starts: starts.clone(),
+        vertex_order,
+    };
     let mut is_dummy = vec![false; vertex_ids];
     for &p in &dummy_positions {
         let v = summary
@@ -545,9 +588,6 @@ pub fn decode_connectivity(
             .get(p as usize)
             .ok_or(Error::Corrupt("dummy vertex position out of range"))?;
         is_dummy[v.index()] = true;
-    }
-    if summary.labels.len() != n as usize {
-        return Err(Error::Corrupt("re-traversal disagrees with the labels"));
     }
     Ok((
         Connectivity {

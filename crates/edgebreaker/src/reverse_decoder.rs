@@ -45,6 +45,10 @@ pub(crate) struct ReverseDecoder {
     leftmost: Vec<u32>,
     valence: Vec<u32>,
     active: Vec<u32>,
+    /// Per entry of `active`, the decoder step of the E that opened it (kept when an S
+    /// puts a split corner in the place of the entry it pops): the entries left at the end
+    /// are the components' bottoms, opened by each component's first decoded symbol.
+    origin: Vec<u32>,
     /// (decoder step of the S, saved corner), in insertion order; looked up linearly from
     /// the back because a pending split is consumed soon after it appears.
     split_active: Vec<(u32, u32)>,
@@ -70,6 +74,7 @@ impl ReverseDecoder {
             leftmost: Vec::with_capacity(capacity_faces / 2 + 3),
             valence: Vec::with_capacity(capacity_faces / 2 + 3),
             active: Vec::new(),
+            origin: Vec::new(),
             split_active: Vec::new(),
             splits,
             next_split: 0,
@@ -152,6 +157,7 @@ impl ReverseDecoder {
                     self.v[(k + j) as usize] = w;
                 }
                 self.active.push(k);
+                self.origin.push(i);
                 self.check_splits(i)?;
             }
             Clers::R | Clers::L => {
@@ -199,9 +205,11 @@ impl ReverseDecoder {
                     .active
                     .pop()
                     .ok_or(Error::Corrupt("S with nothing open"))?;
+                let b_origin = self.origin.pop().unwrap_or(0);
                 if let Some(pos) = self.split_active.iter().rposition(|&(s, _)| s == i) {
                     let (_, c) = self.split_active.swap_remove(pos);
                     self.active.push(c);
+                    self.origin.push(b_origin);
                 }
                 let a = *self
                     .active
@@ -286,7 +294,8 @@ impl ReverseDecoder {
 
     /// Closes each component with its start face and returns the start corners in encoding
     /// order of the components. Fails unless exactly `components` stay open and every corner
-    /// is glued.
+    /// is glued. [`ReverseDecoder::component_steps`] then tells which decoder steps made each
+    /// component.
     pub fn finish(&mut self, components: usize) -> Result<Vec<u32>, Error> {
         if self.step != self.symbols {
             return Err(Error::Corrupt("fewer symbols than announced"));
@@ -322,6 +331,21 @@ impl ReverseDecoder {
             return Err(Error::Corrupt("the decoded mesh is not closed"));
         }
         Ok(starts)
+    }
+
+    /// After [`ReverseDecoder::finish`]: per component in encoding order, the range of
+    /// decoder steps that made it (the decoder meets the components last first, each
+    /// opened by an E that stays at the bottom of its part of the stack).
+    pub fn component_steps(&self) -> Result<Vec<std::ops::Range<u32>>, Error> {
+        let o = &self.origin;
+        if o.first().is_some_and(|&x| x != 0) || o.windows(2).any(|w| w[0] >= w[1]) {
+            return Err(Error::Corrupt("components do not follow each other"));
+        }
+        let mut ranges: Vec<std::ops::Range<u32>> = (0..o.len())
+            .map(|m| o[m]..o.get(m + 1).copied().unwrap_or(self.symbols))
+            .collect();
+        ranges.reverse();
+        Ok(ranges)
     }
 
     /// Number of vertex ids handed out (merged ids stay unused).

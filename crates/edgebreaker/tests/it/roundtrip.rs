@@ -20,6 +20,10 @@ fn round_trip(mesh: &Mesh) -> (f64, [usize; 5]) {
     assert_eq!(used, enc.bytes.len(), "whole payload consumed");
     assert_eq!(dec.summary.labels, enc.connectivity.summary.labels);
     assert_eq!(dec.summary.splits, enc.connectivity.summary.splits);
+    // The decoder's summary (vertex order from the reverse decoder) is what traversing
+    // its table gives.
+    let again = whet_edgebreaker::traverse(&dec.table, Some(&dec.starts), |_| {}).unwrap();
+    assert_eq!(again, dec.summary);
     let mut want: Vec<[u32; 3]> = enc
         .connectivity
         .output_triangles()
