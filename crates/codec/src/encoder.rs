@@ -241,16 +241,15 @@ pub struct PreparedMesh {
 pub fn prepare_mesh(mesh: &Mesh, repair: bool) -> Result<PreparedMesh, Error> {
     let p = prepare(mesh, repair)?;
     Ok(PreparedMesh {
-        mesh: p.mesh.into_owned(),
+        mesh: p.mesh,
         repair: p.repair,
         dropped_unused_vertices: p.dropped_unused,
     })
 }
 
 /// A mesh ready for a mode: finite, oriented manifold, no unused vertices.
-pub(crate) struct Prepared<'a> {
-    /// The input itself unless repair or dropping vertices changed it.
-    pub mesh: std::borrow::Cow<'a, Mesh>,
+pub(crate) struct Prepared {
+    pub mesh: Mesh,
     /// Corner table of `mesh` (built once, reused by the connectivity coder).
     pub table: whet_mesh::CornerTable,
     /// Input vertex of each prepared vertex.
@@ -259,7 +258,7 @@ pub(crate) struct Prepared<'a> {
     pub dropped_unused: usize,
 }
 
-pub(crate) fn prepare(mesh: &Mesh, repair: bool) -> Result<Prepared<'_>, Error> {
+pub(crate) fn prepare(mesh: &Mesh, repair: bool) -> Result<Prepared, Error> {
     prepare_with(mesh, repair, true)
 }
 
@@ -267,13 +266,13 @@ pub(crate) fn prepare(mesh: &Mesh, repair: bool) -> Result<Prepared<'_>, Error> 
 /// `CornerTable::from_triangles_deferring_fans` (a vertex pinching closed fans is not
 /// detected, nor repaired: the caller must check the fans later and fall back to
 /// [`prepare`]).
-fn prepare_with(mesh: &Mesh, repair: bool, walk_fans: bool) -> Result<Prepared<'_>, Error> {
+fn prepare_with(mesh: &Mesh, repair: bool, walk_fans: bool) -> Result<Prepared, Error> {
     if let Some(v) = mesh.positions.iter().position(|p| !p.is_finite()) {
         return Err(Error::InvalidInput(
             whet_mesh::MeshError::NonFiniteCoordinate { vertex: v as u32 },
         ));
     }
-    let mut work = std::borrow::Cow::Borrowed(mesh);
+    let mut work = mesh.clone();
     let input_vertices = work.positions.len();
     let mut rep = ManifoldRepair::default();
     // The table of a valid input is built once and kept unless vertices are dropped below.
@@ -288,7 +287,7 @@ fn prepare_with(mesh: &Mesh, repair: bool, walk_fans: bool) -> Result<Prepared<'
             if !repair {
                 return Err(Error::InvalidInput(e));
             }
-            rep = work.to_mut().make_manifold();
+            rep = work.make_manifold();
             None
         }
     };
@@ -332,13 +331,12 @@ fn prepare_with(mesh: &Mesh, repair: bool, walk_fans: bool) -> Result<Prepared<'
                 orig.push(original[i]);
             }
         }
-        let w = work.to_mut();
-        for t in &mut w.triangles {
+        for t in &mut work.triangles {
             for v in t.iter_mut() {
                 *v = remap[*v as usize];
             }
         }
-        w.positions = positions;
+        work.positions = positions;
         original = orig;
         table = None;
     }
