@@ -129,6 +129,11 @@ pub(crate) struct Scratch {
     pub lp_start: Vec<u32>,
     pub lp_len: Vec<u8>,
     pub lps: Vec<crate::extended::LabelPlane>,
+    /// Extended method on surface samplings: median normal angle of the edges inside each
+    /// smooth region (`crate::extended::region_turns`), and its scratch.
+    pub region_turn: Vec<f32>,
+    pub region_start: Vec<u32>,
+    pub region_angles: Vec<f32>,
 }
 
 fn reset<T: Clone>(v: &mut Vec<T>, n: usize, x: T) {

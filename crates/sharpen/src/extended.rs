@@ -70,7 +70,9 @@ pub(crate) fn classify(run: &mut Run) {
         demote_corridors(run);
     }
     border_planes(run);
-    if !run.surface_samples {
+    if run.surface_samples {
+        region_turns(run);
+    } else {
         gray_vertices(run);
     }
     crease_vertices(run);
@@ -353,6 +355,77 @@ fn neighbour_plane_distance(run: &Run, v: u32, r: u32) -> f64 {
         }
     }
     best / (len / k.max(1) as f64)
+}
+
+/// Surface samplings: the *typical turn* of each smooth region, the median normal angle of
+/// the edges inside it (both triangles in the region), into `run.s.region_turn` (radians;
+/// 0 for a region without inner edges). Linear: the angles are bucketed by region with prefix
+/// sums, and each bucket's median is a selection, not a sort. The median, not the mean: a CAD
+/// region often joins flat faces and the tangent blends between them, whose larger angles would
+/// pull a mean up; the median is the turn of most of the region.
+pub(crate) fn region_turns(run: &mut Run) {
+    let nregions = run
+        .s
+        .region
+        .iter()
+        .filter(|&&r| r != NONE)
+        .max()
+        .map_or(0, |&m| m as usize + 1);
+    let s = &mut *run.s;
+    s.region_turn.clear();
+    s.region_turn.resize(nregions, 0.0);
+    if nregions == 0 {
+        return;
+    }
+    // The inner edges: a corner holding an angle (the lower corner of an interior edge) whose
+    // triangle and opposite triangle are in the same region.
+    let inner = |c: usize, s: &crate::edge_sharpener::Scratch| -> Option<u32> {
+        if s.angles[c] < 0.0 {
+            return None;
+        }
+        let r = s.region[c / 3];
+        if r == NONE {
+            return None;
+        }
+        let o = run.table.opposite(CornerId(c as u32))?;
+        (s.region[o.index() / 3] == r).then_some(r)
+    };
+    s.region_start.clear();
+    s.region_start.resize(nregions + 1, 0);
+    for c in 0..s.angles.len() {
+        if let Some(r) = inner(c, s) {
+            s.region_start[r as usize + 1] += 1;
+        }
+    }
+    for r in 0..nregions {
+        s.region_start[r + 1] += s.region_start[r];
+    }
+    s.region_angles.clear();
+    s.region_angles
+        .resize(s.region_start[nregions] as usize, 0.0);
+    // Fill, advancing each region's start: afterwards region_start[r] is where r ends.
+    for c in 0..s.angles.len() {
+        if let Some(r) = inner(c, s) {
+            let k = s.region_start[r as usize] as usize;
+            s.region_angles[k] = s.angles[c];
+            s.region_start[r as usize] += 1;
+        }
+    }
+    for r in 0..nregions {
+        let a = if r == 0 {
+            0
+        } else {
+            s.region_start[r - 1] as usize
+        };
+        let b = s.region_start[r] as usize;
+        s.region_turn[r] = if a == b {
+            0.0
+        } else {
+            let bucket = &mut s.region_angles[a..b];
+            let mid = bucket.len() / 2;
+            *bucket.select_nth_unstable_by(mid, f32::total_cmp).1
+        };
+    }
 }
 
 /// Label planes of the red vertices that touch a non-red triangle or two regions.
@@ -668,7 +741,9 @@ pub(crate) fn edge_snap(
                     if !consistent(run, p, &[(a, x.label), (b, y.label)], scale)
                         || !supported(run, p, &[a, b])
                         || (run.surface_samples
-                            && strip_offset(run, a, b, x, y) > STRIP_TOLERANCE * scale)
+                            && (strip_offset(run, a, b, x, y) > STRIP_TOLERANCE * scale
+                                || p.distance(anchor) > SURFACE_DISPLACEMENT * scale
+                                || !distinct_crease(run, &[(a, x), (b, y)])))
                     {
                         reason = UnmovedReason::Curved;
                         continue;
@@ -754,6 +829,112 @@ fn consistent(run: &Run, p: DVec3, sources: &[(u32, u32)], scale: f64) -> bool {
     true
 }
 
+/// Surface samplings: an edge snap moves its vertex at most this fraction of the chamfer edge
+/// from the edge's midpoint. Across a right-angled crease the crease line is half a chamfer
+/// edge from a symmetric chamfer (less from a lopsided one); it is farther only across acute
+/// wedges, which [`MAX_SURFACE_TURN`] leaves alone anyway. Measured on swing-decoded fixtures
+/// (6 angle bits, docs/results.md): no snap on the CAD parts goes farther than 0.66; on the
+/// smooth ones (bunny's ears, fertility, armadillo) snaps of 0.8-1.6 put the worst errors.
+pub(crate) const SURFACE_DISPLACEMENT: f64 = 0.75;
+
+/// Surface samplings: a snap needs planes that turn by at least this many times the mean of
+/// the *typical turns* of the two smooth regions they come from ([`region_turns`]): the
+/// *crease contrast*. A sharp crease between smooth faces turns abruptly, far more than the
+/// faces do from one triangle to the next (flat CAD faces swing-decoded with 6 angle bits:
+/// typical turns of 1.5-3 degrees, so a 90-degree crease has a contrast of 30-60; a face curved
+/// at the sampling's scale, a hole's cylinder, raises one side only, hence the mean of the two
+/// sides rather than the larger). On an organic surface the regions are curved at the
+/// sampling's scale (typical turns of 4-6 degrees), and a thin part (an ear, a finger,
+/// fertility's limbs) sampled a few triangles across shows "creases" of 45-110 degrees with a
+/// contrast of 6-20. There the truth is a rounded rim, and the plane intersection overshoots it
+/// (a tip between planes turned by `t` stands `r (1 / cos(t/2) - 1)` above a rim of radius
+/// `r`). Measured on swing-decoded fixtures at 6 angle bits and 2-8 bits per vertex
+/// (`examples/swing_sweep`, docs/results.md): at 18, spot, fertility, armadillo, bunny and
+/// rocker_arm come out unchanged or better, and the CAD parts keep 95-100 % of their RMS
+/// gains (block and partLp 90-94 % at some rates). The two classes overlap around 17-20:
+/// fandisk retiled at a quarter of its vertices (1 bpv; its curved faces turn by 5-6 degrees
+/// per edge) has creases at 18.3-20, and fertility has pseudo-creases at 17.5-18.3; at 17
+/// fertility's come back (max +6-28 % at 8 bpv), at 19-20 fandisk at 1 bpv keeps only 4 % of
+/// RMS gain instead of 7-12 %. With the larger of the two typical turns instead of the mean,
+/// 15-18 cost cad_box_hole and cad_bracket a third of their gain and still sharpened fertility.
+pub(crate) const CREASE_CONTRAST: f64 = 18.0;
+
+/// Surface samplings: sides that are smoothly connected near the chamfer need this many times
+/// [`CREASE_CONTRAST`]: planes of the *same* smooth region (a region that wraps around the end
+/// of a chamfer strip, see [`same_surface`]), or a side whose region holds, within the two-ring
+/// of its end, a triangle facing more like the other side than like its own plane ([`wraps`]).
+/// That the two sides join smoothly is itself evidence of a smooth turn. On fandisk such pairs
+/// sit where a crease fades out, with contrasts of 30-45; on fertility, spot and armadillo they
+/// are 90-110-degree bends of thin parts with contrasts of 20-26, and rocker_arm's at 2 bpv a
+/// bend next to a blend (contrast 17-20): they were the largest errors left at 1.0 (fertility
+/// at 8 bpv: max +14 %, rocker_arm at 2 bpv +4 %); 1.5 still sharpens fertility's at 105-110
+/// degrees, 2.0 costs fandisk 10 % of its RMS gain.
+pub(crate) const SAME_REGION_CONTRAST: f64 = 1.75;
+
+/// Surface samplings: no snap between planes turned by more than this (degrees): an acute
+/// wedge (interior angle under 70 degrees) sampled at the retiler's density is
+/// indistinguishable from a thin part with a rounded rim (bunny's and armadillo's ears,
+/// fertility's limbs: the largest errors the sharpener added, at turns of 110-150 degrees),
+/// and the wedge's tip overshoots a rounded rim by a factor `1 / cos(t/2) - 1` that grows
+/// without bound as the wedge closes (1.9x the rim radius at 130 degrees). The swing-decoded CAD
+/// fixtures have no snap above 105 degrees. The cost: acute CAD wedges (knife edges) stay
+/// chamfered on surface samplings.
+pub(crate) const MAX_SURFACE_TURN_DEGREES: f64 = 110.0;
+
+/// Whether the planes of a snap (`(vertex, label plane)` pairs) meet at a crease distinct
+/// from the regions' own curvature: every pair turns by at most
+/// [`MAX_SURFACE_TURN_DEGREES`] and by at least [`CREASE_CONTRAST`] times the mean typical turn
+/// of its two regions ([`SAME_REGION_CONTRAST`] times more for sides joined smoothly).
+/// Surface samplings only (on marching cubes the consistency test plays this part).
+fn distinct_crease(run: &Run, planes: &[(u32, &LabelPlane)]) -> bool {
+    let typical = |lp: &LabelPlane| {
+        f64::from(
+            run.s
+                .region_turn
+                .get(lp.label as usize)
+                .copied()
+                .unwrap_or(0.0),
+        )
+    };
+    let max_cos = MAX_SURFACE_TURN_DEGREES.to_radians().cos();
+    for (i, &(a, x)) in planes.iter().enumerate() {
+        for &(b, y) in &planes[i + 1..] {
+            let c = x.plane.normal.dot(y.plane.normal).clamp(-1.0, 1.0);
+            if c < max_cos {
+                return false;
+            }
+            // Two sides that are smoothly connected near the chamfer: one region, or a region
+            // that turns towards the other side within the two-ring of its end.
+            let joined = x.label == y.label
+                || wraps(run, a, x, y.plane.normal)
+                || wraps(run, b, y, x.plane.normal);
+            let contrast = if joined {
+                SAME_REGION_CONTRAST * CREASE_CONTRAST
+            } else {
+                CREASE_CONTRAST
+            };
+            if c.acos() < contrast * 0.5 * (typical(x) + typical(y)) {
+                return false;
+            }
+        }
+    }
+    true
+}
+
+/// Whether the region of label plane `lp` at vertex `v` wraps around towards the other side of
+/// the crease: a triangle of that region in the two-ring of `v` faces more like `other` (the
+/// other side's normal) than like `lp`'s plane.
+fn wraps(run: &Run, v: u32, lp: &LabelPlane, other: DVec3) -> bool {
+    run.table.vertex_corners(VertexId(v)).any(|c| {
+        let u = run.cv(next(c.index()));
+        run.table.vertex_corners(VertexId(u)).any(|cc| {
+            let t = cc.index() / 3;
+            run.s.region[t] == lp.label
+                && run.s.normals[t].dot(other) > run.s.normals[t].dot(lp.plane.normal)
+        })
+    })
+}
+
 /// On a surface sampling ([`is_surface_sampling`]) every vertex of a chamfer strip across a
 /// sharp crease lies on one of the two faces; across a blend a few samples wide the strip's
 /// vertices lie on the blend, between the planes, which meet far above it. An edge snap is
@@ -819,6 +1000,8 @@ pub(crate) fn corner_snap(
                             &[(tri[0], x.label), (tri[1], y.label), (tri[2], z.label)],
                             2.0 * scale,
                         ) || !supported(run, q, &tri)
+                            || (run.surface_samples
+                                && !distinct_crease(run, &[(tri[0], x), (tri[1], y), (tri[2], z)]))
                         {
                             reason = UnmovedReason::Curved;
                             continue;
@@ -841,7 +1024,13 @@ pub(crate) fn corner_snap(
         return Ok((q, planes));
     }
     // No three independent planes (a corner triangle inside a straight chamfer): the crease
-    // line of the best pair.
+    // line of the best pair. Not on surface samplings: there a corner triangle whose planes do
+    // not give a corner point lies where a chamfer strip ends or bends, and the line of two of
+    // its planes left spot's and rocker_arm's worst errors (swing-decoded, docs/results.md);
+    // the chamfer edges around it are split and snapped on their own.
+    if run.surface_samples {
+        return Err(reason);
+    }
     for (i, j) in [(0, 1), (1, 2), (2, 0)] {
         for x in p[i] {
             for y in p[j] {
