@@ -738,12 +738,13 @@ pub(crate) fn edge_snap(
         for y in planes_of(run, b) {
             match snap::edge_point(&x.plane, &y.plane, anchor, &run.limits) {
                 Ok(p) => {
+                    // Cheap tests first (the result does not depend on the order).
                     if !consistent(run, p, &[(a, x.label), (b, y.label)], scale)
-                        || !supported(run, p, &[a, b])
                         || (run.surface_samples
-                            && (strip_offset(run, a, b, x, y) > STRIP_TOLERANCE * scale
-                                || p.distance(anchor) > SURFACE_DISPLACEMENT * scale
-                                || !distinct_crease(run, &[(a, x), (b, y)])))
+                            && (p.distance(anchor) > SURFACE_DISPLACEMENT * scale
+                                || !distinct_crease(run, &[(a, x), (b, y)])
+                                || strip_offset(run, a, b, x, y) > STRIP_TOLERANCE * scale))
+                        || !supported(run, p, &[a, b])
                     {
                         reason = UnmovedReason::Curved;
                         continue;
@@ -905,17 +906,19 @@ fn distinct_crease(run: &Run, planes: &[(u32, &LabelPlane)]) -> bool {
             if c < max_cos {
                 return false;
             }
-            // Two sides that are smoothly connected near the chamfer: one region, or a region
-            // that turns towards the other side within the two-ring of its end.
-            let joined = x.label == y.label
-                || wraps(run, a, x, y.plane.normal)
-                || wraps(run, b, y, x.plane.normal);
-            let contrast = if joined {
-                SAME_REGION_CONTRAST * CREASE_CONTRAST
-            } else {
-                CREASE_CONTRAST
-            };
-            if c.acos() < contrast * 0.5 * (typical(x) + typical(y)) {
+            // Two sides that are smoothly connected near the chamfer (one region, or a region
+            // that turns towards the other side within the two-ring of its end) need the higher
+            // contrast; the two-ring is looked at only when the contrast is in between.
+            let needed = CREASE_CONTRAST * 0.5 * (typical(x) + typical(y));
+            let turn = c.acos();
+            if turn < needed {
+                return false;
+            }
+            if turn < SAME_REGION_CONTRAST * needed
+                && (x.label == y.label
+                    || wraps(run, a, x, y.plane.normal)
+                    || wraps(run, b, y, x.plane.normal))
+            {
                 return false;
             }
         }
@@ -1001,9 +1004,9 @@ pub(crate) fn corner_snap(
                             q,
                             &[(tri[0], x.label), (tri[1], y.label), (tri[2], z.label)],
                             2.0 * scale,
-                        ) || !supported(run, q, &tri)
-                            || (run.surface_samples
-                                && !distinct_crease(run, &[(tri[0], x), (tri[1], y), (tri[2], z)]))
+                        ) || (run.surface_samples
+                            && !distinct_crease(run, &[(tri[0], x), (tri[1], y), (tri[2], z)]))
+                            || !supported(run, q, &tri)
                         {
                             reason = UnmovedReason::Curved;
                             continue;
