@@ -851,8 +851,8 @@ pub(crate) const SURFACE_DISPLACEMENT: f64 = 0.75;
 /// (a tip between planes turned by `t` stands `r (1 / cos(t/2) - 1)` above a rim of radius
 /// `r`). Measured on swing-decoded fixtures at 6 angle bits and 2-8 bits per vertex
 /// (`examples/swing_sweep`, docs/results.md): at 18, spot, fertility, armadillo, bunny and
-/// rocker_arm come out unchanged or better, and the CAD parts keep 95-100 % of their RMS
-/// gains (block and partLp 90-94 % at some rates). The two classes overlap around 17-20:
+/// rocker_arm come out unchanged or better, and the CAD parts' RMS ratios move by under 4 %
+/// (fandisk at 2.1 bpv 10 %, block and partLp 7-14 %). The two classes overlap around 17-20:
 /// fandisk retiled at a quarter of its vertices (1 bpv; its curved faces turn by 5-6 degrees
 /// per edge) has creases at 18.3-20, and fertility has pseudo-creases at 17.5-18.3; at 17
 /// fertility's come back (max +6-28 % at 8 bpv), at 19-20 fandisk at 1 bpv keeps only 4 % of
