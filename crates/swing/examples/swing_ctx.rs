@@ -1,6 +1,6 @@
 //! Measurement: cost of the swing indices under several context schemes (bits per index),
 //! among them order 0 (stream kinds 0 and 2) and the shipped fan-normal prediction (kinds 3
-//! and 4).
+//! and 4), and that prediction's angle scaled by 1-2 (not shipped: docs/swing.md section 2).
 //!
 //! ```text
 //! cargo run --release -p whet-swing --example swing_ctx -- x BITS L/diag mesh.off...
@@ -35,6 +35,8 @@ fn main() {
         let mut tri_parent = vec![usize::MAX; t.triangle_count()];
         let mut rows = Vec::new();
         let mut preds: Vec<i32> = Vec::new();
+        // Unrounded angle of the fan-normal prediction (std atan2; a measurement only).
+        let mut pred_theta: Vec<f64> = Vec::new();
         let mut acc = vec![whet_mesh::DVec3::ZERO; t.vertex_count()];
         let pos = &r.mesh.positions;
         let add_tri = |acc: &mut Vec<whet_mesh::DVec3>, c: whet_mesh::CornerId| {
@@ -70,6 +72,12 @@ fn main() {
                     // The shipped prediction (kinds 3 and 4 of the stream).
                     let nn = acc[a.index()] + acc[b.index()];
                     preds.push(whet_codec::swing::predict_swing(&fr, nn, &params.angles));
+                    let (mut x, mut y) = (fr.e2.dot(nn), -fr.e1.dot(nn));
+                    if x < 0.0 {
+                        x = -x;
+                        y = -y;
+                    }
+                    pred_theta.push(y.atan2(x));
                     tri_q[tip.face().index()] = Some(q);
                     last_q = q;
                 }
@@ -130,6 +138,21 @@ fn main() {
             },
             45,
         );
+        // Scaled predictions: the fan normal lags behind the tip (it averages the built
+        // side), so the surface bends on by more than the angle it predicts.
+        let inv = 1.0 / params.angles.step();
+        for lam in [1.0, 1.25, 1.5, 1.75, 2.0] {
+            let mut trees: Vec<BitTree> = (0..8).map(|_| BitTree::new(bits)).collect();
+            let mut c = CostCounter::new();
+            let mask = (1u32 << bits) - 1;
+            let half = 1i32 << (bits - 1);
+            for (row, th) in rows.iter().zip(&pred_theta) {
+                let p = ((lam * th * inv).round() as i32).clamp(-half, half - 1);
+                let d = ((row.0 - p + half).rem_euclid(1 << bits)) - half;
+                c.encode_tree(&mut trees[bl(zz(p)).min(7)], zz(d) & mask);
+            }
+            println!("{name}: scaled prediction x{lam}: {:.3} bits", c.bits() / n);
+        }
         println!("{name} B={bits} f={f}: n={} order0 {o0:.3} parent-bucket {pbucket:.3} parent-resid {pres:.3} parent-resid+bucket {pres_b:.3} last-bucket {lastq:.3} NORMAL-PRED {lastres:.3} normpred+bucket {normpred_b:.3} SHIPPED {shipped:.3} ({:+.1} %) avg-pred {avg:.3} pbucket+label {pb_label:.3}", rows.len(), 100.0 * (shipped / o0 - 1.0));
     }
 }

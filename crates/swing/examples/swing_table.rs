@@ -67,6 +67,7 @@ fn main() {
             }
         };
         let enc_ms = t0.elapsed().as_secs_f64() * 1e3;
+        eprintln!("{name}: search (L/diag, bytes) {:?}", out.search);
         let t1 = Instant::now();
         let back = decode(&out.bytes, &DecodeOptions::DEFAULT).unwrap();
         let dec_ms = t1.elapsed().as_secs_f64() * 1e3;

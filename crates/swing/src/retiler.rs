@@ -178,6 +178,13 @@ pub struct Retiled {
 
 const NONE: u32 = u32::MAX;
 
+/// Most triangles one retiled vertex may get (a regular one has 6; the wedge measure walks
+/// at most 64): beyond, the front is spinning around the vertex, wrapping the same spot
+/// again and again, and the retiler gives up at once (the encoder retries at another `L`)
+/// instead of running on to the triangle budget, which took minutes on the armadillo at
+/// one length (5 angle bits, L = 0.9606 % of the diagonal).
+const MAX_VALENCE: u32 = 40;
+
 #[derive(Clone, Copy, Debug)]
 struct Node {
     v: u32,
@@ -249,6 +256,10 @@ struct Retiler<'s, 'm> {
     l: f64,
     pos: Vec<DVec3>,
     nrm: Vec<DVec3>,
+    /// Triangles incident to each vertex so far.
+    valence: Vec<u32>,
+    /// Set when a vertex exceeds [`MAX_VALENCE`]: the front is spinning around it.
+    runaway: bool,
     src: Vec<VertexSource>,
     tris: Vec<[u32; 3]>,
     tri_normal: Vec<DVec3>,
@@ -295,6 +306,8 @@ pub fn retile(
         l,
         pos: Vec::new(),
         nrm: Vec::new(),
+        valence: Vec::new(),
+        runaway: false,
         src: Vec::new(),
         tris: Vec::new(),
         tri_normal: Vec::new(),
@@ -560,6 +573,7 @@ impl Retiler<'_, '_> {
         let v = self.pos.len() as u32;
         self.pos.push(p);
         self.nrm.push(n);
+        self.valence.push(0);
         self.src.push(s);
         self.vcorner.push(NONE);
         self.vnode.push(NONE);
@@ -595,6 +609,9 @@ impl Retiler<'_, '_> {
         let id = self.tris.len() as u32;
         let [w, a, b] = t;
         for (k, &v) in t.iter().enumerate() {
+            let n = &mut self.valence[v as usize];
+            *n += 1;
+            self.runaway |= *n > MAX_VALENCE;
             let c = 3 * id + k as u32;
             self.corner_next.push(self.vcorner[v as usize]);
             self.vcorner[v as usize] = c;
@@ -648,6 +665,8 @@ impl Retiler<'_, '_> {
         }
         self.pos.truncate(nv);
         self.nrm.truncate(nv);
+        self.valence.truncate(nv);
+        self.runaway = false;
         self.src.truncate(nv);
         self.vcorner.truncate(nv);
         self.vnode.truncate(nv);
@@ -741,6 +760,14 @@ impl Retiler<'_, '_> {
                 if at.to_str().and_then(|x| x.parse::<usize>().ok()) == Some(self.tris.len()) {
                     self.dump(std::path::Path::new("/tmp/dump_at.off"), gate);
                 }
+            }
+            if self.runaway {
+                self.runaway = false;
+                return Err(Error::Stuck(format!(
+                    "component {} has a vertex with more than {MAX_VALENCE} triangles (the \
+                     front is spinning around it)",
+                    self.comp
+                )));
             }
             let stepped = self.step(gate);
             if let (Err(_), Some(path)) = (&stepped, trace_var("WHET_SWING_DUMP")) {
@@ -1142,13 +1169,7 @@ impl Retiler<'_, '_> {
 
     /// Triangles incident to vertex `v` so far.
     fn triangle_count(&self, v: u32) -> u32 {
-        let mut c = self.vcorner[v as usize];
-        let mut k = 0;
-        while c != NONE {
-            k += 1;
-            c = self.corner_next[c as usize];
-        }
-        k
+        self.valence[v as usize]
     }
 
     /// Adjustment of the closing angle of node `n`'s wedge by the valence its vertex would
@@ -1761,6 +1782,13 @@ impl Retiler<'_, '_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn runaway_cap_stays_within_the_wedge_walk() {
+        // wedge_in walks a fan of at most 66 vertices: the cap must stop the front before
+        // any fan outgrows it, and leave room far above regular valences.
+        const { assert!(MAX_VALENCE < 64 && MAX_VALENCE >= 24) };
+    }
 
     #[test]
     fn ccw_measures_counter_clockwise() {
