@@ -303,18 +303,25 @@ impl ResidualIo for ResidualReader<'_, '_> {
 /// Highest priority bucket of the prediction-degree order.
 const MAX_DEGREE: usize = 4;
 
-/// Vertex states of the prediction-degree walk.
+/// Vertex states of the prediction-degree walk, in the low two bits of a vertex's state
+/// byte; an unknown vertex keeps its degree (saturating at [`MAX_DEGREE`], all the order
+/// distinguishes) above them, so one load tells both and an entry of bucket `d` is current
+/// exactly when its vertex's byte is `d << DEGREE_SHIFT`.
 const UNKNOWN: u8 = 0;
 const KNOWN: u8 = 1;
 const DUMMY: u8 = 2;
+const STATE_MASK: u8 = 3;
+const DEGREE_SHIFT: u32 = 2;
+const DEGREE_ONE: u8 = 1 << DEGREE_SHIFT;
+const FULL_DEGREE: u8 = (MAX_DEGREE as u8) << DEGREE_SHIFT;
 
 /// The walk state of [`code_positions`]: one byte of state, a degree and an anchor corner
 /// per vertex, and the degree buckets.
 struct DegreeOrder<'t> {
     cv: &'t [u32],
     opp: &'t [u32],
+    /// State and degree per vertex (see [`UNKNOWN`]).
     state: Vec<u8>,
-    degree: Vec<u8>,
     // Each vertex's fan is walked from an anchor corner fixed by the order itself (the start
     // corners, then the corner where a vertex was first met), never from the table's own
     // vertex_corner: corner numbering differs between the encoder's table and the decoder's.
@@ -331,40 +338,7 @@ fn next_corner(c: usize) -> usize {
     }
 }
 
-#[inline(always)]
-fn prev_corner(c: usize) -> usize {
-    if c % 3 == 0 {
-        c + 2
-    } else {
-        c - 1
-    }
-}
-
 impl DegreeOrder<'_> {
-    /// Anchors unknown neighbour `x` of a known vertex (at corner `cx`) and raises its degree
-    /// across the triangle whose third vertex is `y`. True when `x` is unknown, so must be
-    /// queued.
-    #[inline(always)]
-    fn raise(&mut self, x: usize, y: usize, cx: usize) -> bool {
-        if self.anchor[x] == u32::MAX {
-            self.anchor[x] = cx as u32;
-        }
-        if self.state[x] != UNKNOWN {
-            return false;
-        }
-        if self.state[y] == KNOWN {
-            self.degree[x] = self.degree[x].saturating_add(1);
-        }
-        true
-    }
-
-    /// Queues `x` at its current degree.
-    #[inline(always)]
-    fn push(&mut self, x: usize) {
-        let d = (self.degree[x] as usize).min(MAX_DEGREE);
-        self.buckets[d].push(x as u32);
-    }
-
     /// One walk around the fan of vertex `v` from its anchor: with `cands`, collects the
     /// parallelogram predictions of `v` (as [`crate::parallelogram::candidates`] does, in
     /// the same order) before `v` is known; and raises the degree of `v`'s unknown
@@ -382,74 +356,20 @@ impl DegreeOrder<'_> {
         &mut self,
         v: usize,
         q: &[[i32; 3]],
-        mut cands: Option<&mut [[i64; 3]; MAX_CANDIDATES]>,
+        cands: Option<&mut [[i64; 3]; MAX_CANDIDATES]>,
     ) -> (usize, [i64; 3]) {
-        let nc = self.cv.len();
-        let start = self.anchor[v] as usize;
-        let mut sum = [0i64; 3];
-        if start >= nc {
-            return (0, sum);
-        }
-        let mut count = 0usize;
-        let mut c = start;
-        let mut guard = 0usize;
-        // The first triangle's first vertex (queued at the end) and the previous triangle's
-        // second vertex (queued with the next triangle's first raise, normally itself).
-        let first = self.cv[next_corner(start)] as usize;
-        let mut first_queued = false;
-        let mut pending = usize::MAX;
-        loop {
-            let (ca, cb) = (next_corner(c), prev_corner(c));
-            let a = self.cv[ca] as usize;
-            let b = self.cv[cb] as usize;
-            if let Some(out) = cands.as_deref_mut() {
-                if count < MAX_CANDIDATES && self.state[a] == KNOWN && self.state[b] == KNOWN {
-                    let o = self.opp[c] as usize;
-                    if o < nc {
-                        let w = self.cv[o] as usize;
-                        if self.state[w] == KNOWN && w != v {
-                            let (qa, qb, qw) = (q[a], q[b], q[w]);
-                            let p = [
-                                qa[0] as i64 + qb[0] as i64 - qw[0] as i64,
-                                qa[1] as i64 + qb[1] as i64 - qw[1] as i64,
-                                qa[2] as i64 + qb[2] as i64 - qw[2] as i64,
-                            ];
-                            out[count] = p;
-                            sum = [sum[0] + p[0], sum[1] + p[1], sum[2] + p[2]];
-                            count += 1;
-                        }
-                    }
-                }
-            }
-            if pending != a && pending != usize::MAX {
-                self.push(pending);
-            }
-            if self.raise(a, b, ca) && c != start {
-                self.push(a);
-            }
-            pending = if self.raise(b, a, cb) { b } else { usize::MAX };
-            let o = self.opp[ca] as usize;
-            if o >= nc {
-                break;
-            }
-            let n = next_corner(o);
-            if n == start {
-                first_queued = pending == first;
-                break;
-            }
-            c = n;
-            guard += 1;
-            if guard > nc {
-                break;
-            }
-        }
-        if pending != usize::MAX {
-            self.push(pending);
-        }
-        if !first_queued && self.state[first] == UNKNOWN {
-            self.push(first);
-        }
-        (count, sum)
+        // The walk proper takes each array as its own argument: distinct slices let the
+        // compiler keep their bounds and base pointers in registers across the stores.
+        walk_fan(
+            self.cv,
+            self.opp,
+            &mut self.state,
+            &mut self.anchor,
+            &mut self.buckets,
+            v,
+            q,
+            cands,
+        )
     }
 
     /// Pops the vertex with the highest degree; stale entries (already known, or queued at
@@ -459,13 +379,134 @@ impl DegreeOrder<'_> {
         for d in (0..=MAX_DEGREE).rev() {
             while let Some(x) = self.buckets[d].pop() {
                 let x = x as usize;
-                if self.state[x] == UNKNOWN && (self.degree[x] as usize).min(MAX_DEGREE) == d {
+                if self.state[x] == (d as u8) << DEGREE_SHIFT {
                     return Some(x);
                 }
             }
         }
         None
     }
+}
+
+/// Anchors unknown neighbour `x` of a known vertex (at corner `cx`) and raises its degree
+/// across the triangle whose third vertex is `y`. True when `x` is unknown, so must be
+/// queued.
+#[inline(always)]
+fn raise(anchor: &mut [u32], state: &mut [u8], x: usize, y: usize, cx: usize) -> bool {
+    if anchor[x] == u32::MAX {
+        anchor[x] = cx as u32;
+    }
+    let sx = state[x];
+    if sx & STATE_MASK != UNKNOWN {
+        return false;
+    }
+    if state[y] & STATE_MASK == KNOWN && sx < FULL_DEGREE {
+        state[x] = sx + DEGREE_ONE;
+    }
+    true
+}
+
+/// Queues `x` at its current degree.
+#[inline(always)]
+fn push(state: &[u8], buckets: &mut [Vec<u32>; MAX_DEGREE + 1], x: usize) {
+    let d = (state[x] >> DEGREE_SHIFT) as usize;
+    buckets[d].push(x as u32);
+}
+
+/// [`DegreeOrder::walk`].
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn walk_fan(
+    cv: &[u32],
+    opp: &[u32],
+    state: &mut [u8],
+    anchor: &mut [u32],
+    buckets: &mut [Vec<u32>; MAX_DEGREE + 1],
+    v: usize,
+    q: &[[i32; 3]],
+    mut cands: Option<&mut [[i64; 3]; MAX_CANDIDATES]>,
+) -> (usize, [i64; 3]) {
+    let nc = cv.len();
+    let start = anchor[v] as usize;
+    let mut sum = [0i64; 3];
+    if start >= nc {
+        return (0, sum);
+    }
+    let mut count = 0usize;
+    let mut c = start;
+    let mut guard = 0usize;
+    // The first triangle's first vertex (queued at the end) and the previous triangle's
+    // second vertex (queued with the next triangle's first raise, normally itself).
+    let first = cv[next_corner(start)] as usize;
+    let mut first_queued = false;
+    let mut pending = usize::MAX;
+    loop {
+        // One modulo per step: the corners after and before c in its triangle.
+        let (ca, cb) = {
+            let c32 = c as u32;
+            let j = c32 % 3;
+            let base = c32 - j;
+            let ca = if j == 2 { base } else { c32 + 1 };
+            let cb = if j == 0 { base + 2 } else { c32 - 1 };
+            (ca as usize, cb as usize)
+        };
+        let a = cv[ca] as usize;
+        let b = cv[cb] as usize;
+        if let Some(out) = cands.as_deref_mut() {
+            if count < MAX_CANDIDATES
+                && state[a] & STATE_MASK == KNOWN
+                && state[b] & STATE_MASK == KNOWN
+            {
+                let o = opp[c] as usize;
+                if o < nc {
+                    let w = cv[o] as usize;
+                    if state[w] & STATE_MASK == KNOWN && w != v {
+                        let (qa, qb, qw) = (q[a], q[b], q[w]);
+                        let p = [
+                            qa[0] as i64 + qb[0] as i64 - qw[0] as i64,
+                            qa[1] as i64 + qb[1] as i64 - qw[1] as i64,
+                            qa[2] as i64 + qb[2] as i64 - qw[2] as i64,
+                        ];
+                        out[count] = p;
+                        sum = [sum[0] + p[0], sum[1] + p[1], sum[2] + p[2]];
+                        count += 1;
+                    }
+                }
+            }
+        }
+        if pending != a && pending != usize::MAX {
+            push(state, buckets, pending);
+        }
+        if raise(anchor, state, a, b, ca) && c != start {
+            push(state, buckets, a);
+        }
+        pending = if raise(anchor, state, b, a, cb) {
+            b
+        } else {
+            usize::MAX
+        };
+        let o = opp[ca];
+        if o as usize >= nc {
+            break;
+        }
+        let n = (if o % 3 == 2 { o - 2 } else { o + 1 }) as usize;
+        if n == start {
+            first_queued = pending == first;
+            break;
+        }
+        c = n;
+        guard += 1;
+        if guard > nc {
+            break;
+        }
+    }
+    if pending != usize::MAX {
+        push(state, buckets, pending);
+    }
+    if !first_queued && state[first] & STATE_MASK == UNKNOWN {
+        push(state, buckets, first);
+    }
+    (count, sum)
 }
 
 /// Codes each real vertex's grid coordinates through `io`, in the prediction-degree order
@@ -500,7 +541,6 @@ pub(crate) fn code_positions<I: ResidualIo>(
                 }
             })
             .collect(),
-        degree: vec![0u8; nv],
         anchor: vec![u32::MAX; nv],
         buckets: Default::default(),
     };
@@ -524,7 +564,7 @@ pub(crate) fn code_positions<I: ResidualIo>(
         let mut first: Option<[i32; 3]> = None;
         let mut second: Option<[i32; 3]> = None;
         for &vi in &vs {
-            if st.state[vi] != UNKNOWN {
+            if st.state[vi] & STATE_MASK != UNKNOWN {
                 continue;
             }
             let mut value = q[vi];

@@ -294,15 +294,15 @@ fn code_labels<S: BitSink>(
     let mut models = LabelModels::new();
     let mut prev = Clers::E;
     for &sym in labels.iter().rev() {
-        if dec.next_is_forced_e() {
-            if sym != Clers::E {
+        let gate = dec.gate();
+        match gate {
+            None if sym != Clers::E => {
                 return Err(Error::Corrupt("a component does not end with E"));
             }
-        } else {
-            let ctx = dec.context();
-            sink.encode_symbol(models.get(ctx, prev), sym as usize);
+            None => {}
+            Some(g) => sink.encode_symbol(models.get(g.context, prev), sym as usize),
         }
-        dec.apply(sym)?;
+        dec.apply(sym, gate)?;
         prev = sym;
     }
     Ok(())
@@ -512,14 +512,16 @@ pub fn decode_connectivity(
     // Labels in decoding order (the reverse of the encoder's).
     let mut decoded: Vec<Clers> = Vec::with_capacity((n as usize).min(1 << 22));
     for i in 0..n32 {
-        let sym = if rev.next_is_forced_e() {
-            Clers::E
-        } else {
-            let ctx = rev.context();
-            let s = dec.decode_symbol(models.get(ctx, prev));
-            Clers::from_index(s).ok_or(Error::Corrupt("label out of range"))?
+        let gate = rev.gate();
+        let sym = match gate {
+            // Nothing open: the symbol is a forced E, not coded.
+            None => Clers::E,
+            Some(g) => {
+                let s = dec.decode_symbol(models.get(g.context, prev));
+                Clers::from_index(s).ok_or(Error::Corrupt("label out of range"))?
+            }
         };
-        rev.apply(sym)?;
+        rev.apply(sym, gate)?;
         decoded.push(sym);
         prev = sym;
         // A stream cut short decodes zeros forever; stop early rather than building a

@@ -36,6 +36,25 @@ fn prev(c: u32) -> u32 {
     }
 }
 
+/// The open edge a symbol is applied at: the corner on top of the active stack, the vertex
+/// after it and that vertex's valence context.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Gate {
+    corner: u32,
+    vertex: u32,
+    /// Remaining valence context, in `0..VALENCE_CONTEXTS`.
+    pub context: usize,
+}
+
+#[inline]
+fn checked_vertex(x: u32) -> Result<u32, Error> {
+    if x == NONE {
+        Err(Error::Corrupt("a corner has no vertex"))
+    } else {
+        Ok(x)
+    }
+}
+
 /// The state of a reverse decode.
 pub(crate) struct ReverseDecoder {
     /// Vertex of each corner.
@@ -83,23 +102,24 @@ impl ReverseDecoder {
         }
     }
 
-    /// True when the next symbol is forced to be E (nothing is open yet), so it is not coded.
+    /// The open edge the next symbol is applied at (`None` when nothing is open and the
+    /// next symbol is a forced E), looked up once for both the symbol's context and
+    /// [`ReverseDecoder::apply`].
     #[inline]
-    pub fn next_is_forced_e(&self) -> bool {
-        self.active.is_empty()
-    }
-
-    /// The valence context of the next symbol, in `0..VALENCE_CONTEXTS`.
-    #[inline]
-    pub fn context(&self) -> usize {
-        match self.active.last() {
-            Some(&a) => {
-                let x = self.v[next(a) as usize];
-                let val = self.valence[x as usize].clamp(2, 7);
-                (val - 2) as usize
-            }
-            None => 0,
-        }
+    pub fn gate(&self) -> Option<Gate> {
+        let &a = self.active.last()?;
+        let x = self.v.get(next(a) as usize).copied().unwrap_or(NONE);
+        let val = self
+            .valence
+            .get(x as usize)
+            .copied()
+            .unwrap_or(0)
+            .clamp(2, 7);
+        Some(Gate {
+            corner: a,
+            vertex: x,
+            context: (val - 2) as usize,
+        })
     }
 
     fn new_vertex(&mut self, corner: u32) -> u32 {
@@ -138,8 +158,10 @@ impl ReverseDecoder {
         }
     }
 
-    /// Applies one symbol (the next one in decoding order).
-    pub fn apply(&mut self, sym: Clers) -> Result<(), Error> {
+    /// Applies one symbol (the next one in decoding order) at `gate`, which must be what
+    /// [`ReverseDecoder::gate`] returned just before.
+    #[inline]
+    pub fn apply(&mut self, sym: Clers, gate: Option<Gate>) -> Result<(), Error> {
         if self.step >= self.symbols {
             return Err(Error::Corrupt("more symbols than announced"));
         }
@@ -161,10 +183,11 @@ impl ReverseDecoder {
                 self.check_splits(i)?;
             }
             Clers::R | Clers::L => {
-                let a = *self
-                    .active
-                    .last()
-                    .ok_or(Error::Corrupt("R or L with nothing open"))?;
+                let Gate {
+                    corner: a,
+                    vertex: x,
+                    ..
+                } = gate.ok_or(Error::Corrupt("R or L with nothing open"))?;
                 let (o, cl, cr) = if sym == Clers::R {
                     (k + 2, k + 1, k)
                 } else {
@@ -176,18 +199,19 @@ impl ReverseDecoder {
                 let vr = self.vertex_of(prev(a))?;
                 self.v[cr as usize] = vr;
                 self.leftmost[vr as usize] = cr;
-                self.v[cl as usize] = self.vertex_of(next(a))?;
+                self.v[cl as usize] = checked_vertex(x)?;
                 if let Some(top) = self.active.last_mut() {
                     *top = k;
                 }
                 self.check_splits(i)?;
             }
             Clers::C => {
-                let a = *self
-                    .active
-                    .last()
-                    .ok_or(Error::Corrupt("C with nothing open"))?;
-                let x = self.vertex_of(next(a))?;
+                let Gate {
+                    corner: a,
+                    vertex: x,
+                    ..
+                } = gate.ok_or(Error::Corrupt("C with nothing open"))?;
+                let x = checked_vertex(x)?;
                 let b = next(self.leftmost_of(x)?);
                 self.glue(a, k + 1)?;
                 self.glue(b, k + 2)?;
@@ -268,7 +292,18 @@ impl ReverseDecoder {
         Ok(())
     }
 
+    /// Activates the split events whose source is decoder step `i`.
+    #[inline(always)]
     fn check_splits(&mut self, i: u32) -> Result<(), Error> {
+        // Most steps have none: the next event's source is further on.
+        match self.splits.get(self.next_split) {
+            Some(ev) if ev.source >= self.symbols - 1 - i => self.check_splits_at(i),
+            _ => Ok(()),
+        }
+    }
+
+    #[inline(never)]
+    fn check_splits_at(&mut self, i: u32) -> Result<(), Error> {
         let source = self.symbols - 1 - i;
         while let Some(ev) = self.splits.get(self.next_split) {
             if ev.source != source {

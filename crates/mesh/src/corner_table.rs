@@ -258,14 +258,19 @@ impl CornerTable {
                 let oi = o as usize;
                 let c = 3 * t + j;
                 let (x, y) = (tv[(j + 1) % 3], tv[(j + 2) % 3]);
-                let base = oi - oi % 3;
+                // The corners before and after oi in its triangle from one 32-bit modulo
+                // and two table offsets (three 64-bit modulos were most of this loop).
+                const BEFORE: [u32; 3] = [2, 0, 1];
+                const AFTER: [u32; 3] = [1, 2, 0];
+                let k = (o % 3) as usize;
+                let base = o - k as u32;
+                let before = (base + BEFORE[k]) as usize;
+                let after = (base + AFTER[k]) as usize;
                 // A pair is checked in full from its first corner; from the second, that
                 // it is mutual is enough (the first then checked this very pair).
                 let consistent = oi < nc
                     && opposite[oi] == c as u32
-                    && (oi < c
-                        || (corner_vertex[base + (oi + 2) % 3] == x
-                            && corner_vertex[base + (oi + 1) % 3] == y));
+                    && (oi < c || (corner_vertex[before] == x && corner_vertex[after] == y));
                 if !consistent {
                     return Err(MeshError::NonManifoldEdge {
                         a: x.min(y),

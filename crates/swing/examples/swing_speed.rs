@@ -6,7 +6,8 @@
 //! cargo run --release -p whet-swing --example swing_speed [-- mesh.off [fraction]]
 //! ```
 //! Without arguments: armadillo split 1-to-4 twice (1.38 M triangles), L chosen for about
-//! 100 k retiled triangles.
+//! 100 k retiled triangles. With `SWING_SPEED_STREAM=<path>` the stream is also written there,
+//! for `cargo run --release -p whet-codec --example decode_file -- <path>`.
 #![allow(clippy::unwrap_used)] // a measurement tool
 
 use std::collections::HashMap;
@@ -64,6 +65,10 @@ fn main() {
         out = Some(o);
     }
     let out = out.unwrap();
+    if let Ok(path) = std::env::var("SWING_SPEED_STREAM") {
+        // Keep the stream for `whet-codec`'s decode_file example (a decode-only profile).
+        std::fs::write(path, &out.bytes).unwrap();
+    }
     let tris = out.report.triangles;
     let mut best_dec = f64::MAX;
     for _ in 0..10 {
