@@ -87,11 +87,12 @@ impl BitModel {
     /// Moves the probability towards the bit just seen.
     #[inline]
     pub fn update(&mut self, bit: bool) {
-        if bit {
-            self.0 -= self.0 >> ADAPT_SHIFT;
-        } else {
-            self.0 += ((PROB_ONE as u16) - self.0) >> ADAPT_SHIFT;
-        }
+        // Both moves computed and one masked away: decoded bits are often unpredictable,
+        // and a branch on them costs more than the arithmetic.
+        let one = 0u16.wrapping_sub(bit as u16);
+        let down = self.0 >> ADAPT_SHIFT;
+        let up = ((PROB_ONE as u16) - self.0) >> ADAPT_SHIFT;
+        self.0 = self.0.wrapping_add(up & !one).wrapping_sub(down & one);
     }
 
     /// Cost of coding `bit` now, in 1/[`crate::COST_ONE`] bits (without updating).

@@ -208,14 +208,11 @@ impl<'a> RangeDecoder<'a> {
     #[inline]
     pub fn decode_bit(&mut self, model: &mut BitModel) -> bool {
         let bound = (self.range >> PROB_BITS) * model.p0() as u32;
-        let bit = if self.code < bound {
-            self.range = bound;
-            false
-        } else {
-            self.code -= bound;
-            self.range -= bound;
-            true
-        };
+        // Without a branch on the bit (see BitModel::update): the masked interval.
+        let bit = self.code >= bound;
+        let one = 0u32.wrapping_sub(bit as u32);
+        self.code = self.code.wrapping_sub(bound & one);
+        self.range = (bound & !one) | (self.range.wrapping_sub(bound) & one);
         model.update(bit);
         self.normalize();
         bit

@@ -42,7 +42,7 @@
 use crate::exact::{code_positions, ResidualReader, ResidualWriter};
 use crate::{EncodeReport, Error, Quantizer};
 use whet_bits::{BitModel, BitSink, BitTree, RangeDecoder, RangeEncoder};
-use whet_edgebreaker::{traverse, Clers, Connectivity, ConnectivityLimits, Step};
+use whet_edgebreaker::{Clers, Connectivity, ConnectivityLimits, Step};
 use whet_format::{tag, Container, Header, Limits, Mode, SectionKind, Version};
 use whet_mesh::{Aabb, DVec3, ManifoldRepair, Mesh, VertexId};
 
@@ -571,43 +571,51 @@ impl SwingIo for SwingReader<'_, '_> {
     }
 }
 
-/// Walks `conn` in traversal order, reconstructing every vertex through `io` into
-/// `positions` (indexed by table vertex) and listing the triangles in output order (table
-/// vertex ids, `[tip, n(tip), p(tip)]`). The same code runs in the encoder and the decoder.
-/// With `predict` (kinds 3 and 4) every swing index is coded as the residual of
-/// [`predict_swing`] from the normals of the triangles reconstructed so far.
+/// Walks `conn` in traversal order, reconstructing every vertex through `io`: `positions`
+/// in creation order and the triangles in traversal order as `[tip, n(tip), p(tip)]` in
+/// creation indices, which is the output mesh of a closed connectivity (the traversal's
+/// vertex order is the output order), so neither needs a remapping pass afterwards. The same
+/// code runs in the encoder and the decoder. With `predict` (kinds 3 and 4) every swing
+/// index is coded as the residual of [`predict_swing`] from the normals of the triangles
+/// reconstructed so far.
 fn walk<I: SwingIo>(
     conn: &Connectivity,
     params: &SwingParams,
     io: &mut I,
-    positions: &mut [DVec3],
+    positions: &mut Vec<DVec3>,
     triangles: &mut Vec<[u32; 3]>,
     predict: bool,
 ) -> Result<(), Error> {
     let table = &conn.table;
+    let nv = table.vertex_count();
     let bits = params.quantizer.bits;
     let angle_bits = params.angles.bits();
     let mut models = SwingModels::new(angle_bits, predict);
-    // Per vertex: the sum of the cross products of its reconstructed triangles.
+    // Creation index of each table vertex (u32::MAX until created).
+    let mut rank = vec![u32::MAX; nv];
+    positions.clear();
+    positions.reserve(nv);
+    // Per created vertex: the sum of the cross products of its reconstructed triangles.
     let mut fan = if predict {
-        vec![DVec3::ZERO; positions.len()]
+        vec![DVec3::ZERO; nv]
     } else {
         Vec::new()
     };
-    let accumulate = |fan: &mut Vec<DVec3>, positions: &[DVec3], vs: [usize; 3]| {
+    let accumulate = |fan: &mut Vec<DVec3>, positions: &[DVec3], vs: [u32; 3]| {
         if fan.is_empty() {
             return;
         }
-        let [p0, p1, p2] = vs.map(|v| positions[v]);
+        let [p0, p1, p2] = vs.map(|v| positions[v as usize]);
         let n = cross(sub(p1, p0), sub(p2, p0));
         for v in vs {
-            fan[v] = add(fan[v], n);
+            fan[v as usize] = add(fan[v as usize], n);
         }
     };
     let mut failure: Option<Error> = None;
+    let corrupt = || Error::Corrupt("a triangle uses a vertex before it is created".into());
     triangles.clear();
     triangles.reserve(table.triangle_count());
-    traverse(table, Some(&conn.starts), |step| {
+    conn.for_each_step(|step| {
         if failure.is_some() {
             return;
         }
@@ -615,28 +623,35 @@ fn walk<I: SwingIo>(
             Step::Start { corner } => {
                 let cs = [corner, table.next(corner), table.prev(corner)];
                 let vs = cs.map(|c| table.vertex(c));
-                for v in vs {
+                let mut created = [0u32; 3];
+                for (k, v) in vs.into_iter().enumerate() {
                     let mut g = [0i32; 3];
                     io.seed(v, bits, &mut g);
-                    positions[v.index()] = params.quantizer.dequantize(g);
+                    created[k] = positions.len() as u32;
+                    rank[v.index()] = created[k];
+                    positions.push(params.quantizer.dequantize(g));
                 }
-                accumulate(&mut fan, positions, vs.map(|v| v.index()));
-                triangles.push(vs.map(|v| v.0));
+                accumulate(&mut fan, positions, created);
+                triangles.push(created);
             }
             Step::Triangle { tip, label, .. } => {
-                let a = table.vertex(table.next(tip));
-                let b = table.vertex(table.prev(tip));
+                let ra = rank[table.vertex(table.next(tip)).index()];
+                let rb = rank[table.vertex(table.prev(tip)).index()];
                 let v = table.vertex(tip);
+                if ra == u32::MAX || rb == u32::MAX {
+                    failure = Some(corrupt());
+                    return;
+                }
+                let (pa, pb) = (positions[ra as usize], positions[rb as usize]);
                 if label == Clers::C {
                     // The traversal only runs on closed tables: the opposite exists.
                     let o = table.opposite(tip).unwrap_or(tip);
-                    let c = table.vertex(o);
-                    let frame = params.frame(
-                        positions[a.index()],
-                        positions[b.index()],
-                        positions[c.index()],
-                    );
-                    let Some(frame) = frame else {
+                    let rc = rank[table.vertex(o).index()];
+                    if rc == u32::MAX || rank[v.index()] != u32::MAX {
+                        failure = Some(corrupt());
+                        return;
+                    }
+                    let Some(frame) = params.frame(pa, pb, positions[rc as usize]) else {
                         failure = Some(Error::Corrupt(
                             "a swing gate is degenerate (longer than 2L or flat)".into(),
                         ));
@@ -645,7 +660,7 @@ fn walk<I: SwingIo>(
                     let pred = if fan.is_empty() {
                         0
                     } else {
-                        let n = add(fan[a.index()], fan[b.index()]);
+                        let n = add(fan[ra as usize], fan[rb as usize]);
                         predict_swing(&frame, n, &params.angles)
                     };
                     let mut q = 0i32;
@@ -654,10 +669,16 @@ fn walk<I: SwingIo>(
                         failure = Some(e);
                         return;
                     }
-                    positions[v.index()] = frame.tip(&params.angles, q);
+                    rank[v.index()] = positions.len() as u32;
+                    positions.push(frame.tip(&params.angles, q));
                 }
-                accumulate(&mut fan, positions, [v.index(), a.index(), b.index()]);
-                triangles.push([v.0, a.0, b.0]);
+                let rv = rank[v.index()];
+                if rv == u32::MAX {
+                    failure = Some(corrupt());
+                    return;
+                }
+                accumulate(&mut fan, positions, [rv, ra, rb]);
+                triangles.push([rv, ra, rb]);
             }
         }
     })
@@ -689,7 +710,7 @@ fn output_mesh(conn: &Connectivity, positions: &[DVec3], triangles: &[[u32; 3]])
 fn traversal_triangles(conn: &Connectivity) -> Result<Vec<[u32; 3]>, Error> {
     let table = &conn.table;
     let mut tris = Vec::with_capacity(table.triangle_count());
-    traverse(table, Some(&conn.starts), |step| {
+    conn.for_each_step(|step| {
         let c = match step {
             Step::Start { corner } => corner,
             Step::Triangle { tip, .. } => tip,
@@ -758,7 +779,7 @@ pub fn encode_retiled(
     let mut decoded = None;
     if geometry_kind == SwingGeometry::Swing {
         let mut range = RangeEncoder::new();
-        let mut positions = vec![DVec3::ZERO; nv];
+        let mut positions = Vec::new();
         let mut tris = Vec::new();
         let mut io = SwingWriter {
             sink: &mut range,
@@ -766,14 +787,17 @@ pub fn encode_retiled(
             bad_seed: false,
         };
         let walked = walk(conn, params, &mut io, &mut positions, &mut tris, true);
+        // The traversal's vertex order is the retiler's (checked above), so creation order
+        // is the retiled mesh's own order.
         let exact = walked.is_ok()
             && !io.bad_seed
+            && positions.len() == retiled.positions.len()
             && positions
                 .iter()
                 .zip(&retiled.positions)
                 .all(|(p, r)| p.to_array().map(f64::to_bits) == r.to_array().map(f64::to_bits));
         if exact {
-            let mut mesh = output_mesh(conn, &positions, &tris);
+            let mut mesh = Mesh::new(positions, tris);
             if cutting {
                 // The walk met the triangles in creation order (the labels matched).
                 code_cut_flags(&mut range, &retiled.deleted);
@@ -999,7 +1023,7 @@ pub(crate) fn decode_swing(container: &Container, limits: &Limits) -> Result<Mes
                     "swing geometry on an open connectivity".into(),
                 ));
             }
-            let mut positions = vec![DVec3::ZERO; nv];
+            let mut positions = Vec::new();
             let mut tris = Vec::new();
             let mut io = SwingReader {
                 dec: &mut dec,
@@ -1018,7 +1042,12 @@ pub(crate) fn decode_swing(container: &Container, limits: &Limits) -> Result<Mes
             if positions.iter().any(|p| !p.is_finite()) {
                 return Err(Error::Corrupt("a decoded position is not finite".into()));
             }
-            Ok(cut(output_mesh(&conn, &positions, &tris), &flags))
+            if positions.len() != conn.summary.vertex_order.len() {
+                return Err(Error::Corrupt(
+                    "the swing walk did not create every vertex".into(),
+                ));
+            }
+            Ok(cut(Mesh::new(positions, tris), &flags))
         }
         KIND_EXPLICIT => {
             let mut q = vec![[0i32; 3]; nv];

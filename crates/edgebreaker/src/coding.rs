@@ -12,7 +12,7 @@
 
 use crate::holes::close_holes;
 use crate::reverse_decoder::{ReverseDecoder, VALENCE_CONTEXTS};
-use crate::traversal::{traverse, Clers, SplitEvent, Step, TraversalSummary};
+use crate::traversal::{traverse, Clers, SplitEvent, Step, TraversalError, TraversalSummary};
 use crate::Error;
 use whet_bits::{
     BitModel, BitSink, CostCounter, RangeDecoder, RangeEncoder, SymbolModel, UnsignedIntModel,
@@ -87,7 +87,7 @@ impl Default for ConnectivityLimits {
 
 /// A closed corner table, its component start corners and its dummy vertices: what both the
 /// encoder and the decoder hand to a geometry coder, which walks it with
-/// [`crate::traverse`]`(table, Some(starts), ..)`.
+/// [`Connectivity::for_each_step`].
 #[derive(Clone, Debug)]
 pub struct Connectivity {
     /// The closed mesh (holes filled with dummy fans).
@@ -98,9 +98,39 @@ pub struct Connectivity {
     pub is_dummy: Vec<bool>,
     /// The traversal's results on `table` from `starts`.
     pub summary: TraversalSummary,
+    /// Set when the table was built by the reverse decoder: per component (in encoding
+    /// order) the decoder steps that made it. Decoder step `i` made triangle `i`, entered
+    /// by the traversal at corner `3 i` as symbol `N - 1 - i`, so the traversal's steps
+    /// are known without traversing.
+    decoder_steps: Option<Vec<std::ops::Range<u32>>>,
 }
 
 impl Connectivity {
+    /// Calls `visit` with every step of the traversal of `table` from `starts`, in order:
+    /// what [`crate::traverse`]`(&self.table, Some(&self.starts), visit)` does, without
+    /// walking the table when it was decoded (the decoder's own construction order gives
+    /// the steps).
+    pub fn for_each_step(&self, mut visit: impl FnMut(Step)) -> Result<(), TraversalError> {
+        let Some(steps) = &self.decoder_steps else {
+            return traverse(&self.table, Some(&self.starts), visit).map(|_| ());
+        };
+        let labels = &self.summary.labels;
+        let n = labels.len() as u32;
+        for (&corner, range) in self.starts.iter().zip(steps) {
+            visit(Step::Start { corner });
+            for i in range.clone().rev() {
+                // The decoder checked i < n; a symbol index of the encoding order.
+                let symbol = n - 1 - i;
+                visit(Step::Triangle {
+                    tip: CornerId(3 * i),
+                    label: labels[symbol as usize],
+                    symbol,
+                });
+            }
+        }
+        Ok(())
+    }
+
     /// The real triangles (dummy fans removed) with vertices renumbered in traversal order
     /// (dummies skipped): the triangle list a decoder outputs.
     pub fn output_triangles(&self) -> Vec<[u32; 3]> {
@@ -205,6 +235,7 @@ impl EncodedConnectivity {
                 starts,
                 is_dummy,
                 summary,
+                decoder_steps: None,
             },
             old,
         ))
@@ -426,6 +457,7 @@ pub fn encode_connectivity_with_table(
             starts,
             is_dummy,
             summary,
+            decoder_steps: None,
         },
         face_order,
         ordered: Some((ov, oo, new_starts)),
@@ -597,6 +629,8 @@ pub fn decode_connectivity(
             starts,
             is_dummy,
             summary,
+            // The ranges partition 0..n (component_steps checks it).
+            decoder_steps: Some(steps),
         },
         consumed,
     ))

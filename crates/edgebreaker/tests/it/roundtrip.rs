@@ -22,8 +22,17 @@ fn round_trip(mesh: &Mesh) -> (f64, [usize; 5]) {
     assert_eq!(dec.summary.splits, enc.connectivity.summary.splits);
     // The decoder's summary (vertex order from the reverse decoder) is what traversing
     // its table gives.
-    let again = whet_edgebreaker::traverse(&dec.table, Some(&dec.starts), |_| {}).unwrap();
+    let mut traversed = Vec::new();
+    let again =
+        whet_edgebreaker::traverse(&dec.table, Some(&dec.starts), |s| traversed.push(s)).unwrap();
     assert_eq!(again, dec.summary);
+    // ... and the steps it reports without traversing are the traversal's, in order.
+    let mut stepped = Vec::new();
+    dec.for_each_step(|s| stepped.push(s)).unwrap();
+    assert_eq!(
+        stepped, traversed,
+        "decoder steps differ from the traversal"
+    );
     let mut want: Vec<[u32; 3]> = enc
         .connectivity
         .output_triangles()
