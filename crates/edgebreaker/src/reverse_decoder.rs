@@ -160,7 +160,7 @@ impl ReverseDecoder {
 
     /// Applies one symbol (the next one in decoding order) at `gate`, which must be what
     /// [`ReverseDecoder::gate`] returned just before.
-    #[inline]
+    #[inline(always)]
     pub fn apply(&mut self, sym: Clers, gate: Option<Gate>) -> Result<(), Error> {
         if self.step >= self.symbols {
             return Err(Error::Corrupt("more symbols than announced"));
@@ -169,126 +169,174 @@ impl ReverseDecoder {
         if k > u32::MAX - 8 {
             return Err(Error::Corrupt("too many faces"));
         }
-        self.v.extend_from_slice(&[NONE; 3]);
-        self.o.extend_from_slice(&[NONE; 3]);
-        let i = self.step;
         match sym {
-            Clers::E => {
-                for j in 0..3 {
-                    let w = self.new_vertex(k + j);
-                    self.v[(k + j) as usize] = w;
-                }
-                self.active.push(k);
-                self.origin.push(i);
-                self.check_splits(i)?;
-            }
-            Clers::R | Clers::L => {
-                let Gate {
-                    corner: a,
-                    vertex: x,
-                    ..
-                } = gate.ok_or(Error::Corrupt("R or L with nothing open"))?;
-                let (o, cl, cr) = if sym == Clers::R {
-                    (k + 2, k + 1, k)
-                } else {
-                    (k + 1, k, k + 2)
-                };
-                self.glue(o, a)?;
-                let w = self.new_vertex(o);
-                self.v[o as usize] = w;
-                let vr = self.vertex_of(prev(a))?;
-                self.v[cr as usize] = vr;
-                self.leftmost[vr as usize] = cr;
-                self.v[cl as usize] = checked_vertex(x)?;
-                if let Some(top) = self.active.last_mut() {
-                    *top = k;
-                }
-                self.check_splits(i)?;
-            }
-            Clers::C => {
-                let Gate {
-                    corner: a,
-                    vertex: x,
-                    ..
-                } = gate.ok_or(Error::Corrupt("C with nothing open"))?;
-                let x = checked_vertex(x)?;
-                let b = next(self.leftmost_of(x)?);
-                self.glue(a, k + 1)?;
-                self.glue(b, k + 2)?;
-                self.v[k as usize] = x;
-                self.v[(k + 1) as usize] = self.vertex_of(next(b))?;
-                let w = self.vertex_of(prev(a))?;
-                self.v[(k + 2) as usize] = w;
-                self.leftmost[w as usize] = k + 2;
-                if let Some(top) = self.active.last_mut() {
-                    *top = k;
-                }
-            }
-            Clers::S => {
-                let b = self
-                    .active
-                    .pop()
-                    .ok_or(Error::Corrupt("S with nothing open"))?;
-                let b_origin = self.origin.pop().unwrap_or(0);
-                if let Some(pos) = self.split_active.iter().rposition(|&(s, _)| s == i) {
-                    let (_, c) = self.split_active.swap_remove(pos);
-                    self.active.push(c);
-                    self.origin.push(b_origin);
-                }
-                let a = *self
-                    .active
-                    .last()
-                    .ok_or(Error::Corrupt("S with one edge open"))?;
-                self.glue(a, k + 2)?;
-                self.glue(b, k + 1)?;
-                let p = self.vertex_of(prev(a))?;
-                self.v[k as usize] = p;
-                self.v[(k + 1) as usize] = self.vertex_of(next(a))?;
-                let w = self.vertex_of(prev(b))?;
-                self.v[(k + 2) as usize] = w;
-                self.leftmost[w as usize] = k + 2;
-                let n = self.vertex_of(next(b))?;
-                if n != p {
-                    self.leftmost[p as usize] = self.leftmost_of(n)?;
-                    // Merge n into p around n's fan, clockwise from next(b).
-                    let mut x = next(b);
-                    let mut guard = self.v.len();
-                    loop {
-                        self.v[x as usize] = p;
-                        let on = self.o[next(x) as usize];
-                        if on == NONE {
-                            break;
-                        }
-                        x = next(on);
-                        guard -= 1;
-                        if guard == 0 {
-                            return Err(Error::Corrupt("vertex merge does not end"));
-                        }
-                    }
-                    let merged = self.valence[n as usize];
-                    self.valence[p as usize] += merged;
-                    self.leftmost[n as usize] = NONE;
-                }
-                if let Some(top) = self.active.last_mut() {
-                    *top = k;
-                }
-            }
-        }
-        // Valence counters (Draco's table): how many times each vertex of the new face
-        // gained a triangle edge, by corner (k, k+1, k+2).
-        let add: [u32; 3] = match sym {
-            Clers::C | Clers::S => [0, 1, 1],
-            Clers::R => [1, 1, 2],
-            Clers::L => [1, 2, 1],
-            Clers::E => [2, 2, 2],
-        };
-        for j in 0..3 {
-            let x = self.v[(k + j) as usize] as usize;
-            if let Some(val) = self.valence.get_mut(x) {
-                *val += add[j as usize];
-            }
+            Clers::C => self.apply_c(k, gate)?,
+            Clers::R | Clers::L => self.apply_rl(k, gate, sym == Clers::R)?,
+            Clers::E => self.apply_e(k)?,
+            Clers::S => self.apply_s(k)?,
         }
         self.step += 1;
+        Ok(())
+    }
+
+    /// Adds `n` triangle-edge gains to vertex `x`'s valence counter (Draco's table).
+    #[inline(always)]
+    fn gain(&mut self, x: u32, n: u32) {
+        if let Some(val) = self.valence.get_mut(x as usize) {
+            *val += n;
+        }
+    }
+
+    /// Pairs an existing corner `a` (below the new triangle) with the new triangle's
+    /// corner `new`: `a` must still be unpaired.
+    #[inline(always)]
+    fn glue_new(&mut self, a: u32, new: u32) -> Result<(), Error> {
+        match self.o.get_mut(a as usize) {
+            Some(slot) if *slot == NONE => {
+                *slot = new;
+                Ok(())
+            }
+            _ => Err(Error::Corrupt("an edge is glued twice")),
+        }
+    }
+
+    /// C: the new triangle (x, v(n b), w) closes the gate `a` against the edge `b` after
+    /// the gate vertex `x`'s leftmost corner. Each new triangle is appended whole (one
+    /// write per array), not first filled with placeholders.
+    #[inline(always)]
+    fn apply_c(&mut self, k: u32, gate: Option<Gate>) -> Result<(), Error> {
+        let Gate {
+            corner: a,
+            vertex: x,
+            ..
+        } = gate.ok_or(Error::Corrupt("C with nothing open"))?;
+        let x = checked_vertex(x)?;
+        let b = next(self.leftmost_of(x)?);
+        if a == b {
+            return Err(Error::Corrupt("an edge is glued twice"));
+        }
+        self.glue_new(a, k + 1)?;
+        self.glue_new(b, k + 2)?;
+        let nb = self.vertex_of(next(b))?;
+        let w = self.vertex_of(prev(a))?;
+        self.v.extend_from_slice(&[x, nb, w]);
+        self.o.extend_from_slice(&[NONE, a, b]);
+        self.leftmost[w as usize] = k + 2;
+        if let Some(top) = self.active.last_mut() {
+            *top = k;
+        }
+        self.gain(nb, 1);
+        self.gain(w, 1);
+        Ok(())
+    }
+
+    /// R (`right`) or L: the new triangle on the gate `a` with a new vertex at the corner
+    /// facing it (k + 2 for R, k + 1 for L).
+    #[inline(always)]
+    fn apply_rl(&mut self, k: u32, gate: Option<Gate>, right: bool) -> Result<(), Error> {
+        let Gate {
+            corner: a,
+            vertex: x,
+            ..
+        } = gate.ok_or(Error::Corrupt("R or L with nothing open"))?;
+        let x = checked_vertex(x)?;
+        let facing = if right { k + 2 } else { k + 1 };
+        self.glue_new(a, facing)?;
+        let vr = self.vertex_of(prev(a))?;
+        let w = self.new_vertex(facing);
+        if right {
+            self.v.extend_from_slice(&[vr, x, w]);
+            self.o.extend_from_slice(&[NONE, NONE, a]);
+            self.leftmost[vr as usize] = k;
+            self.gain(vr, 1);
+            self.gain(x, 1);
+            self.gain(w, 2);
+        } else {
+            self.v.extend_from_slice(&[x, w, vr]);
+            self.o.extend_from_slice(&[NONE, a, NONE]);
+            self.leftmost[vr as usize] = k + 2;
+            self.gain(x, 1);
+            self.gain(w, 2);
+            self.gain(vr, 1);
+        }
+        if let Some(top) = self.active.last_mut() {
+            *top = k;
+        }
+        self.check_splits(self.step)
+    }
+
+    /// E: a new triangle of three new vertices opens a new part of the stack.
+    #[inline(always)]
+    fn apply_e(&mut self, k: u32) -> Result<(), Error> {
+        let ids = [k, k + 1, k + 2].map(|c| self.new_vertex(c));
+        self.v.extend_from_slice(&ids);
+        self.o.extend_from_slice(&[NONE; 3]);
+        for id in ids {
+            self.gain(id, 2);
+        }
+        self.active.push(k);
+        self.origin.push(self.step);
+        self.check_splits(self.step)
+    }
+
+    /// S: the new triangle joins the two top parts of the stack, merging the vertex after
+    /// the lower one's edge into the upper one's when they differ.
+    #[inline(never)]
+    fn apply_s(&mut self, k: u32) -> Result<(), Error> {
+        let i = self.step;
+        self.v.extend_from_slice(&[NONE; 3]);
+        self.o.extend_from_slice(&[NONE; 3]);
+        let b = self
+            .active
+            .pop()
+            .ok_or(Error::Corrupt("S with nothing open"))?;
+        let b_origin = self.origin.pop().unwrap_or(0);
+        if let Some(pos) = self.split_active.iter().rposition(|&(s, _)| s == i) {
+            let (_, c) = self.split_active.swap_remove(pos);
+            self.active.push(c);
+            self.origin.push(b_origin);
+        }
+        let a = *self
+            .active
+            .last()
+            .ok_or(Error::Corrupt("S with one edge open"))?;
+        self.glue(a, k + 2)?;
+        self.glue(b, k + 1)?;
+        let p = self.vertex_of(prev(a))?;
+        self.v[k as usize] = p;
+        self.v[(k + 1) as usize] = self.vertex_of(next(a))?;
+        let w = self.vertex_of(prev(b))?;
+        self.v[(k + 2) as usize] = w;
+        self.leftmost[w as usize] = k + 2;
+        let n = self.vertex_of(next(b))?;
+        if n != p {
+            self.leftmost[p as usize] = self.leftmost_of(n)?;
+            // Merge n into p around n's fan, clockwise from next(b).
+            let mut x = next(b);
+            let mut guard = self.v.len();
+            loop {
+                self.v[x as usize] = p;
+                let on = self.o[next(x) as usize];
+                if on == NONE {
+                    break;
+                }
+                x = next(on);
+                guard -= 1;
+                if guard == 0 {
+                    return Err(Error::Corrupt("vertex merge does not end"));
+                }
+            }
+            let merged = self.valence[n as usize];
+            self.valence[p as usize] += merged;
+            self.leftmost[n as usize] = NONE;
+        }
+        if let Some(top) = self.active.last_mut() {
+            *top = k;
+        }
+        // The vertices at k + 1 and k + 2 gained an edge each.
+        let (v1, v2) = (self.v[(k + 1) as usize], self.v[(k + 2) as usize]);
+        self.gain(v1, 1);
+        self.gain(v2, 1);
         Ok(())
     }
 
