@@ -34,8 +34,9 @@ impl LabelModels {
     }
     #[inline]
     fn get(&mut self, valence_ctx: usize, prev: Clers) -> &mut SymbolModel {
-        let i = (valence_ctx * 5 + prev as usize) % self.models.len();
-        &mut self.models[i]
+        // valence_ctx < VALENCE_CONTEXTS and prev < 5, so the index is in range (a modulo
+        // here was a division on the chain from one label to the next).
+        &mut self.models[valence_ctx * 5 + prev as usize]
     }
 }
 
