@@ -17,6 +17,9 @@ use whet_bits::{BitModel, RangeDecoder, ResidualModel, SignedIntModel};
 use whet_edgebreaker::{Connectivity, TraversalError};
 
 const CLASSES: usize = 4;
+/// Candidate counts up to which [`ResidualWriter::select`] builds subset sums incrementally
+/// (a table of `2^k` sums on the stack); more candidates are averaged subset by subset.
+const MAX_SUBSET_PRICED: usize = 4;
 const PREV_BUCKETS: usize = 6;
 
 /// Adaptive models of the position stream.
@@ -114,19 +117,38 @@ impl ResidualIo for ResidualWriter<'_> {
         if !self.constrained {
             return (1u32 << k) - 1;
         }
+        // One parallelogram leaves no choice (the flag below still codes it).
         let mut best = (u64::MAX, 1u32);
-        for mask in 1..(1u32 << k) {
-            let p = average(cands, mask);
-            let class = class_of(mask);
-            let mut cost = selection_cost(models, k, mask) as u64;
-            let mut prev = 0usize;
-            for axis in 0..3 {
-                let r = q[axis].wrapping_sub(p[axis]);
-                cost += models.residual[model_index(class, axis, prev)].cost(r) as u64;
-                prev = bucket(r);
-            }
-            if cost < best.0 {
-                best = (cost, mask);
+        if k > 1 {
+            // Each subset's sum from a smaller one's (drop its lowest member): the same sums
+            // `average` forms, one addition per axis per subset.
+            let mut sums = [[0i64; 3]; 1 << MAX_SUBSET_PRICED];
+            for mask in 1..(1u32 << k) {
+                let p = if k <= MAX_SUBSET_PRICED {
+                    let low = mask.trailing_zeros() as usize;
+                    let rest = sums[(mask & (mask - 1)) as usize];
+                    let c = cands[low];
+                    let sum = [rest[0] + c[0], rest[1] + c[1], rest[2] + c[2]];
+                    sums[mask as usize] = sum;
+                    mean(sum, mask.count_ones() as i64)
+                } else {
+                    average(cands, mask)
+                };
+                let class = class_of(mask);
+                let mut cost = selection_cost(models, k, mask) as u64;
+                let mut prev = 0usize;
+                for axis in 0..3 {
+                    // Costs only grow: a subset already at the best cost cannot win.
+                    if cost >= best.0 {
+                        break;
+                    }
+                    let r = q[axis].wrapping_sub(p[axis]);
+                    cost += models.residual[model_index(class, axis, prev)].cost(r) as u64;
+                    prev = bucket(r);
+                }
+                if cost < best.0 {
+                    best = (cost, mask);
+                }
             }
         }
         let mask = best.1;
