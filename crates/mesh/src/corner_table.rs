@@ -129,27 +129,33 @@ impl CornerTable {
         // by the higher vertex, and pair the runs: two entries of opposite directions are
         // twins, one is a boundary edge, anything else is refused. Two sequential passes with
         // one scatter in between: linear for bounded valence.
+        // Triangle by triangle: corner 3t + j faces the edge from vertex j + 1 to j + 2
+        // (mod 3) of triangle t, read without a modulo per corner.
+        let edges = |tri: &[u32]| [(tri[1], tri[2]), (tri[2], tri[0]), (tri[0], tri[1])];
         let mut offsets = vec![0u32; vertex_count + 1];
-        for c in 0..nc {
-            let a = corner_vertex[next_raw(c)];
-            let b = corner_vertex[prev_raw(c)];
-            offsets[a.min(b) as usize + 1] += 1;
+        for tri in corner_vertex.chunks_exact(3) {
+            for (a, b) in edges(tri) {
+                offsets[a.min(b) as usize + 1] += 1;
+            }
         }
         for v in 0..vertex_count {
             offsets[v + 1] += offsets[v];
         }
         let mut fill = offsets.clone();
-        let mut bucket = vec![(0u32, 0u32); nc];
+        // Entries pack (higher vertex, corner) into one u64, so the small sorts compare one
+        // word (the same order as the pair).
+        let mut bucket = vec![0u64; nc];
         // One bit per corner: its edge runs from the lower vertex up. Read back when pairing
         // (twins must differ), it saves a random access to the corner vertices per edge.
         let mut upward = vec![0u64; nc.div_ceil(64)];
-        for c in 0..nc {
-            let a = corner_vertex[next_raw(c)];
-            let b = corner_vertex[prev_raw(c)];
-            let lo = a.min(b) as usize;
-            bucket[fill[lo] as usize] = (a.max(b), c as u32);
-            fill[lo] += 1;
-            upward[c / 64] |= ((a < b) as u64) << (c % 64);
+        for (t, tri) in corner_vertex.chunks_exact(3).enumerate() {
+            for (j, (a, b)) in edges(tri).into_iter().enumerate() {
+                let c = 3 * t + j;
+                let lo = a.min(b) as usize;
+                bucket[fill[lo] as usize] = (a.max(b) as u64) << 32 | c as u64;
+                fill[lo] += 1;
+                upward[c / 64] |= ((a < b) as u64) << (c % 64);
+            }
         }
         drop(fill);
         let is_upward = |c: usize| upward[c / 64] >> (c % 64) & 1 == 1;
@@ -162,13 +168,13 @@ impl CornerTable {
             let mut i = 0;
             while i < s.len() {
                 let mut j = i + 1;
-                while j < s.len() && s[j].0 == s[i].0 {
+                while j < s.len() && s[j] >> 32 == s[i] >> 32 {
                     j += 1;
                 }
                 match j - i {
                     1 => {}
                     2 => {
-                        let (c1, c2) = (s[i].1 as usize, s[i + 1].1 as usize);
+                        let (c1, c2) = (s[i] as u32 as usize, s[i + 1] as u32 as usize);
                         // Twins run in opposite directions: c1's edge starts where c2's ends.
                         if is_upward(c1) == is_upward(c2) {
                             return Err(MeshError::InconsistentOrientation {
@@ -184,7 +190,7 @@ impl CornerTable {
                     n => {
                         return Err(MeshError::NonManifoldEdge {
                             a: v as u32,
-                            b: s[i].0,
+                            b: (s[i] >> 32) as u32,
                             count: n as u32,
                         })
                     }
