@@ -110,12 +110,24 @@ impl Connectivity {
     /// Calls `visit` with every step of the traversal of `table` from `starts`, in order:
     /// what [`crate::traverse`]`(&self.table, Some(&self.starts), visit)` does, without
     /// walking the table when it was decoded (the decoder's own construction order gives
-    /// the steps).
+    /// the steps; a decoded connectivity whose table was replaced by another of the same
+    /// size gets the decoded table's steps).
     pub fn for_each_step(&self, mut visit: impl FnMut(Step)) -> Result<(), TraversalError> {
-        let Some(steps) = &self.decoder_steps else {
-            return traverse(&self.table, Some(&self.starts), visit).map(|_| ());
-        };
         let labels = &self.summary.labels;
+        // The fields are public: a caller may have edited them since decoding. When they no
+        // longer have the decoded shape (one triangle per symbol plus one start triangle per
+        // component, a step range per component within the labels), traverse instead; the
+        // fast path then cannot index out of range.
+        let steps = match &self.decoder_steps {
+            Some(steps)
+                if steps.len() == self.starts.len()
+                    && steps.iter().all(|r| r.end as usize <= labels.len())
+                    && self.table.corner_count() == 3 * (labels.len() + self.starts.len()) =>
+            {
+                steps
+            }
+            _ => return traverse(&self.table, Some(&self.starts), visit).map(|_| ()),
+        };
         let n = labels.len() as u32;
         for (&corner, range) in self.starts.iter().zip(steps) {
             visit(Step::Start { corner });

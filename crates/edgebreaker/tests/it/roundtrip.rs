@@ -209,3 +209,18 @@ fn label_letters() {
     assert_eq!(Clers::from_index(4), Some(Clers::S));
     assert_eq!(Clers::from_index(5), None);
 }
+
+/// A decoded connectivity whose public fields were edited afterwards falls back to
+/// traversing (no stale decoder steps, no panic).
+#[test]
+fn edited_decoded_connectivity_is_traversed() {
+    let mesh = icosphere(2);
+    let enc = encode_connectivity(&mesh.triangles, mesh.positions.len()).unwrap();
+    let (mut dec, _) = decode_connectivity(&enc.bytes, &ConnectivityLimits::DEFAULT).unwrap();
+    dec.summary.labels.truncate(3);
+    let mut stepped = Vec::new();
+    dec.for_each_step(|s| stepped.push(s)).unwrap();
+    let mut traversed = Vec::new();
+    whet_edgebreaker::traverse(&dec.table, Some(&dec.starts), |s| traversed.push(s)).unwrap();
+    assert_eq!(stepped, traversed);
+}
