@@ -1,8 +1,10 @@
 //! Times EdgeSharpener alone on the bench's input, the rotated synth fandisk sampled by
 //! marching cubes (a profiling aid beside `cargo bench -p whet-sharpen`, whose setup also
 //! encodes swing inputs): `cargo run --release -p whet-sharpen --example sharpen_speed --
-//! [resolution] [runs] [papers|extended]`; resolution 50, 160 and 505 give about 10k, 100k
-//! and 1M triangles. Prints the fastest and the median run.
+//! [resolution] [runs] [papers|extended] [out.off]`; resolution 50, 160 and 505 give about
+//! 10k, 100k and 1M triangles. Prints the fastest and the median run; with `out.off` it also
+//! writes the sharpened mesh (a refactoring aid: a change meant to keep the output must keep
+//! the file byte for byte).
 #![allow(clippy::unwrap_used)] // a measurement tool
 
 use glam::{DQuat, DVec3};
@@ -28,11 +30,16 @@ fn main() {
     let mesh = marching_cubes(&shape, resolution).unwrap();
     let mut sharpener = EdgeSharpener::new(SharpenOptions::DEFAULT.with_method(method));
     let mut times = Vec::with_capacity(runs);
+    let mut last = None;
     for _ in 0..runs.max(1) {
         let t = Instant::now();
         let out = sharpener.sharpen(&mesh).unwrap();
         times.push(t.elapsed().as_secs_f64());
-        std::hint::black_box(out);
+        last = Some(std::hint::black_box(out));
+    }
+    if let (Some(path), Some(out)) = (args.get(3), last) {
+        let opts = whet_io::WriteOptions::default();
+        whet_io::write_path(std::path::Path::new(path), &out.mesh, None, &opts).unwrap();
     }
     times.sort_by(f64::total_cmp);
     let t = mesh.triangles.len() as f64;

@@ -256,6 +256,9 @@ pub(crate) struct Run<'a> {
     pub surface_samples: bool,
 }
 
+/// Per corner position `j` in a triangle, the positions of the corners after and before it.
+const AFTER_BEFORE: [(usize, usize); 3] = [(1, 2), (2, 0), (0, 1)];
+
 #[inline]
 pub(crate) fn next(c: usize) -> usize {
     if c % 3 == 2 {
@@ -332,25 +335,30 @@ impl Run<'_> {
         let mut sum = 0.0f64;
         let mut count = 0usize;
         let mut max_edge2 = 0.0f64;
-        for c in 0..nc {
-            let o = self.table.opposite(CornerId(c as u32));
-            if let Some(o) = o {
-                if o.index() < c {
+        // Triangle by triangle, in corner order: the vertices after and before corner j of
+        // a triangle are at (j + 1) % 3 and (j + 2) % 3, with no division per corner.
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            for (j, (after, before)) in AFTER_BEFORE.into_iter().enumerate() {
+                let c = 3 * t + j;
+                let o = self.table.opposite(CornerId(c as u32));
+                if let Some(o) = o {
+                    if o.index() < c {
+                        continue;
+                    }
+                }
+                let a = mesh.positions[tri[after] as usize];
+                let b = mesh.positions[tri[before] as usize];
+                max_edge2 = max_edge2.max(a.distance_squared(b));
+                let Some(o) = o else { continue };
+                let (n1, n2) = (s.normals[c / 3], s.normals[o.index() / 3]);
+                if n1 == DVec3::ZERO || n2 == DVec3::ZERO {
                     continue;
                 }
+                let angle = normal_angle(n1, n2);
+                s.angles[c] = angle as f32;
+                sum += angle;
+                count += 1;
             }
-            let a = mesh.positions[mesh.triangles[next(c) / 3][next(c) % 3] as usize];
-            let b = mesh.positions[mesh.triangles[prev(c) / 3][prev(c) % 3] as usize];
-            max_edge2 = max_edge2.max(a.distance_squared(b));
-            let Some(o) = o else { continue };
-            let (n1, n2) = (s.normals[c / 3], s.normals[o.index() / 3]);
-            if n1 == DVec3::ZERO || n2 == DVec3::ZERO {
-                continue;
-            }
-            let angle = normal_angle(n1, n2);
-            s.angles[c] = angle as f32;
-            sum += angle;
-            count += 1;
         }
         self.max_edge = max_edge2.sqrt();
         let mean = if count > 0 { sum / count as f64 } else { 0.0 };
@@ -382,11 +390,14 @@ impl Run<'_> {
         let nc = 3 * nt;
         let s = &mut *self.s;
         // Filter 1: red (core) vertices, all of whose edges are brown.
-        for c in 0..nc {
-            let v = mesh.triangles[c / 3][c % 3] as usize;
-            s.vflags[v] |= V_USED;
-            if s.cflags[next(c)] & s.cflags[prev(c)] & C_BROWN == 0 {
-                s.vflags[v] |= V_NOT_SMOOTH;
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            let cf = &s.cflags[3 * t..3 * t + 3];
+            for (j, (after, before)) in AFTER_BEFORE.into_iter().enumerate() {
+                let v = tri[j] as usize;
+                s.vflags[v] |= V_USED;
+                if cf[after] & cf[before] & C_BROWN == 0 {
+                    s.vflags[v] |= V_NOT_SMOOTH;
+                }
             }
         }
         for f in s.vflags.iter_mut() {
@@ -428,8 +439,8 @@ impl Run<'_> {
             }
             if let Some(o) = table.opposite(CornerId(c as u32)) {
                 if s.tflags[o.index() / 3] & T_RED != 0 {
-                    let tri_a = mesh.triangles[next(c) / 3][next(c) % 3];
-                    let tri_b = mesh.triangles[prev(c) / 3][prev(c) % 3];
+                    let tri_a = table.corner_vertices()[next(c)];
+                    let tri_b = table.corner_vertices()[prev(c)];
                     s.vflags[tri_a as usize] |= V_TAG;
                     s.vflags[tri_b as usize] |= V_TAG;
                 }
@@ -469,10 +480,11 @@ impl Run<'_> {
         }
     }
 
-    /// Vertex at corner `c` of the input.
+    /// Vertex at corner `c` of the input (the table was built from the input's triangles in
+    /// order, so its flat corner array is theirs: one load, no division).
     #[inline]
     pub(crate) fn cv(&self, c: usize) -> u32 {
-        self.mesh.triangles[c / 3][c % 3]
+        self.table.corner_vertices()[c]
     }
 
     /// Filters 5 and 6: blue chamfer edges (interior, not red, two red ends; extended: two
