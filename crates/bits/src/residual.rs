@@ -68,11 +68,11 @@ impl CdfModel {
         if (self.count as u32) < RATE_STEP as u32 * RATE_STEPS {
             self.count += 1;
         }
-        // Branch-free over a whole number of vectors so that it vectorises wherever it is
-        // inlined: entries above s rise, the rest fall. c[0] = 0 stays 0 (it falls by
-        // 0 >> rate); c[32] = CDF_SPAN is left alone (it would rise by 0).
-        // The entry index as a 16-bit lane and a lane mask rather than a select: the
-        // select on a usize index compiled to about three times the instructions.
+        // Branch-free over a whole number of vectors, so that it vectorises: entries above
+        // s rise, the rest fall. c[0] = 0 stays 0 (it falls by 0 >> rate); c[32] = CDF_SPAN
+        // is left alone (it would rise by 0). The entry index is a 16-bit lane and the
+        // choice a lane mask: a select on a usize index compiled to about three times the
+        // instructions.
         const LANE: [u16; CDF_SYMBOLS] = {
             let mut l = [0u16; CDF_SYMBOLS];
             let mut i = 0;
