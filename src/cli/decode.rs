@@ -31,6 +31,11 @@ pub struct DecodeArgs {
     /// Subdiv streams: subdivision levels, overriding the header (0 gives the control mesh).
     #[arg(long)]
     levels: Option<u32>,
+    /// Swing streams: leave out the surface filter the stream carries (the retiled vertices
+    /// stay on the original surface). `--sharpen` always leaves it out: EdgeSharpener
+    /// extrapolates planes from those vertices.
+    #[arg(long)]
+    no_surface_filter: bool,
 }
 
 pub fn run(args: &DecodeArgs) -> CliResult {
@@ -39,17 +44,17 @@ pub fn run(args: &DecodeArgs) -> CliResult {
             anyhow::Error::new(e).context(format!("cannot read {}", args.input.display())),
         )
     })?;
-    let mesh =
-        whet::decode_with_levels(&bytes, &DecodeOptions::DEFAULT, args.levels).map_err(|e| {
-            let input = e.is_input_error();
-            let err =
-                anyhow::Error::new(e).context(format!("cannot decode {}", args.input.display()));
-            if input {
-                Failure::input(err)
-            } else {
-                Failure::other(err)
-            }
-        })?;
+    let opts =
+        DecodeOptions::DEFAULT.with_surface_filter(!(args.no_surface_filter || args.sharpen));
+    let mesh = whet::decode_with_levels(&bytes, &opts, args.levels).map_err(|e| {
+        let input = e.is_input_error();
+        let err = anyhow::Error::new(e).context(format!("cannot decode {}", args.input.display()));
+        if input {
+            Failure::input(err)
+        } else {
+            Failure::other(err)
+        }
+    })?;
     let mesh = if args.sharpen {
         let opts = super::sharpen::sharpen_options(&args.method, args.smooth_factor)?;
         let s = super::sharpen::run_sharpen(&mesh, &opts)?;

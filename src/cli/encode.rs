@@ -122,6 +122,11 @@ pub struct EncodeArgs {
     /// the decoded mesh after `whet decode --sharpen` (for CAD parts).
     #[arg(long, value_enum, default_value_t = OptimizeFor::Decoded)]
     optimize_for: OptimizeFor,
+    /// Swing: write no surface filter into the stream (the decoder then returns the retiled
+    /// vertices on the original surface). By default the encoder fits one, except with
+    /// `--optimize-for sharpened`: EdgeSharpener works on the unfiltered vertices.
+    #[arg(long)]
+    no_surface_filter: bool,
     /// Swing: also write the retiled mesh the stream encodes (byte-identical to what
     /// `whet decode` writes in the same format).
     #[arg(long, value_name = "PATH")]
@@ -269,7 +274,8 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh) -> CliResult {
         SwingOptions::DEFAULT
             .with_rate(rate)
             .with_quant_bits(quant_bits)
-            .with_error_of(args.optimize_for.into()),
+            .with_error_of(args.optimize_for.into())
+            .with_surface_filter(!args.no_surface_filter),
     );
     let out = whet_swing::encode(mesh, &opts).map_err(|e| {
         let input = e.is_input_error();
@@ -317,6 +323,10 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh) -> CliResult {
                 _ => "explicit",
             },
             "rms_error_pct": out.rms_pct,
+            "surface_filter": {
+                "normal": out.surface_filter.factors().0,
+                "smoothed": out.surface_filter.factors().1,
+            },
             "search": out.search.iter().map(|&(f, b)| json!([f, b])).collect::<Vec<_>>(),
             "angle_trials": out.angle_trials.iter().map(|t| json!({
                 "angle_bits": t.angle_bits,

@@ -14,17 +14,28 @@ use whet_mesh::{Aabb, DVec3, Mesh};
 pub struct DecodeOptions {
     /// Bounds on what a stream may make the decoder allocate.
     pub limits: Limits,
+    /// Apply the surface filter a swing stream carries ([`crate::SurfaceFilter`]). Off, the
+    /// decoder returns the retiled vertices as the swing construction placed them, on the
+    /// original surface: the input EdgeSharpener expects (`whet decode --sharpen`).
+    pub surface_filter: bool,
 }
 
 impl DecodeOptions {
-    /// Safe default limits.
+    /// Safe default limits, the stream's surface filter applied.
     pub const DEFAULT: DecodeOptions = DecodeOptions {
         limits: Limits::DEFAULT,
+        surface_filter: true,
     };
 
     /// Sets the limits.
     pub const fn with_limits(mut self, limits: Limits) -> Self {
         self.limits = limits;
+        self
+    }
+
+    /// Applies the stream's surface filter or not.
+    pub const fn with_surface_filter(mut self, on: bool) -> Self {
+        self.surface_filter = on;
         self
     }
 }
@@ -81,7 +92,7 @@ pub fn decode_container(container: &Container, opts: &DecodeOptions) -> Result<M
                 .with_max_triangles(h.triangle_count.saturating_mul(2).saturating_add(64));
             decode_exact(conn, geom, &quantizer, &limits)?
         }
-        Mode::Swing => crate::swing::decode_swing(container, &opts.limits)?,
+        Mode::Swing => crate::swing::decode_swing(container, opts)?,
         other => {
             return Err(Error::Parameter(format!(
                 "mode {other} is not available in this build"

@@ -32,6 +32,7 @@ mod exact;
 mod fuzz;
 mod parallelogram;
 mod quantize;
+pub mod surface_filter;
 pub mod swing;
 
 pub use decoder::{
@@ -45,6 +46,7 @@ pub use exact::ExactPayloads;
 pub use fuzz::{fuzz_decode, fuzz_exact_payloads};
 pub use parallelogram::{average, candidates, gate_fallback, MAX_CANDIDATES};
 pub use quantize::Quantizer;
+pub use surface_filter::{FilterFields, SurfaceFilter};
 pub use swing::{
     encode_retiled, AngleTable, RetiledMesh, SwingEncoded, SwingFrame, SwingGeometry, SwingParams,
     SwingStreamInfo, VertexSource,

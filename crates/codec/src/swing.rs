@@ -40,10 +40,11 @@
 //! Not handled here: the retiling itself (whet-swing).
 
 use crate::exact::{code_positions, ResidualReader, ResidualWriter};
+use crate::surface_filter::{self, SurfaceFilter};
 use crate::{EncodeReport, Error, Quantizer};
 use whet_bits::{BitModel, BitSink, BitTree, RangeDecoder, RangeEncoder};
 use whet_edgebreaker::{Clers, Connectivity, ConnectivityLimits, Step};
-use whet_format::{tag, Container, Header, Limits, Mode, SectionKind, Version};
+use whet_format::{tag, Container, Header, Mode, SectionKind, Version};
 use whet_mesh::{Aabb, DVec3, ManifoldRepair, Mesh, VertexId};
 
 /// Fewest angle bits a stream may use.
@@ -585,7 +586,7 @@ fn walk<I: SwingIo>(
     positions: &mut Vec<DVec3>,
     triangles: &mut Vec<[u32; 3]>,
     predict: bool,
-) -> Result<(), Error> {
+) -> Result<Vec<DVec3>, Error> {
     let table = &conn.table;
     let nv = table.vertex_count();
     let bits = params.quantizer.bits;
@@ -685,7 +686,7 @@ fn walk<I: SwingIo>(
     .map_err(whet_edgebreaker::Error::from)?;
     match failure {
         Some(e) => Err(e),
-        None => Ok(()),
+        None => Ok(fan),
     }
 }
 
@@ -734,6 +735,8 @@ pub struct SwingStreamInfo<'a> {
     pub repair: &'a ManifoldRepair,
     /// Unused vertices of the original left out.
     pub dropped_unused_vertices: usize,
+    /// The surface filter the decoder applies to its output ([`SurfaceFilter::NONE`]: none).
+    pub filter: SurfaceFilter,
 }
 
 /// Writes the swing stream of a retiled mesh, after checking that Edgebreaker reproduces the
@@ -802,6 +805,9 @@ pub fn encode_retiled(
                 // The walk met the triangles in creation order (the labels matched).
                 code_cut_flags(&mut range, &retiled.deleted);
                 mesh = cut(mesh, &retiled.deleted);
+                info.filter.apply(&mut mesh);
+            } else if let Ok(fan) = walked {
+                info.filter.apply_closed(&mut mesh, fan);
             }
             geometry.push(if cutting {
                 KIND_SWING_PRED_CUT
@@ -813,7 +819,7 @@ pub fn encode_retiled(
         } else {
             geometry_kind = SwingGeometry::Explicit(match walked {
                 Err(e) => format!("the swing walk failed: {e}"),
-                Ok(()) => {
+                Ok(_) => {
                     "the shared reconstruction does not reproduce the retiler's positions".into()
                 }
             });
@@ -832,7 +838,9 @@ pub fn encode_retiled(
         geometry.push(KIND_EXPLICIT);
         geometry.extend_from_slice(&bytes);
         let tris = traversal_triangles(&enc.connectivity)?;
-        decoded = Some(output_mesh(&enc.connectivity, &positions, &tris));
+        let mut mesh = output_mesh(&enc.connectivity, &positions, &tris);
+        info.filter.apply(&mut mesh);
+        decoded = Some(mesh);
     }
     let decoded = decoded.unwrap_or_default();
     let clers_histogram = enc.histogram();
@@ -849,6 +857,16 @@ pub fn encode_retiled(
     .with(tag::QUANT_BITS, params.quantizer.bits as u64)
     .with(tag::EDGE_LENGTH, params.edge_length)
     .with(tag::ANGLE_BITS, params.angles.bits() as u64);
+    if !info.filter.is_none() {
+        // The filter fields are format 1.1 (docs/format.md section 6): a 1.0 reader refuses
+        // them by name.
+        if header.version < Version::new(1, 1) {
+            header = header.with_version(Version::new(1, 1));
+        }
+        header = header
+            .with(tag::FILTER_NORMAL, info.filter.normal)
+            .with(tag::FILTER_SMOOTHED, info.filter.smoothed);
+    }
     header.set_bbox(min, max);
     let connectivity_bits = enc.bytes.len() as u64 * 8;
     let geometry_bits = geometry.len() as u64 * 8;
@@ -954,7 +972,11 @@ fn encode_explicit(
 }
 
 /// Decodes a swing container (called by [`crate::decode_container`]).
-pub(crate) fn decode_swing(container: &Container, limits: &Limits) -> Result<Mesh, Error> {
+pub(crate) fn decode_swing(
+    container: &Container,
+    opts: &crate::DecodeOptions,
+) -> Result<Mesh, Error> {
+    let limits = &opts.limits;
     let h = &container.header;
     let edge_length = h
         .get_f64(tag::EDGE_LENGTH)
@@ -989,6 +1011,20 @@ pub(crate) fn decode_swing(container: &Container, limits: &Limits) -> Result<Mes
     if !(edge_length > 0.0 && edge_length.is_finite()) {
         return Err(Error::Corrupt(format!(
             "edge length {edge_length} is not positive and finite"
+        )));
+    }
+    let filter = SurfaceFilter {
+        normal: h.get_i64(tag::FILTER_NORMAL).unwrap_or(0),
+        smoothed: h.get_i64(tag::FILTER_SMOOTHED).unwrap_or(0),
+    };
+    if filter.normal.abs() > surface_filter::MAX_CODED
+        || filter.smoothed.abs() > surface_filter::MAX_CODED
+    {
+        return Err(Error::Corrupt(format!(
+            "surface filter factors {} and {} out of range (at most {} in magnitude)",
+            filter.normal,
+            filter.smoothed,
+            surface_filter::MAX_CODED
         )));
     }
     let params = SwingParams::new(edge_length, angle_bits as u32, &bbox, quant_bits as u32)?;
@@ -1030,7 +1066,7 @@ pub(crate) fn decode_swing(container: &Container, limits: &Limits) -> Result<Mes
                 max_level: params.quantizer.max_level(),
             };
             let predict = kind == KIND_SWING_PRED || kind == KIND_SWING_PRED_CUT;
-            walk(&conn, &params, &mut io, &mut positions, &mut tris, predict)?;
+            let fan = walk(&conn, &params, &mut io, &mut positions, &mut tris, predict)?;
             let flags = if kind == KIND_SWING_CUT || kind == KIND_SWING_PRED_CUT {
                 decode_cut_flags(&mut dec, tris.len())
             } else {
@@ -1047,7 +1083,17 @@ pub(crate) fn decode_swing(container: &Container, limits: &Limits) -> Result<Mes
                     "the swing walk did not create every vertex".into(),
                 ));
             }
-            Ok(cut(Mesh::new(positions, tris), &flags))
+            let mut mesh = cut(Mesh::new(positions, tris), &flags);
+            if opts.surface_filter {
+                // As the encoder does: the walk's fan sums on a closed (uncut) predicted
+                // mesh, else the filter's own normals.
+                if kind == KIND_SWING_PRED {
+                    filter.apply_closed(&mut mesh, fan);
+                } else {
+                    filter.apply(&mut mesh);
+                }
+            }
+            Ok(mesh)
         }
         KIND_EXPLICIT => {
             let mut q = vec![[0i32; 3]; nv];
@@ -1073,7 +1119,11 @@ pub(crate) fn decode_swing(container: &Container, limits: &Limits) -> Result<Mes
             }
             let positions: Vec<DVec3> = q.iter().map(|&g| params.quantizer.dequantize(g)).collect();
             let tris = traversal_triangles(&conn)?;
-            Ok(output_mesh(&conn, &positions, &tris))
+            let mut mesh = output_mesh(&conn, &positions, &tris);
+            if opts.surface_filter {
+                filter.apply(&mut mesh);
+            }
+            Ok(mesh)
         }
         other => Err(Error::Corrupt(format!(
             "unknown swing geometry kind {other}"
@@ -1155,7 +1205,57 @@ mod tests {
             version: Version::CURRENT,
             repair: REPAIR.get_or_init(ManifoldRepair::default),
             dropped_unused_vertices: 0,
+            filter: SurfaceFilter::NONE,
         }
+    }
+
+    #[test]
+    fn the_surface_filter_is_written_applied_and_checked() {
+        let (retiled, params) = tetrahedron(-20);
+        let filter = SurfaceFilter::from_factors(0.25, -0.125);
+        let with_filter = SwingStreamInfo { filter, ..info() };
+        let enc = encode_retiled(&retiled, &params, &with_filter).unwrap();
+        assert_eq!(enc.geometry, SwingGeometry::Swing);
+        // Every vertex of a tetrahedron is convex with a closed fan: all of them moved.
+        for (p, r) in enc.decoded.positions.iter().zip(&retiled.positions) {
+            assert_ne!(p, r);
+        }
+        let mut expected = Mesh::new(retiled.positions.clone(), retiled.triangles.clone());
+        filter.apply(&mut expected);
+        assert_eq!(enc.decoded, expected);
+        let back = crate::decode(&enc.bytes, &crate::DecodeOptions::DEFAULT).unwrap();
+        let bits = |m: &Mesh| -> Vec<[u64; 3]> {
+            m.positions
+                .iter()
+                .map(|p| p.to_array().map(f64::to_bits))
+                .collect()
+        };
+        assert_eq!(bits(&back), bits(&enc.decoded));
+        assert_eq!(back.triangles, enc.decoded.triangles);
+        // Skipping the filter gives the swing construction's own positions.
+        let raw = crate::decode(
+            &enc.bytes,
+            &crate::DecodeOptions::DEFAULT.with_surface_filter(false),
+        )
+        .unwrap();
+        assert_eq!(raw.positions, retiled.positions);
+        let header = crate::peek_header(&enc.bytes).unwrap();
+        assert_eq!(header.version, Version::new(1, 1));
+        // Without a filter the stream stays 1.0 and has no filter field.
+        let plain = encode_retiled(&retiled, &params, &info()).unwrap();
+        assert_eq!(
+            crate::peek_header(&plain.bytes).unwrap().version,
+            Version::CURRENT
+        );
+        // A factor beyond the range is refused by name.
+        let mut container = whet_format::parse(&enc.bytes, &crate::Limits::DEFAULT).unwrap();
+        container.header = container
+            .header
+            .clone()
+            .with(tag::FILTER_NORMAL, surface_filter::MAX_CODED + 1);
+        let bad = container.to_bytes().unwrap();
+        let err = crate::decode(&bad, &crate::DecodeOptions::DEFAULT).unwrap_err();
+        assert!(err.to_string().contains("surface filter"), "{err}");
     }
 
     #[test]

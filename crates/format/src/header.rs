@@ -144,9 +144,15 @@ pub mod tag {
     pub const ANGLE_BITS: u64 = 10;
     /// u64: subdivision levels the decoder applies to the control mesh (subdiv).
     pub const SUBDIV_LEVELS: u64 = 12;
+    /// i64 (format 1.1): factor of the normal Laplacian in the swing decoder's surface
+    /// filter, in units of 1/1024 (swing; absent: 0).
+    pub const FILTER_NORMAL: u64 = 14;
+    /// i64 (format 1.1): factor of the one-ring mean of the normal Laplacian in the swing
+    /// decoder's surface filter, in units of 1/1024 (swing; absent: 0).
+    pub const FILTER_SMOOTHED: u64 = 16;
 
     /// Every tag this crate knows, with its name and value type.
-    pub const KNOWN: [(u64, &str, ValueType); 7] = [
+    pub const KNOWN: [(u64, &str, ValueType); 9] = [
         (ENCODER, "encoder", ValueType::Bytes),
         (COMPONENT_COUNT, "component_count", ValueType::U64),
         (QUANT_BITS, "quant_bits", ValueType::U64),
@@ -154,6 +160,8 @@ pub mod tag {
         (EDGE_LENGTH, "edge_length", ValueType::F64),
         (ANGLE_BITS, "angle_bits", ValueType::U64),
         (SUBDIV_LEVELS, "subdiv_levels", ValueType::U64),
+        (FILTER_NORMAL, "filter_normal", ValueType::I64),
+        (FILTER_SMOOTHED, "filter_smoothed", ValueType::I64),
     ];
 
     /// Name and type of a known tag.

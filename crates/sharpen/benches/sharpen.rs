@@ -55,8 +55,11 @@ fn bench(c: &mut Criterion) {
         let mesh = match whet_swing::encode(&original, &opts)
             .map_err(|e| e.to_string())
             .and_then(|out| {
-                whet_codec::decode(&out.bytes, &whet_codec::DecodeOptions::DEFAULT)
-                    .map_err(|e| e.to_string())
+                whet_codec::decode(
+                    &out.bytes,
+                    &whet_codec::DecodeOptions::DEFAULT.with_surface_filter(false),
+                )
+                .map_err(|e| e.to_string())
             }) {
             Ok(m) => m,
             Err(e) => panic!("{fixture}: {e}"),

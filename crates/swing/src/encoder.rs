@@ -3,14 +3,16 @@
 //! (`algorithms.md` 1.9: the size goes as `L^-2`, so a secant on `log L` converges in a few
 //! steps; the error goes roughly as `L^2`).
 
+use crate::filter_fit::fit_surface_filter;
 use crate::retiler::{retile, RetileStats, RetileTuning};
 use crate::Error;
+use std::sync::OnceLock;
 use whet_codec::{
-    encode_retiled, prepare_mesh, EncodeReport, SwingEncoded, SwingGeometry, SwingParams,
-    SwingStreamInfo, Version,
+    encode_retiled, prepare_mesh, EncodeReport, SurfaceFilter, SwingEncoded, SwingGeometry,
+    SwingParams, SwingStreamInfo, Version,
 };
 use whet_mesh::Mesh;
-use whet_metro::{metro, MetroOptions};
+use whet_metro::{metro, Bvh, MetroOptions};
 
 /// How the encoder chooses the edge length.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -80,6 +82,10 @@ pub struct SwingOptions {
     pub auto_angle_bits: bool,
     /// What the error measurements (error targets, automatic angle bits) refer to.
     pub error_of: ErrorOf,
+    /// Fit the decoder's surface filter to the original and write it into the stream
+    /// (`whet_codec::surface_filter`; docs/swing.md section 2). Off, or with
+    /// [`ErrorOf::Sharpened`], the stream carries no filter.
+    pub surface_filter: bool,
 }
 
 impl SwingOptions {
@@ -104,6 +110,7 @@ impl SwingOptions {
         tuning: RetileTuning::DEFAULT,
         auto_angle_bits: false,
         error_of: ErrorOf::Decoded,
+        surface_filter: true,
     };
 
     /// Sets the rate.
@@ -154,6 +161,12 @@ impl SwingOptions {
         self
     }
 
+    /// Turns the surface filter on or off.
+    pub const fn with_surface_filter(mut self, on: bool) -> Self {
+        self.surface_filter = on;
+        self
+    }
+
     /// Sets the retiler constants.
     pub const fn with_tuning(mut self, tuning: RetileTuning) -> Self {
         self.tuning = tuning;
@@ -197,6 +210,8 @@ pub struct SwingOutput {
     pub search: Vec<(f64, usize)>,
     /// The quantizations the automatic angle-bit choice tried (empty when off).
     pub angle_trials: Vec<AngleTrial>,
+    /// The surface filter the stream carries ([`SurfaceFilter::NONE`]: none).
+    pub surface_filter: SurfaceFilter,
 }
 
 impl SwingOutput {
@@ -243,6 +258,8 @@ struct Prepared {
     dropped: usize,
     diagonal: f64,
     area: f64,
+    /// The original's BVH, built when the first surface filter is fitted.
+    bvh: OnceLock<Bvh>,
 }
 
 impl SwingEncoder {
@@ -287,6 +304,7 @@ impl SwingEncoder {
             repair: p.repair,
             dropped: p.dropped_unused_vertices,
             mesh: p.mesh,
+            bvh: OnceLock::new(),
         };
         if o.auto_angle_bits {
             return self.encode_auto_angle_bits(&prep);
@@ -450,15 +468,22 @@ impl SwingEncoder {
         let l = fraction * prep.diagonal;
         let params = SwingParams::new(l, o.angle_bits, &prep.mesh.bounding_box(), o.quant_bits)?;
         let retiled = retile(&prep.mesh, &params, &o.tuning)?;
-        let enc: SwingEncoded = encode_retiled(
-            &retiled.mesh,
-            &params,
-            &SwingStreamInfo {
-                version: o.version,
-                repair: &prep.repair,
-                dropped_unused_vertices: prep.dropped,
-            },
-        )?;
+        let mut info = SwingStreamInfo {
+            version: o.version,
+            repair: &prep.repair,
+            dropped_unused_vertices: prep.dropped,
+            filter: SurfaceFilter::NONE,
+        };
+        let mut enc: SwingEncoded = encode_retiled(&retiled.mesh, &params, &info)?;
+        if o.surface_filter && o.error_of == ErrorOf::Decoded {
+            // The fit needs the unfiltered decoded mesh; the stream is then written again
+            // with the factors, and its decoded mesh is the filtered one.
+            let bvh = prep.bvh.get_or_init(|| Bvh::new(&prep.mesh));
+            info.filter = fit_surface_filter(bvh, &enc.decoded);
+            if !info.filter.is_none() {
+                enc = encode_retiled(&retiled.mesh, &params, &info)?;
+            }
+        }
         Ok(SwingOutput {
             bytes: enc.bytes,
             report: enc.report,
@@ -473,6 +498,7 @@ impl SwingEncoder {
             rms_pct: None,
             search: Vec::new(),
             angle_trials: Vec::new(),
+            surface_filter: info.filter,
         })
     }
 

@@ -19,6 +19,7 @@
 #![forbid(unsafe_code)]
 
 mod encoder;
+mod filter_fit;
 mod grid;
 mod holes;
 mod retiler;
@@ -27,6 +28,7 @@ mod surface;
 pub use encoder::{
     encode, valence6_fraction, AngleTrial, ErrorOf, Rate, SwingEncoder, SwingOptions, SwingOutput,
 };
+pub use filter_fit::fit_surface_filter;
 pub use retiler::{retile, RetileStats, RetileTuning, Retiled};
 
 /// Why a mesh could not be encoded in the swing mode.

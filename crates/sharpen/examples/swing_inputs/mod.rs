@@ -78,8 +78,11 @@ pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
     };
     let out = whet_swing::encode(&original, &opts)
         .unwrap_or_else(|e| panic!("{name} at {bpv} bpv: encode: {e}"));
-    let decoded = whet_codec::decode(&out.bytes, &whet_codec::DecodeOptions::DEFAULT)
-        .unwrap_or_else(|e| panic!("{name} at {bpv} bpv: decode: {e}"));
+    let decoded = whet_codec::decode(
+        &out.bytes,
+        &whet_codec::DecodeOptions::DEFAULT.with_surface_filter(false),
+    )
+    .unwrap_or_else(|e| panic!("{name} at {bpv} bpv: decode: {e}"));
     let got = out.bits_per_original_vertex();
     let _ = whet_io::write_path(&path, &decoded, None, &whet_io::WriteOptions::DEFAULT);
     let _ = std::fs::write(&meta, format!("{got} {}\n", out.angle_bits));

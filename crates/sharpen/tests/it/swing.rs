@@ -1,6 +1,7 @@
 //! EdgeSharpener on swing-decoded meshes (issue 6's real input): fixtures encoded by
 //! whet-swing (a dev-dependency) and decoded by whet-codec, as `whet encode --bpv 4
-//! --angle-bits 6` then `whet decode` make them.
+//! --angle-bits 6` then `whet decode --sharpen` make them (the decoder leaves out the
+//! stream's surface filter before sharpening).
 
 use whet_mesh::Mesh;
 use whet_sharpen::{sharpen, Method, SharpenOptions};
@@ -17,7 +18,11 @@ fn swing_decoded(name: &str, bpv: f64) -> (Mesh, Mesh) {
         .with_rate(Rate::BitsPerVertex(bpv))
         .with_angle_bits(6);
     let out = whet_swing::encode(&original, &opts).unwrap();
-    let decoded = whet_codec::decode(&out.bytes, &whet_codec::DecodeOptions::DEFAULT).unwrap();
+    let decoded = whet_codec::decode(
+        &out.bytes,
+        &whet_codec::DecodeOptions::DEFAULT.with_surface_filter(false),
+    )
+    .unwrap();
     (original, decoded)
 }
 
@@ -27,9 +32,11 @@ fn swing_decoded_fandisk_is_sharpened_and_rocker_arm_not_made_worse() {
     // bits (sharpen_figures, 1M Metro samples; here 200k): fandisk RMS
     // 0.091 % -> 0.038 % (2.4x), max 1.03 % -> 0.58 % (1.8x); rocker_arm (smooth blends)
     // RMS 0.0376 % -> 0.0374 %, max unchanged. Before the surface-sampling rules rocker_arm
-    // went to 0.0409 % and 0.47 %.
+    // went to 0.0409 % and 0.47 %. Since the stream carries the surface filter's two fields
+    // the rate search lands on another L for fandisk: 0.067 % -> 0.027 % (2.5x), max 0.73 % ->
+    // 0.50 % (1.45x; the max gain moves with L, hence the issue's bound of 1.25x here).
     for (name, min_rms_gain, min_max_gain) in
-        [("fandisk.off", 2.0, 1.5), ("rocker_arm.off", 0.99, 0.999)]
+        [("fandisk.off", 2.0, 1.25), ("rocker_arm.off", 0.99, 0.999)]
     {
         let (original, decoded) = swing_decoded(name, 4.0);
         let before = error(&original, &decoded, SAMPLES);
@@ -62,7 +69,11 @@ fn swing_decoded_mesh(original: &Mesh, bpv: f64) -> Mesh {
         .with_rate(Rate::BitsPerVertex(bpv))
         .with_angle_bits(6);
     let out = whet_swing::encode(original, &opts).unwrap();
-    whet_codec::decode(&out.bytes, &whet_codec::DecodeOptions::DEFAULT).unwrap()
+    whet_codec::decode(
+        &out.bytes,
+        &whet_codec::DecodeOptions::DEFAULT.with_surface_filter(false),
+    )
+    .unwrap()
 }
 
 /// The extended method must be (nearly) the identity on smooth surfaces: RMS and max may not

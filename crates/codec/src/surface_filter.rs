@@ -1,0 +1,295 @@
+//! The swing decoder's surface filter: a post-pass over the decoded mesh that moves each
+//! interior vertex along its normal to cancel the chord bias of uniform retiling.
+//!
+//! Every swing vertex lies on the original surface, so on a convex patch every flat
+//! triangle between them lies inside it (and outside on a concave one): the error has a
+//! mean, not only a spread. For a sphere of radius `R` sampled at edge length `L` the mean
+//! depth of a triangle below the surface is about `L²/(8R)`, while the normal component of
+//! a vertex's umbrella Laplacian is about `L²/(2R)`: moving the vertex out by a quarter of
+//! that component cancels the bias. The encoder fits the factors by least squares against
+//! the original (whet-swing) and writes them in the header; the decoder runs this very code
+//! on its decoded mesh, so the output is still bit-exact between the two (docs/swing.md
+//! section 2, "Surface filter").
+//!
+//! Two displacement fields are combined, both along the area-weighted vertex normal `n`:
+//! `d(v) n`, where `d(v) = −n · (mean of the neighbours − v)` is the normal component of the
+//! umbrella Laplacian (positive on convex parts), and `s(v) n`, where `s(v)` is the mean of
+//! `d` over `v` and its neighbours. The first also carries the angle quantization's noise;
+//! the smoothed one carries mostly the curvature, so their least-squares mix both restores
+//! the bulge and damps the noise. Boundary vertices (open fans) and vertices without a
+//! normal are not moved and contribute `d = 0`.
+
+use whet_mesh::{DVec3, Mesh};
+
+/// Units of a coded factor: the header stores `round(factor · SCALE)`.
+pub const SCALE: f64 = 1024.0;
+
+/// Largest coded factor magnitude (`±4.0`), checked by the decoder.
+pub const MAX_CODED: i64 = 4 * 1024;
+
+/// The two coded factors of the filter, in units of `1 / SCALE`; both zero: no filter.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SurfaceFilter {
+    /// Factor of the vertex's own normal Laplacian `d(v)`.
+    pub normal: i64,
+    /// Factor of the one-ring mean `s(v)` of the normal Laplacian.
+    pub smoothed: i64,
+}
+
+impl SurfaceFilter {
+    /// No filter.
+    pub const NONE: SurfaceFilter = SurfaceFilter {
+        normal: 0,
+        smoothed: 0,
+    };
+
+    /// The coded form of real factors: rounded, and clamped to the range the decoder
+    /// accepts (non-finite factors give no filter).
+    pub fn from_factors(normal: f64, smoothed: f64) -> SurfaceFilter {
+        let code = |x: f64| {
+            if x.is_finite() {
+                ((x * SCALE).round() as i64).clamp(-MAX_CODED, MAX_CODED)
+            } else {
+                0
+            }
+        };
+        SurfaceFilter {
+            normal: code(normal),
+            smoothed: code(smoothed),
+        }
+    }
+
+    /// True when the filter moves nothing.
+    pub fn is_none(&self) -> bool {
+        self.normal == 0 && self.smoothed == 0
+    }
+
+    /// The factors as reals.
+    pub fn factors(&self) -> (f64, f64) {
+        (self.normal as f64 / SCALE, self.smoothed as f64 / SCALE)
+    }
+
+    /// Moves the vertices of `mesh` by the filter (nothing when it is [`Self::NONE`]).
+    pub fn apply(&self, mesh: &mut Mesh) {
+        if self.is_none() {
+            return;
+        }
+        let normals = unit_normals(&mesh.positions, &mesh.triangles);
+        self.apply_with_normals(mesh, normals);
+    }
+
+    /// [`Self::apply`] on a closed mesh (every fan closed) whose per-vertex sums of the
+    /// triangles' cross products `(p1 − p0) × (p2 − p0)` the caller has already: the swing
+    /// walk keeps them for its prediction, so the decoder need not sum them again. The
+    /// result differs from [`Self::apply`] in the last bits (other summation order), so
+    /// encoder and decoder must pick the same entry point (docs/swing.md section 2).
+    pub(crate) fn apply_closed(&self, mesh: &mut Mesh, mut fan_sums: Vec<DVec3>) {
+        if self.is_none() {
+            return;
+        }
+        fan_sums.resize(mesh.positions.len(), DVec3::ZERO);
+        for n in &mut fan_sums {
+            let len = n.length();
+            *n = if len.is_normal() {
+                *n / len
+            } else {
+                DVec3::ZERO
+            };
+        }
+        self.apply_with_normals(mesh, fan_sums);
+    }
+
+    fn apply_with_normals(&self, mesh: &mut Mesh, normals: Vec<DVec3>) {
+        let (a, b) = self.factors();
+        let (d, s) = normal_fields(&mesh.positions, &mesh.triangles, &normals);
+        for (((p, n), d), s) in mesh.positions.iter_mut().zip(&normals).zip(&d).zip(&s) {
+            *p += (a * d + b * s) * *n;
+        }
+    }
+}
+
+/// The two displacement fields of a mesh (per vertex, along its normal), before any factor:
+/// what the encoder fits the factors on (computed as [`SurfaceFilter::apply`] does).
+#[derive(Clone, Debug)]
+pub struct FilterFields {
+    /// `d(v) n(v)`.
+    pub normal: Vec<DVec3>,
+    /// `s(v) n(v)`.
+    pub smoothed: Vec<DVec3>,
+}
+
+impl FilterFields {
+    /// The fields of `mesh`.
+    pub fn new(mesh: &Mesh) -> FilterFields {
+        let normals = unit_normals(&mesh.positions, &mesh.triangles);
+        let (d, s) = normal_fields(&mesh.positions, &mesh.triangles, &normals);
+        FilterFields {
+            normal: normals.iter().zip(&d).map(|(n, d)| *d * *n).collect(),
+            smoothed: normals.iter().zip(&s).map(|(n, s)| *s * *n).collect(),
+        }
+    }
+
+    /// `(d n, s n)` per vertex.
+    pub fn displacements(&self) -> impl Iterator<Item = (DVec3, DVec3)> + '_ {
+        self.normal
+            .iter()
+            .copied()
+            .zip(self.smoothed.iter().copied())
+    }
+}
+
+/// The triangle's corners as indices, when all are in range.
+#[inline]
+fn corners(t: &[u32; 3], n: usize) -> Option<[usize; 3]> {
+    let c = t.map(|v| v as usize);
+    (c[0] < n && c[1] < n && c[2] < n).then_some(c)
+}
+
+/// Unit area-weighted normal of every vertex with a closed fan; zero (the vertex does not
+/// move) on open fans and where the normal vanishes. In a closed fan the next corners and
+/// the previous corners are the same set of vertices, so the wrapping sum of `next − prev`
+/// vanishes; in one open fan it is `last − first ≠ 0`.
+fn unit_normals(pos: &[DVec3], triangles: &[[u32; 3]]) -> Vec<DVec3> {
+    let n = pos.len();
+    let mut normals = vec![DVec3::ZERO; n];
+    let mut open = vec![0u32; n];
+    for t in triangles {
+        let Some([i, j, k]) = corners(t, n) else {
+            continue;
+        };
+        let c = (pos[j] - pos[i]).cross(pos[k] - pos[i]);
+        for (v, next, prev) in [(i, t[1], t[2]), (j, t[2], t[0]), (k, t[0], t[1])] {
+            normals[v] += c;
+            open[v] = open[v].wrapping_add(next.wrapping_sub(prev));
+        }
+    }
+    for (nv, open) in normals.iter_mut().zip(open) {
+        let len = nv.length();
+        *nv = if open == 0 && len.is_normal() {
+            *nv / len
+        } else {
+            DVec3::ZERO
+        };
+    }
+    normals
+}
+
+/// `d(v)` and `s(v)` of every vertex given its unit normal (zero: `d = 0`), summed in
+/// triangle order in f64, so the encoder and the decoder compute the same bits.
+///
+/// `d(v) = −n · (mean of the neighbours − v) = n · (3k v − Σ corner sums) / 2k`, where the
+/// corner sum of a triangle is `p0 + p1 + p2` and `k` the triangles at `v`: an interior vertex
+/// meets each neighbour twice. `s(v)` is the mean of `d` over `v` and its neighbours (each
+/// once, as the next corner of a triangle).
+fn normal_fields(pos: &[DVec3], triangles: &[[u32; 3]], normals: &[DVec3]) -> (Vec<f64>, Vec<f64>) {
+    let n = pos.len().min(normals.len());
+    let mut d = vec![0.0f64; n];
+    let mut k = vec![0u32; n];
+    for t in triangles {
+        let Some([i, j, l]) = corners(t, n) else {
+            continue;
+        };
+        let sum = pos[i] + pos[j] + pos[l];
+        for v in [i, j, l] {
+            d[v] += normals[v].dot(sum);
+            k[v] += 1;
+        }
+    }
+    for v in 0..n {
+        let kv = k[v] as f64;
+        let dv = (3.0 * kv * normals[v].dot(pos[v]) - d[v]) / (2.0 * kv);
+        d[v] = if dv.is_finite() && normals[v] != DVec3::ZERO {
+            dv
+        } else {
+            0.0
+        };
+    }
+    let mut s = d.clone();
+    for t in triangles {
+        let Some([i, j, l]) = corners(t, n) else {
+            continue;
+        };
+        s[i] += d[j];
+        s[j] += d[l];
+        s[l] += d[i];
+    }
+    for (s, k) in s.iter_mut().zip(&k) {
+        *s /= (1 + k) as f64;
+    }
+    (d, s)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An octahedron: every vertex convex, closed fans.
+    fn octahedron() -> Mesh {
+        Mesh::new(
+            vec![
+                DVec3::X,
+                DVec3::Y,
+                -DVec3::X,
+                -DVec3::Y,
+                DVec3::Z,
+                -DVec3::Z,
+            ],
+            vec![
+                [0, 1, 4],
+                [1, 2, 4],
+                [2, 3, 4],
+                [3, 0, 4],
+                [1, 0, 5],
+                [2, 1, 5],
+                [3, 2, 5],
+                [0, 3, 5],
+            ],
+        )
+    }
+
+    #[test]
+    fn convex_vertices_move_outwards() {
+        let mut m = octahedron();
+        let before = m.positions.clone();
+        SurfaceFilter::from_factors(0.25, 0.0).apply(&mut m);
+        for (p, q) in m.positions.iter().zip(&before) {
+            // d = 1 at every vertex (the neighbours' mean is the origin): moved out by 1/4.
+            assert!((p.length() - 1.25).abs() < 1e-12, "{p:?}");
+            assert!((p.normalize() - *q).length() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn smoothed_field_of_a_uniform_field_is_the_same() {
+        let f = FilterFields::new(&octahedron());
+        for (d, s) in f.displacements() {
+            assert!((d - s).length() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn boundary_vertices_stay_and_no_filter_moves_nothing() {
+        // The octahedron without its last face: vertices 0, 3 and 5 are on the boundary.
+        let mut m = octahedron();
+        m.triangles.pop();
+        let before = m.positions.clone();
+        SurfaceFilter::NONE.apply(&mut m);
+        assert_eq!(m.positions, before);
+        SurfaceFilter::from_factors(0.3, 0.2).apply(&mut m);
+        for v in [0usize, 3, 5] {
+            assert_eq!(m.positions[v], before[v], "boundary vertex {v} moved");
+        }
+        assert_ne!(m.positions[4], before[4]);
+    }
+
+    #[test]
+    fn coded_factors_are_rounded_and_clamped() {
+        let f = SurfaceFilter::from_factors(0.2501, -100.0);
+        assert_eq!(f.normal, 256);
+        assert_eq!(f.smoothed, -MAX_CODED);
+        assert_eq!(
+            SurfaceFilter::from_factors(f64::NAN, 0.0),
+            SurfaceFilter::NONE
+        );
+    }
+}

@@ -1,0 +1,84 @@
+//! Least-squares fit of the swing decoder's surface filter (`whet_codec::surface_filter`)
+//! against the original surface.
+//!
+//! The decoder moves each vertex by `a · d(v) n + b · s(v) n` (two displacement fields of
+//! the decoded mesh). A point `p = Σ wᵢ pᵢ` of a decoded triangle then moves by the same
+//! barycentric mix of its corners' displacements; its error along the triangle's normal `n_f`
+//! is `r − a x₀ − b x₁` with `r = (closest point of the original − p) · n_f` and `xₖ` the
+//! fields' mixes along `n_f`. The encoder samples fixed barycentric points of every decoded
+//! triangle (a strided subset on large meshes), weights them by the triangle's area and
+//! solves the 2 × 2 normal equations for `(a, b)`: the forward (decoded to original) RMS of
+//! the filtered mesh, linearised. Measured against the Metro error of factor sweeps, the fit
+//! lands on the sweep's optimum within its resolution (docs/results.md).
+
+use whet_codec::{FilterFields, SurfaceFilter};
+use whet_mesh::{DVec3, Mesh};
+use whet_metro::Bvh;
+
+/// Most surface samples of one fit: two unknowns need few, and the fit runs once per
+/// retiling of a rate search.
+const MAX_SAMPLES: usize = 1 << 16;
+
+/// Barycentric sample points of a triangle: the centroid and the centroids of the three
+/// corner sub-triangles.
+const PATTERN: [[f64; 3]; 4] = [
+    [1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0],
+    [2.0 / 3.0, 1.0 / 6.0, 1.0 / 6.0],
+    [1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0],
+    [1.0 / 6.0, 1.0 / 6.0, 2.0 / 3.0],
+];
+
+/// The filter factors that best fit `decoded` to the surface of `original` (its BVH),
+/// coded; [`SurfaceFilter::NONE`] when the fit is degenerate (no samples, no displacement).
+pub fn fit_surface_filter(original: &Bvh, decoded: &Mesh) -> SurfaceFilter {
+    let fields = FilterFields::new(decoded);
+    let pos = &decoded.positions;
+    let total = decoded.triangles.len() * PATTERN.len();
+    let stride = total.div_ceil(MAX_SAMPLES).max(1);
+    let mut query = original.coherent_query();
+    // Normal equations: m = Σ w x xᵀ, v = Σ w r x.
+    let (mut m00, mut m01, mut m11, mut v0, mut v1) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    let mut sample = 0usize;
+    while sample < total {
+        let t = sample / PATTERN.len();
+        let w = PATTERN[sample % PATTERN.len()];
+        sample += stride;
+        let Some(tri) = decoded.triangles.get(t) else {
+            break;
+        };
+        let [i, j, k] = tri.map(|v| v as usize);
+        if i >= pos.len() || j >= pos.len() || k >= pos.len() {
+            continue;
+        }
+        let cross = (pos[j] - pos[i]).cross(pos[k] - pos[i]);
+        let len = cross.length();
+        if !(len > 0.0 && len.is_finite()) {
+            continue;
+        }
+        let nf = cross / len;
+        let area = 0.5 * len;
+        let mix = |f: &[DVec3]| (w[0] * f[i] + w[1] * f[j] + w[2] * f[k]).dot(nf);
+        let p = w[0] * pos[i] + w[1] * pos[j] + w[2] * pos[k];
+        let r = (query.closest_point(p).point - p).dot(nf);
+        let (x0, x1) = (mix(&fields.normal), mix(&fields.smoothed));
+        if !(r.is_finite() && x0.is_finite() && x1.is_finite()) {
+            continue;
+        }
+        m00 += area * x0 * x0;
+        m01 += area * x0 * x1;
+        m11 += area * x1 * x1;
+        v0 += area * r * x0;
+        v1 += area * r * x1;
+    }
+    let det = m00 * m11 - m01 * m01;
+    // Nearly collinear fields (a uniform curvature): one factor carries the fit.
+    if det > 1e-9 * m00 * m11 && det.is_finite() {
+        let a = (v0 * m11 - v1 * m01) / det;
+        let b = (m00 * v1 - m01 * v0) / det;
+        SurfaceFilter::from_factors(a, b)
+    } else if m00 > 0.0 {
+        SurfaceFilter::from_factors(v0 / m00, 0.0)
+    } else {
+        SurfaceFilter::NONE
+    }
+}
