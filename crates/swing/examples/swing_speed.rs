@@ -6,7 +6,8 @@
 //! cargo run --release -p whet-swing --example swing_speed [-- mesh.off [fraction]]
 //! ```
 //! Without arguments: armadillo split 1-to-4 twice (1.38 M triangles), L chosen for about
-//! 100 k retiled triangles. With `SWING_SPEED_STREAM=<path>` the stream is also written there,
+//! 100 k retiled triangles (`WHET_NO_SURFACE_FILTER=1`: without the surface filter). With
+//! `SWING_SPEED_STREAM=<path>` the stream is also written there,
 //! for `cargo run --release -p whet-codec --example decode_file -- <path>`.
 #![allow(clippy::unwrap_used)] // a measurement tool
 
@@ -55,7 +56,9 @@ fn main() {
         mesh.positions.len(),
         mesh.triangles.len()
     );
-    let opts = SwingOptions::DEFAULT.with_rate(Rate::EdgeLength(fraction));
+    let opts = SwingOptions::DEFAULT
+        .with_rate(Rate::EdgeLength(fraction))
+        .with_surface_filter(std::env::var_os("WHET_NO_SURFACE_FILTER").is_none());
     let mut best_enc = f64::MAX;
     let mut out = None;
     for _ in 0..3 {

@@ -3,16 +3,14 @@
 //! (`algorithms.md` 1.9: the size goes as `L^-2`, so a secant on `log L` converges in a few
 //! steps; the error goes roughly as `L^2`).
 
-use crate::filter_fit::fit_surface_filter;
-use crate::retiler::{retile, RetileStats, RetileTuning};
+use crate::retiler::{retile_fitted, RetileStats, RetileTuning};
 use crate::Error;
-use std::sync::OnceLock;
 use whet_codec::{
     encode_retiled, prepare_mesh, EncodeReport, SurfaceFilter, SwingEncoded, SwingGeometry,
     SwingParams, SwingStreamInfo, Version,
 };
 use whet_mesh::Mesh;
-use whet_metro::{metro, Bvh, MetroOptions};
+use whet_metro::{metro, MetroOptions};
 
 /// How the encoder chooses the edge length.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -258,8 +256,6 @@ struct Prepared {
     dropped: usize,
     diagonal: f64,
     area: f64,
-    /// The original's BVH, built when the first surface filter is fitted.
-    bvh: OnceLock<Bvh>,
 }
 
 impl SwingEncoder {
@@ -304,7 +300,6 @@ impl SwingEncoder {
             repair: p.repair,
             dropped: p.dropped_unused_vertices,
             mesh: p.mesh,
-            bvh: OnceLock::new(),
         };
         if o.auto_angle_bits {
             return self.encode_auto_angle_bits(&prep);
@@ -467,23 +462,16 @@ impl SwingEncoder {
         let o = &self.opts;
         let l = fraction * prep.diagonal;
         let params = SwingParams::new(l, o.angle_bits, &prep.mesh.bounding_box(), o.quant_bits)?;
-        let retiled = retile(&prep.mesh, &params, &o.tuning)?;
-        let mut info = SwingStreamInfo {
+        // EdgeSharpener wants the vertices on the surface: no filter when optimising for it.
+        let fit = o.surface_filter && o.error_of == ErrorOf::Decoded;
+        let retiled = retile_fitted(&prep.mesh, &params, &o.tuning, fit)?;
+        let info = SwingStreamInfo {
             version: o.version,
             repair: &prep.repair,
             dropped_unused_vertices: prep.dropped,
-            filter: SurfaceFilter::NONE,
+            filter: retiled.filter,
         };
-        let mut enc: SwingEncoded = encode_retiled(&retiled.mesh, &params, &info)?;
-        if o.surface_filter && o.error_of == ErrorOf::Decoded {
-            // The fit needs the unfiltered decoded mesh; the stream is then written again
-            // with the factors, and its decoded mesh is the filtered one.
-            let bvh = prep.bvh.get_or_init(|| Bvh::new(&prep.mesh));
-            info.filter = fit_surface_filter(bvh, &enc.decoded);
-            if !info.filter.is_none() {
-                enc = encode_retiled(&retiled.mesh, &params, &info)?;
-            }
-        }
+        let enc: SwingEncoded = encode_retiled(&retiled.mesh, &params, &info)?;
         Ok(SwingOutput {
             bytes: enc.bytes,
             report: enc.report,

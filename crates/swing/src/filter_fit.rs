@@ -6,14 +6,14 @@
 //! barycentric mix of its corners' displacements; its error along the triangle's normal `n_f`
 //! is `r − a x₀ − b x₁` with `r = (closest point of the original − p) · n_f` and `xₖ` the
 //! fields' mixes along `n_f`. The encoder samples fixed barycentric points of every decoded
-//! triangle (a strided subset on large meshes), weights them by the triangle's area and
+//! triangle (a strided subset on large meshes), finds their closest points on the original
+//! (the retiler's grid, within 2 L), weights them by the triangle's area and
 //! solves the 2 × 2 normal equations for `(a, b)`: the forward (decoded to original) RMS of
 //! the filtered mesh, linearised. Measured against the Metro error of factor sweeps, the fit
 //! lands on the sweep's optimum within its resolution (docs/results.md).
 
 use whet_codec::{FilterFields, SurfaceFilter};
 use whet_mesh::{DVec3, Mesh};
-use whet_metro::Bvh;
 
 /// Most surface samples of one fit: two unknowns need few, and the fit runs once per
 /// retiling of a rate search.
@@ -28,14 +28,19 @@ const PATTERN: [[f64; 3]; 4] = [
     [1.0 / 6.0, 1.0 / 6.0, 2.0 / 3.0],
 ];
 
-/// The filter factors that best fit `decoded` to the surface of `original` (its BVH),
-/// coded; [`SurfaceFilter::NONE`] when the fit is degenerate (no samples, no displacement).
-pub fn fit_surface_filter(original: &Bvh, decoded: &Mesh) -> SurfaceFilter {
+/// The filter factors that best fit `decoded` to the original surface, coded;
+/// [`SurfaceFilter::NONE`] when the fit is degenerate (no samples, no displacement).
+/// `closest` gives the closest point of the original to a point, or `None` when there is
+/// none near enough to trust (such samples are left out: wraps and bridges far from the
+/// surface are not what the filter can fix).
+pub fn fit_surface_filter(
+    decoded: &Mesh,
+    mut closest: impl FnMut(DVec3) -> Option<DVec3>,
+) -> SurfaceFilter {
     let fields = FilterFields::new(decoded);
     let pos = &decoded.positions;
     let total = decoded.triangles.len() * PATTERN.len();
     let stride = total.div_ceil(MAX_SAMPLES).max(1);
-    let mut query = original.coherent_query();
     // Normal equations: m = Σ w x xᵀ, v = Σ w r x.
     let (mut m00, mut m01, mut m11, mut v0, mut v1) = (0.0, 0.0, 0.0, 0.0, 0.0);
     let mut sample = 0usize;
@@ -59,7 +64,10 @@ pub fn fit_surface_filter(original: &Bvh, decoded: &Mesh) -> SurfaceFilter {
         let area = 0.5 * len;
         let mix = |f: &[DVec3]| (w[0] * f[i] + w[1] * f[j] + w[2] * f[k]).dot(nf);
         let p = w[0] * pos[i] + w[1] * pos[j] + w[2] * pos[k];
-        let r = (query.closest_point(p).point - p).dot(nf);
+        let Some(c) = closest(p) else {
+            continue;
+        };
+        let r = (c - p).dot(nf);
         let (x0, x1) = (mix(&fields.normal), mix(&fields.smoothed));
         if !(r.is_finite() && x0.is_finite() && x1.is_finite()) {
             continue;

@@ -48,7 +48,7 @@ use crate::grid::{Cells, FastMap, PointGrid};
 use crate::surface::{Hit, Surface};
 use crate::Error;
 use std::f64::consts::{PI, TAU};
-use whet_codec::{RetiledMesh, SwingFrame, SwingParams, VertexSource};
+use whet_codec::{RetiledMesh, SurfaceFilter, SwingFrame, SwingParams, VertexSource};
 use whet_edgebreaker::Clers;
 use whet_mesh::DVec3;
 
@@ -174,6 +174,8 @@ pub struct Retiled {
     pub mesh: RetiledMesh,
     /// What happened.
     pub stats: RetileStats,
+    /// The surface filter fitted to the original ([`SurfaceFilter::NONE`] unless asked for).
+    pub filter: SurfaceFilter,
 }
 
 const NONE: u32 = u32::MAX;
@@ -290,6 +292,17 @@ pub fn retile(
     params: &SwingParams,
     tune: &RetileTuning,
 ) -> Result<Retiled, Error> {
+    retile_fitted(mesh, params, tune, false)
+}
+
+/// [`retile`], and with `fit` also the surface filter fitted to `mesh`
+/// ([`crate::fit_surface_filter`], on the retiler's own grid of the original).
+pub(crate) fn retile_fitted(
+    mesh: &whet_mesh::Mesh,
+    params: &SwingParams,
+    tune: &RetileTuning,
+    fit: bool,
+) -> Result<Retiled, Error> {
     let l = params.edge_length;
     // Originals with boundaries: retile the surface with its holes capped, then delete the
     // retiled triangles over the caps (holes.rs).
@@ -374,6 +387,26 @@ pub fn retile(
         None => Vec::new(),
     };
     r.stats.deleted_triangles = deleted.iter().filter(|&&d| d).count();
+    let filter = if fit {
+        // The decoder's output: the kept triangles (unused vertices do not matter to the
+        // filter). Closest points on the original only, not on the filler over its holes.
+        let kept = whet_mesh::Mesh::new(
+            r.pos.clone(),
+            r.tris
+                .iter()
+                .enumerate()
+                .filter(|(t, _)| !deleted.get(*t).copied().unwrap_or(false))
+                .map(|(_, t)| *t)
+                .collect(),
+        );
+        let filler = filler.unwrap_or(&[]);
+        let surf = &*r.surf;
+        crate::fit_surface_filter(&kept, |p| {
+            surf.closest_point(p, 2.0 * l, |t| !filler.get(t).copied().unwrap_or(false))
+        })
+    } else {
+        SurfaceFilter::NONE
+    };
     Ok(Retiled {
         mesh: RetiledMesh {
             positions: r.pos,
@@ -384,6 +417,7 @@ pub fn retile(
             deleted,
         },
         stats: r.stats,
+        filter,
     })
 }
 

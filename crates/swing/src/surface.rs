@@ -291,6 +291,16 @@ impl<'m> Surface<'m> {
     /// farther is skipped without the exact test. Ties go to the lowest triangle index, so
     /// the answer does not depend on the visiting order.
     fn nearest(&self, p: DVec3, comp: u32, radius: f64) -> Option<(f64, DVec3, u32)> {
+        self.nearest_where(p, radius, |t| self.component[t] == comp)
+    }
+
+    /// [`Self::nearest`] among the triangles `accept` takes.
+    fn nearest_where(
+        &self,
+        p: DVec3,
+        radius: f64,
+        accept: impl Fn(usize) -> bool,
+    ) -> Option<(f64, DVec3, u32)> {
         let mesh = self.mesh;
         let mut cells = std::mem::take(&mut *self.cell_scratch.borrow_mut());
         self.grid.cells.by_distance(p, radius, &mut cells);
@@ -303,7 +313,7 @@ impl<'m> Surface<'m> {
             }
             for &t in self.grid.cell_items(key) {
                 let ti = t as usize;
-                if self.component[ti] != comp {
+                if !accept(ti) {
                     continue;
                 }
                 let [a, b, c] = mesh.triangles[ti].map(|v| mesh.positions[v as usize]);
@@ -335,6 +345,16 @@ impl<'m> Surface<'m> {
         let (_, _, t) = self.nearest(p, comp, radius)?;
         let n = self.face_normal[t as usize];
         (n != DVec3::ZERO).then_some(n)
+    }
+
+    /// The closest point to `p` within distance `radius` on any triangle `accept` takes.
+    pub fn closest_point(
+        &self,
+        p: DVec3,
+        radius: f64,
+        accept: impl Fn(usize) -> bool,
+    ) -> Option<DVec3> {
+        self.nearest_where(p, radius, accept).map(|(_, x, _)| x)
     }
 
     /// The closest point to `p` on component `comp` within distance `radius`, with its
