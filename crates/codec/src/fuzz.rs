@@ -2,13 +2,17 @@
 //! their regressions, so a crasher found by the fuzzer is re-checked by `cargo test` forever.
 
 use crate::{decode, DecodeOptions, ExactPayloads, Quantizer};
-use whet_format::Limits;
+use whet_format::{tag, Container, Header, Limits, Mode, SectionKind};
 
 fn check_valid(mesh: &whet_mesh::Mesh) {
     let n = mesh.positions.len() as u32;
     assert!(
         mesh.triangles.iter().all(|t| t.iter().all(|&v| v < n)),
         "decoder returned an index out of range"
+    );
+    assert!(
+        mesh.positions.iter().all(|p| p.is_finite()),
+        "decoder returned a non-finite position"
     );
 }
 
@@ -54,4 +58,78 @@ pub fn fuzz_exact_payloads(data: &[u8]) {
     if let Ok(mesh) = crate::decode_exact_payloads(&p) {
         check_valid(&mesh);
     }
+}
+
+/// Bytes before the payloads in a [`fuzz_swing_payloads`] input.
+const SWING_PREFIX: usize = 67;
+
+/// The swing decoder behind the container's CRCs: the input carries the header fields raw
+/// (angle bits, quantization bits and component count as one byte each, then `L` and the
+/// box as little-endian f64, the two surface filter factors as i16, the connectivity
+/// length as u32) and then the connectivity and geometry payloads; the container is built
+/// with valid CRCs, so every mutation reaches the swing walk, the cut flags and the surface
+/// filter. [`swing_payload_seed`] turns a real stream into such an input. Returns the
+/// decoded mesh, if any (checked: indices in range, positions finite).
+pub fn fuzz_swing_payloads(data: &[u8]) -> Option<whet_mesh::Mesh> {
+    if data.len() < SWING_PREFIX {
+        return None;
+    }
+    let f64_at = |i: usize| {
+        let mut b = [0u8; 8];
+        b.copy_from_slice(&data[i..i + 8]);
+        f64::from_le_bytes(b)
+    };
+    let i16_at = |i: usize| i16::from_le_bytes([data[i], data[i + 1]]) as i64;
+    let bbox: Vec<f64> = (0..6).map(|k| f64_at(11 + 8 * k)).collect();
+    let conn_len = u32::from_le_bytes([data[63], data[64], data[65], data[66]]) as usize;
+    let body = &data[SWING_PREFIX..];
+    let (conn, geom) = body.split_at(conn_len.min(body.len()));
+    let mut header = Header::new(Mode::Swing, 0, 0)
+        .with(tag::COMPONENT_COUNT, data[2] as u64)
+        .with(tag::QUANT_BITS, data[1] as u64)
+        .with(tag::EDGE_LENGTH, f64_at(3))
+        .with(tag::ANGLE_BITS, data[0] as u64)
+        .with(tag::FILTER_NORMAL, i16_at(59))
+        .with(tag::FILTER_SMOOTHED, i16_at(61));
+    header.set_bbox([bbox[0], bbox[1], bbox[2]], [bbox[3], bbox[4], bbox[5]]);
+    let container = Container::new(header)
+        .with_section(SectionKind::CONNECTIVITY, conn.to_vec())
+        .with_section(SectionKind::GEOMETRY, geom.to_vec());
+    let opts = DecodeOptions::DEFAULT.with_limits(
+        Limits::DEFAULT
+            .with_max_faces(1 << 20)
+            .with_max_vertices(1 << 20),
+    );
+    let mesh = crate::swing::decode_swing(&container, &opts).ok()?;
+    check_valid(&mesh);
+    Some(mesh)
+}
+
+/// The [`fuzz_swing_payloads`] input of a swing stream (`None` for other streams).
+pub fn swing_payload_seed(stream: &[u8]) -> Option<Vec<u8>> {
+    let c = whet_format::parse(stream, &Limits::DEFAULT).ok()?;
+    let h = &c.header;
+    if h.mode != Mode::Swing {
+        return None;
+    }
+    let byte = |t: u64| h.get_u64(t).and_then(|v| u8::try_from(v).ok());
+    let mut out = vec![
+        byte(tag::ANGLE_BITS)?,
+        byte(tag::QUANT_BITS)?,
+        byte(tag::COMPONENT_COUNT)?,
+    ];
+    out.extend_from_slice(&h.get_f64(tag::EDGE_LENGTH)?.to_le_bytes());
+    let (min, max) = h.bbox()?;
+    for v in min.iter().chain(&max) {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    for t in [tag::FILTER_NORMAL, tag::FILTER_SMOOTHED] {
+        let v = i16::try_from(h.get_i64(t).unwrap_or(0)).ok()?;
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    let conn = c.section(SectionKind::CONNECTIVITY)?;
+    out.extend_from_slice(&u32::try_from(conn.len()).ok()?.to_le_bytes());
+    out.extend_from_slice(conn);
+    out.extend_from_slice(c.section(SectionKind::GEOMETRY)?);
+    Some(out)
 }

@@ -43,7 +43,7 @@ pub use encoder::{
 };
 pub use exact::ExactPayloads;
 #[doc(hidden)]
-pub use fuzz::{fuzz_decode, fuzz_exact_payloads};
+pub use fuzz::{fuzz_decode, fuzz_exact_payloads, fuzz_swing_payloads, swing_payload_seed};
 pub use parallelogram::{average, candidates, gate_fallback, MAX_CANDIDATES};
 pub use quantize::Quantizer;
 pub use surface_filter::{FilterFields, SurfaceFilter};

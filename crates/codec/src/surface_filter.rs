@@ -103,7 +103,12 @@ impl SurfaceFilter {
         let (a, b) = self.factors();
         let (d, s) = normal_fields(&mesh.positions, &mesh.triangles, &normals);
         for (((p, n), d), s) in mesh.positions.iter_mut().zip(&normals).zip(&d).zip(&s) {
-            *p += (a * d + b * s) * *n;
+            // Finite in, finite out: sums of huge coordinates may overflow, and such a
+            // vertex then stays where it is (on both sides alike).
+            let moved = *p + (a * d + b * s) * *n;
+            if moved.is_finite() {
+                *p = moved;
+            }
         }
     }
 }
@@ -215,6 +220,9 @@ fn normal_fields(pos: &[DVec3], triangles: &[[u32; 3]], normals: &[DVec3]) -> (V
     }
     for (s, k) in s.iter_mut().zip(&k) {
         *s /= (1 + k) as f64;
+        if !s.is_finite() {
+            *s = 0.0;
+        }
     }
     (d, s)
 }
@@ -280,6 +288,16 @@ mod tests {
             assert_eq!(m.positions[v], before[v], "boundary vertex {v} moved");
         }
         assert_ne!(m.positions[4], before[4]);
+    }
+
+    #[test]
+    fn huge_coordinates_never_give_non_finite_positions() {
+        let mut m = octahedron();
+        for p in &mut m.positions {
+            *p *= 1e307;
+        }
+        SurfaceFilter::from_factors(4.0, 4.0).apply(&mut m);
+        assert!(m.positions.iter().all(|p| p.is_finite()));
     }
 
     #[test]

@@ -1017,9 +1017,8 @@ pub(crate) fn decode_swing(
         normal: h.get_i64(tag::FILTER_NORMAL).unwrap_or(0),
         smoothed: h.get_i64(tag::FILTER_SMOOTHED).unwrap_or(0),
     };
-    if filter.normal.abs() > surface_filter::MAX_CODED
-        || filter.smoothed.abs() > surface_filter::MAX_CODED
-    {
+    let coded = -surface_filter::MAX_CODED..=surface_filter::MAX_CODED;
+    if !coded.contains(&filter.normal) || !coded.contains(&filter.smoothed) {
         return Err(Error::Corrupt(format!(
             "surface filter factors {} and {} out of range (at most {} in magnitude)",
             filter.normal,

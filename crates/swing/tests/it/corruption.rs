@@ -113,3 +113,42 @@ fn bad_header_fields_are_errors() {
     decode_ok_or_err(&rebuild(&|h| h.set(tag::EDGE_LENGTH, 1e-6)));
     decode_ok_or_err(&rebuild(&|h| h.set(tag::EDGE_LENGTH, 1e6)));
 }
+
+#[test]
+fn any_surface_filter_in_range_decodes_to_finite_positions_and_others_are_refused() {
+    let good = stream();
+    let c = parse(&good, &Limits::DEFAULT).unwrap();
+    let rebuilt = |normal: i64, smoothed: i64| {
+        let header = c
+            .header
+            .clone()
+            .with(tag::FILTER_NORMAL, normal)
+            .with(tag::FILTER_SMOOTHED, smoothed);
+        let mut out = Container::new(header);
+        for kind in [SectionKind::CONNECTIVITY, SectionKind::GEOMETRY] {
+            out = out.with_section(kind, c.section(kind).unwrap().to_vec());
+        }
+        out.to_bytes().unwrap()
+    };
+    let max = whet_codec::surface_filter::MAX_CODED;
+    for (a, b) in [
+        (0, 0),
+        (max, max),
+        (-max, -max),
+        (max, -max),
+        (1, -1),
+        (-2000, 3000),
+    ] {
+        let bytes = rebuilt(a, b);
+        let m = decode(&bytes, &DecodeOptions::DEFAULT).unwrap();
+        assert!(m.validate().is_ok());
+        assert!(m.positions.iter().all(|p| p.is_finite()), "{a} {b}");
+        // The filter moves vertices only: the same triangles as without it.
+        let plain = decode(&bytes, &DecodeOptions::DEFAULT.with_surface_filter(false)).unwrap();
+        assert_eq!(m.triangles, plain.triangles);
+    }
+    for (a, b) in [(max + 1, 0), (0, -max - 1), (i64::MIN, 0), (0, i64::MAX)] {
+        let err = decode(&rebuilt(a, b), &DecodeOptions::DEFAULT).unwrap_err();
+        assert!(err.to_string().contains("surface filter"), "{err}");
+    }
+}
