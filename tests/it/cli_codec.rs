@@ -96,3 +96,51 @@ fn non_manifold_input_is_cut_and_reported() {
     assert_eq!(j["repair"]["cut_edges"], 1);
     assert!(String::from_utf8_lossy(&o.stderr).contains("make_manifold"));
 }
+
+#[test]
+fn swing_surface_filter_flags_and_emitted_mesh() {
+    let dir = scratch_dir("cli-codec-filter");
+    let src = shared_fixture("spot.off");
+    let encode = |name: &str, extra: &[&str]| {
+        let stream = dir.join(format!("{name}.whet"));
+        let emitted = dir.join(format!("{name}.emitted.off"));
+        let mut args = vec![
+            "encode",
+            s(&src),
+            "-o",
+            s(&stream),
+            "--edge-length",
+            "0.03",
+            "--emit-retiled",
+            s(&emitted),
+            "--json",
+        ];
+        args.extend_from_slice(extra);
+        (whet_json(&args), stream, emitted)
+    };
+    let decode = |stream: &std::path::Path, name: &str, extra: &[&str]| {
+        let out = dir.join(format!("{name}.off"));
+        let mut args = vec!["decode", s(stream), "-o", s(&out)];
+        args.extend_from_slice(extra);
+        let o = whet(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        std::fs::read(out).unwrap()
+    };
+    let (j, stream, emitted) = encode("filtered", &[]);
+    let (a, b) = (
+        j["surface_filter"]["normal"].as_f64().unwrap(),
+        j["surface_filter"]["smoothed"].as_f64().unwrap(),
+    );
+    // A smooth closed surface: the fit restores a bulge (docs/swing.md section 2).
+    assert!(a + b > 0.05 && a + b < 0.6, "{j}");
+    let filtered = decode(&stream, "decoded", &[]);
+    assert_eq!(filtered, std::fs::read(&emitted).unwrap());
+    // Without the filter: the swing construction's vertices, as an unfiltered stream has them.
+    let raw = decode(&stream, "raw", &["--no-surface-filter"]);
+    assert_ne!(raw, filtered);
+    let (j, plain_stream, plain_emitted) = encode("plain", &["--no-surface-filter"]);
+    assert_eq!(j["surface_filter"]["normal"], 0.0);
+    assert_eq!(j["surface_filter"]["smoothed"], 0.0);
+    assert_eq!(raw, std::fs::read(&plain_emitted).unwrap());
+    assert_eq!(raw, decode(&plain_stream, "plain-decoded", &[]));
+}
