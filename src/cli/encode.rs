@@ -123,8 +123,8 @@ pub struct EncodeArgs {
     #[arg(long, value_enum, default_value_t = OptimizeFor::Decoded)]
     optimize_for: OptimizeFor,
     /// Swing: write no surface filter into the stream (the decoder then returns the retiled
-    /// vertices on the original surface). By default the encoder fits one, except with
-    /// `--optimize-for sharpened`: EdgeSharpener works on the unfiltered vertices.
+    /// vertices on the original surface). By default the encoder fits one; `whet decode
+    /// --sharpen` leaves it out, as EdgeSharpener works on the unfiltered vertices.
     #[arg(long)]
     no_surface_filter: bool,
     /// Swing: also write the retiled mesh the stream encodes (byte-identical to what

@@ -66,6 +66,11 @@ impl Codec for SwingCodec {
     fn decode(&self, bytes: &[u8]) -> Result<Mesh, String> {
         whet::decode(bytes, &whet_codec::DecodeOptions::DEFAULT).map_err(|e| e.to_string())
     }
+    fn decode_for_stages(&self, bytes: &[u8]) -> Option<Result<Mesh, String>> {
+        // As `whet decode --sharpen`: EdgeSharpener starts from the unfiltered vertices.
+        let opts = whet_codec::DecodeOptions::DEFAULT.with_surface_filter(false);
+        Some(whet::decode(bytes, &opts).map_err(|e| e.to_string()))
+    }
 }
 
 /// Default rates of the swing curve, bits per original vertex.

@@ -14,6 +14,12 @@ pub trait Codec: Sync {
     fn encode(&self, mesh: &Mesh, rate: f64) -> Result<Vec<u8>, String>;
     /// Decodes a stream this codec wrote.
     fn decode(&self, bytes: &[u8]) -> Result<Mesh, String>;
+    /// The decoded mesh the post-processing stages start from, when it is not
+    /// [`Codec::decode`]'s (`None`, the default): the swing mode's stages sharpen the mesh
+    /// decoded without its surface filter, as `whet decode --sharpen` does.
+    fn decode_for_stages(&self, _bytes: &[u8]) -> Option<Result<Mesh, String>> {
+        None
+    }
 }
 
 /// A post-processing stage applied to the decoded mesh (`decoded` itself is the identity).
@@ -23,18 +29,22 @@ pub struct Stage {
     /// The stage; it receives the decoded mesh.
     #[allow(clippy::type_complexity)]
     pub apply: Box<dyn Fn(&Mesh) -> Result<Mesh, String> + Sync + Send>,
+    /// Whether the stage starts from [`Codec::decode_for_stages`] (post-processing) rather
+    /// than from [`Codec::decode`] (the identity stage).
+    pub post_processing: bool,
 }
 
 impl Stage {
-    /// The identity stage `decoded`.
+    /// The identity stage `decoded`: what the codec's decoder outputs.
     pub fn decoded() -> Stage {
         Stage {
             name: "decoded".into(),
             apply: Box::new(|m| Ok(m.clone())),
+            post_processing: false,
         }
     }
 
-    /// A named stage.
+    /// A named post-processing stage.
     pub fn new(
         name: impl Into<String>,
         f: impl Fn(&Mesh) -> Result<Mesh, String> + Sync + Send + 'static,
@@ -42,6 +52,7 @@ impl Stage {
         Stage {
             name: name.into(),
             apply: Box::new(f),
+            post_processing: true,
         }
     }
 }
@@ -229,6 +240,13 @@ pub fn run_point(
         Err(e) => return fail_all(base, format!("decode: {e}")),
     };
     base.decode_ms = ms(t);
+    // The post-processing stages' input, decoded once if the codec has its own and a stage
+    // needs it (not timed: the decode column is the decoder's output).
+    let for_stages = if stages.iter().any(|s| s.post_processing) {
+        codec.decode_for_stages(&bytes)
+    } else {
+        None
+    };
     let metro_opts = MetroOptions::DEFAULT
         .with_samples(opts.metro_samples)
         .with_seed(opts.seed);
@@ -239,8 +257,16 @@ pub fn run_point(
                 stage: stage.name.clone(),
                 ..base.clone()
             };
+            let input = match (&for_stages, stage.post_processing) {
+                (Some(Ok(m)), true) => m,
+                (Some(Err(e)), true) => {
+                    p.error = Some(format!("decode: {e}"));
+                    return p;
+                }
+                _ => &decoded,
+            };
             let t = Instant::now();
-            let mesh = match (stage.apply)(&decoded) {
+            let mesh = match (stage.apply)(input) {
                 Ok(m) => m,
                 Err(e) => {
                     p.error = Some(format!("{}: {e}", stage.name));

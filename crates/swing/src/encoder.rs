@@ -81,8 +81,9 @@ pub struct SwingOptions {
     /// What the error measurements (error targets, automatic angle bits) refer to.
     pub error_of: ErrorOf,
     /// Fit the decoder's surface filter to the original and write it into the stream
-    /// (`whet_codec::surface_filter`; docs/swing.md section 2). Off, or with
-    /// [`ErrorOf::Sharpened`], the stream carries no filter.
+    /// (`whet_codec::surface_filter`; docs/swing.md section 2). Off, the stream carries no
+    /// filter. Sharpening decodes without it either way, so [`ErrorOf::Sharpened`]
+    /// measures the sharpened unfiltered mesh.
     pub surface_filter: bool,
 }
 
@@ -462,9 +463,7 @@ impl SwingEncoder {
         let o = &self.opts;
         let l = fraction * prep.diagonal;
         let params = SwingParams::new(l, o.angle_bits, &prep.mesh.bounding_box(), o.quant_bits)?;
-        // EdgeSharpener wants the vertices on the surface: no filter when optimising for it.
-        let fit = o.surface_filter && o.error_of == ErrorOf::Decoded;
-        let retiled = retile_fitted(&prep.mesh, &params, &o.tuning, fit)?;
+        let retiled = retile_fitted(&prep.mesh, &params, &o.tuning, o.surface_filter)?;
         let info = SwingStreamInfo {
             version: o.version,
             repair: &prep.repair,
@@ -564,11 +563,19 @@ impl SwingEncoder {
     /// Measures the symmetric RMS error of `out` (decoded, or sharpened: [`ErrorOf`])
     /// against the original, in % of its diagonal.
     fn measure(&self, prep: &Prepared, out: &SwingOutput) -> Result<f64, Error> {
-        let sharpened;
+        let (sharpened, unfiltered);
         let mesh = match self.opts.error_of {
             ErrorOf::Decoded => &out.retiled,
             ErrorOf::Sharpened => {
-                match whet_sharpen::sharpen(&out.retiled, &whet_sharpen::SharpenOptions::DEFAULT) {
+                // `whet decode --sharpen`: the mesh without its surface filter, sharpened.
+                let input = if out.surface_filter.is_none() {
+                    &out.retiled
+                } else {
+                    let opts = whet_codec::DecodeOptions::DEFAULT.with_surface_filter(false);
+                    unfiltered = whet_codec::decode(&out.bytes, &opts)?;
+                    &unfiltered
+                };
+                match whet_sharpen::sharpen(input, &whet_sharpen::SharpenOptions::DEFAULT) {
                     Ok(s) => {
                         sharpened = s.mesh;
                         &sharpened
@@ -576,7 +583,7 @@ impl SwingEncoder {
                     // A retiled mesh is a valid manifold; should the sharpener refuse one
                     // anyway, `whet decode --sharpen` would fail the same way, and the
                     // decoded mesh is what the user keeps.
-                    Err(_) => &out.retiled,
+                    Err(_) => input,
                 }
             }
         };
