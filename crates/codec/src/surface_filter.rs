@@ -81,8 +81,9 @@ impl SurfaceFilter {
     /// [`Self::apply`] on a closed mesh (every fan closed) whose per-vertex sums of the
     /// triangles' cross products `(p1 − p0) × (p2 − p0)` the caller has already: the swing
     /// walk keeps them for its prediction, so the decoder need not sum them again. The
-    /// result differs from [`Self::apply`] in the last bits (other summation order), so
-    /// encoder and decoder must pick the same entry point (docs/swing.md section 2).
+    /// walk sums the same products in the same triangle order, but its arithmetic is its own
+    /// code: encoder and decoder pick the same entry point by rule (docs/swing.md section
+    /// 2), so the two never need to agree to the bit.
     pub(crate) fn apply_closed(&self, mesh: &mut Mesh, mut fan_sums: Vec<DVec3>) {
         if self.is_none() {
             return;

@@ -26,7 +26,8 @@ pub trait Codec: Sync {
 pub struct Stage {
     /// Name shown in tables and legends (`decoded`, `sharpened`, `bent`).
     pub name: String,
-    /// The stage; it receives the decoded mesh.
+    /// The stage; it receives the decoded mesh ([`Codec::decode`]'s, or for a
+    /// post-processing stage [`Codec::decode_for_stages`]' when the codec has one).
     #[allow(clippy::type_complexity)]
     pub apply: Box<dyn Fn(&Mesh) -> Result<Mesh, String> + Sync + Send>,
     /// Whether the stage starts from [`Codec::decode_for_stages`] (post-processing) rather
@@ -116,7 +117,8 @@ pub struct Point {
     pub diagonal: f64,
     /// Encode time.
     pub encode_ms: f64,
-    /// Decode time.
+    /// Decode time of [`Codec::decode`] (on every stage's row; a post-processing stage's
+    /// own decode through [`Codec::decode_for_stages`] is not timed).
     pub decode_ms: f64,
     /// Stage time (0 for `decoded`).
     pub stage_ms: f64,

@@ -40,7 +40,12 @@ pub fn fit_surface_filter(
     let fields = FilterFields::new(decoded);
     let pos = &decoded.positions;
     let total = decoded.triangles.len() * PATTERN.len();
-    let stride = total.div_ceil(MAX_SAMPLES).max(1);
+    // An odd stride cycles through the four pattern points (an even one would keep to one
+    // or two of them).
+    let stride = match total.div_ceil(MAX_SAMPLES) {
+        0 | 1 => 1,
+        s => s | 1,
+    };
     // Normal equations: m = Σ w x xᵀ, v = Σ w r x.
     let (mut m00, mut m01, mut m11, mut v0, mut v1) = (0.0, 0.0, 0.0, 0.0, 0.0);
     let mut sample = 0usize;
@@ -48,10 +53,7 @@ pub fn fit_surface_filter(
         let t = sample / PATTERN.len();
         let w = PATTERN[sample % PATTERN.len()];
         sample += stride;
-        let Some(tri) = decoded.triangles.get(t) else {
-            break;
-        };
-        let [i, j, k] = tri.map(|v| v as usize);
+        let [i, j, k] = decoded.triangles[t].map(|v| v as usize);
         if i >= pos.len() || j >= pos.len() || k >= pos.len() {
             continue;
         }
