@@ -234,26 +234,7 @@ mod tests {
 
     /// An octahedron: every vertex convex, closed fans.
     fn octahedron() -> Mesh {
-        Mesh::new(
-            vec![
-                DVec3::X,
-                DVec3::Y,
-                -DVec3::X,
-                -DVec3::Y,
-                DVec3::Z,
-                -DVec3::Z,
-            ],
-            vec![
-                [0, 1, 4],
-                [1, 2, 4],
-                [2, 3, 4],
-                [3, 0, 4],
-                [1, 0, 5],
-                [2, 1, 5],
-                [3, 2, 5],
-                [0, 3, 5],
-            ],
-        )
+        whet_testkit::meshes::octahedron()
     }
 
     #[test]

@@ -467,25 +467,8 @@ mod tests {
     }
 
     fn octahedron() -> (Vec<DVec3>, Vec<[u32; 3]>) {
-        let p = vec![
-            DVec3::X,
-            DVec3::Y,
-            -DVec3::X,
-            -DVec3::Y,
-            DVec3::Z,
-            -DVec3::Z,
-        ];
-        let t = vec![
-            [0, 1, 4],
-            [1, 2, 4],
-            [2, 3, 4],
-            [3, 0, 4],
-            [1, 0, 5],
-            [2, 1, 5],
-            [3, 2, 5],
-            [0, 3, 5],
-        ];
-        (p, t)
+        let m = whet_testkit::meshes::octahedron();
+        (m.positions, m.triangles)
     }
 
     #[test]

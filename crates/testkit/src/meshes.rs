@@ -1,7 +1,32 @@
-//! Test meshes built in code: subdivided icosahedra, torus grids, open grids, unions,
-//! punched holes and deterministic relabelings.
+//! Test meshes built in code: an octahedron, subdivided icosahedra, torus grids, open grids,
+//! unions, punched holes and deterministic relabelings.
 
 use whet_mesh::{DVec3, Mesh};
+
+/// The regular octahedron with vertices at ±x, ±y, ±z (outward orientation): six valence-4
+/// vertices whose neighbours average to the origin.
+pub fn octahedron() -> Mesh {
+    Mesh::new(
+        vec![
+            DVec3::X,
+            DVec3::Y,
+            -DVec3::X,
+            -DVec3::Y,
+            DVec3::Z,
+            -DVec3::Z,
+        ],
+        vec![
+            [0, 1, 4],
+            [1, 2, 4],
+            [2, 3, 4],
+            [3, 0, 4],
+            [1, 0, 5],
+            [2, 1, 5],
+            [3, 2, 5],
+            [0, 3, 5],
+        ],
+    )
+}
 
 /// Icosahedron subdivided `levels` times (1-to-4), projected on the unit sphere.
 pub fn icosphere(levels: u32) -> Mesh {
