@@ -17,7 +17,7 @@ use whet_mesh::{DVec3, Mesh};
 
 /// Most surface samples of one fit: two unknowns need few, and the fit runs once per
 /// retiling of a rate search.
-const MAX_SAMPLES: usize = 1 << 16;
+const MAX_SAMPLES: usize = 1 << 14;
 
 /// Barycentric sample points of a triangle: the centroid and the centroids of the three
 /// corner sub-triangles.
