@@ -67,7 +67,18 @@ impl Codec for SwingCodec {
         whet::decode(bytes, &whet_codec::DecodeOptions::DEFAULT).map_err(|e| e.to_string())
     }
     fn decode_for_stages(&self, bytes: &[u8]) -> Option<Result<Mesh, String>> {
-        // As `whet decode --sharpen`: EdgeSharpener starts from the unfiltered vertices.
+        // As `whet decode --sharpen`: EdgeSharpener starts from the unfiltered vertices. A
+        // stream without a filter decodes to them already: no second decode.
+        let header = whet_format::parse(bytes, &whet_format::Limits::DEFAULT)
+            .ok()?
+            .header;
+        let tags = [
+            whet_format::tag::FILTER_NORMAL,
+            whet_format::tag::FILTER_SMOOTHED,
+        ];
+        if tags.iter().all(|&t| header.get_i64(t).is_none()) {
+            return None;
+        }
         let opts = whet_codec::DecodeOptions::DEFAULT.with_surface_filter(false);
         Some(whet::decode(bytes, &opts).map_err(|e| e.to_string()))
     }

@@ -859,7 +859,7 @@ pub fn encode_retiled(
     .with(tag::ANGLE_BITS, params.angles.bits() as u64);
     if !info.filter.is_none() {
         // The filter fields are format 1.1 (docs/format.md section 6): a 1.0 reader refuses
-        // them by name.
+        // them as unknown required tags.
         if header.version < Version::new(1, 1) {
             header = header.with_version(Version::new(1, 1));
         }
