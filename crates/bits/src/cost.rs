@@ -111,6 +111,10 @@ impl BitSink for CostCounter {
         model.update(symbol);
     }
     #[inline]
+    fn encode_interval(&mut self, _cum: u32, freq: u32, total: u32) {
+        self.cost += ratio_cost(freq, total) as u64;
+    }
+    #[inline]
     fn encode_tree(&mut self, tree: &mut BitTree, value: u32) {
         let bits = tree.bits();
         let mut node = 1usize;

@@ -31,6 +31,9 @@ pub trait BitSink {
     fn encode_direct(&mut self, value: u32, bits: u32);
     /// Codes a symbol with an adaptive frequency model (and updates it).
     fn encode_symbol(&mut self, model: &mut SymbolModel, symbol: usize);
+    /// Codes the interval `[cum, cum + freq)` of a frequency table summing to `total`
+    /// (`0 < freq`, `cum + freq <= total <= 2^16`); the caller updates its table.
+    fn encode_interval(&mut self, cum: u32, freq: u32, total: u32);
     /// Codes a value through a bit tree.
     fn encode_tree(&mut self, tree: &mut BitTree, value: u32) {
         let bits = tree.bits();
@@ -55,6 +58,10 @@ impl BitSink for RangeEncoder {
     #[inline]
     fn encode_symbol(&mut self, model: &mut SymbolModel, symbol: usize) {
         RangeEncoder::encode_symbol(self, model, symbol)
+    }
+    #[inline]
+    fn encode_interval(&mut self, cum: u32, freq: u32, total: u32) {
+        RangeEncoder::encode_interval(self, cum, freq, total)
     }
     #[inline]
     fn encode_tree(&mut self, tree: &mut BitTree, value: u32) {
@@ -233,6 +240,96 @@ impl SymbolModel {
     pub fn cost(&self, symbol: usize) -> u32 {
         let (_, f, t) = self.interval(symbol);
         crate::cost::ratio_cost(f, t)
+    }
+}
+
+/// Many adaptive frequency tables over one small alphabet, in one flat array: the counting
+/// rule of [`SymbolModel`] (counts start at 1, each occurrence adds 32, the table halves when
+/// its total passes 2^16) for coders that pick one of thousands of contexts per symbol, where
+/// a [`SymbolModel`] each would cost an allocation per context.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SymbolTables {
+    symbols: usize,
+    freq: Vec<u32>,
+    total: Vec<u32>,
+}
+
+impl SymbolTables {
+    /// `tables` tables (at least one) of `symbols` equally likely symbols (`symbols` clamped
+    /// to 1..=64).
+    pub fn new(tables: usize, symbols: usize) -> Self {
+        let symbols = symbols.clamp(1, 64);
+        let tables = tables.max(1);
+        SymbolTables {
+            symbols,
+            freq: vec![1; tables * symbols],
+            total: vec![symbols as u32; tables],
+        }
+    }
+
+    /// Number of tables.
+    pub fn len(&self) -> usize {
+        self.total.len()
+    }
+
+    /// Always false: a set has at least one table.
+    pub fn is_empty(&self) -> bool {
+        self.total.is_empty()
+    }
+
+    /// Codes `symbol` (clamped into the alphabet) with table `table` (clamped into range),
+    /// then counts it.
+    #[inline]
+    pub fn encode<S: BitSink>(&mut self, sink: &mut S, table: usize, symbol: usize) {
+        let t = table.min(self.total.len() - 1);
+        let s = symbol.min(self.symbols - 1);
+        let row = &self.freq[t * self.symbols..(t + 1) * self.symbols];
+        let cum: u32 = row[..s].iter().sum();
+        sink.encode_interval(cum, row[s], self.total[t]);
+        self.update(t, s);
+    }
+
+    /// Decodes a symbol coded with table `table` by [`SymbolTables::encode`], then counts it.
+    #[inline]
+    pub fn decode(&mut self, dec: &mut RangeDecoder<'_>, table: usize) -> usize {
+        let t = table.min(self.total.len() - 1);
+        let n = self.symbols;
+        let row = &self.freq[t * n..(t + 1) * n];
+        let s = dec.decode_with(self.total[t], |target| {
+            let mut cum = 0;
+            for (s, &f) in row.iter().enumerate() {
+                if target < cum + f {
+                    return (s, cum, f);
+                }
+                cum += f;
+            }
+            // target < total: unreachable; answer the last symbol.
+            (n - 1, cum - row[n - 1], row[n - 1])
+        });
+        self.update(t, s);
+        s
+    }
+
+    /// Cost of coding `symbol` with table `table` now, in 1/[`crate::COST_ONE`] bits.
+    pub fn cost(&self, table: usize, symbol: usize) -> u32 {
+        let t = table.min(self.total.len() - 1);
+        let s = symbol.min(self.symbols - 1);
+        crate::cost::ratio_cost(self.freq[t * self.symbols + s], self.total[t])
+    }
+
+    #[inline]
+    fn update(&mut self, t: usize, s: usize) {
+        let row = &mut self.freq[t * self.symbols..(t + 1) * self.symbols];
+        row[s] += SymbolModel::STEP;
+        self.total[t] += SymbolModel::STEP;
+        if self.total[t] > SymbolModel::LIMIT {
+            let mut total = 0;
+            for f in row.iter_mut() {
+                *f = (*f).div_ceil(2);
+                total += *f;
+            }
+            self.total[t] = total;
+        }
     }
 }
 

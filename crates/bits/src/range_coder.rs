@@ -125,6 +125,15 @@ impl RangeEncoder {
         self.normalize();
     }
 
+    /// Codes the interval `[cum, cum + freq)` of a frequency table summing to `total`.
+    #[inline]
+    pub fn encode_interval(&mut self, cum: u32, freq: u32, total: u32) {
+        let r = self.range / total.max(1);
+        self.low += (r as u64) * (cum as u64);
+        self.range = r * freq;
+        self.normalize();
+    }
+
     /// Codes `value` (below `2^tree.bits()`) through a binary tree of adaptive bit models.
     #[inline]
     pub fn encode_tree(&mut self, tree: &mut BitTree, value: u32) {
@@ -250,6 +259,25 @@ impl<'a> RangeDecoder<'a> {
         symbol
     }
 
+    /// Decodes an interval coded with [`RangeEncoder::encode_interval`]: `find` maps the
+    /// target count (below `total`) to `(symbol, cum, freq)` of the interval holding it.
+    #[inline]
+    pub fn decode_with(
+        &mut self,
+        total: u32,
+        find: impl FnOnce(u32) -> (usize, u32, u32),
+    ) -> usize {
+        let total = total.max(1);
+        let r = self.range / total;
+        // A corrupt stream can put `code` past the last interval: clamp, as decode_symbol.
+        let target = (self.code / r.max(1)).min(total - 1);
+        let (symbol, cum, freq) = find(target);
+        self.code = self.code.wrapping_sub(r * cum);
+        self.range = r * freq;
+        self.normalize();
+        symbol
+    }
+
     /// Decodes a value coded with [`RangeEncoder::encode_tree`].
     #[inline]
     pub fn decode_tree(&mut self, tree: &mut BitTree) -> u32 {
@@ -334,6 +362,55 @@ mod tests {
         }
         assert_eq!(d.finish(), Err(Error::Truncated));
         assert_eq!(RangeDecoder::new(&bytes[..4]).err(), Some(Error::Truncated));
+    }
+
+    #[test]
+    fn symbol_tables_code_as_symbol_models_do() {
+        use crate::{BitSink, CostCounter, SymbolTables};
+        // One table of n symbols counts and codes exactly as a SymbolModel of n symbols
+        // (past several halvings of its counts), and tables of one set keep apart.
+        let symbols: Vec<(usize, usize)> = (0..20_000u32)
+            .map(|i| {
+                let h = i.wrapping_mul(2654435761);
+                (
+                    (h >> 28) as usize % 3,
+                    if h >> 31 == 0 {
+                        0
+                    } else {
+                        (h >> 20) as usize % 5
+                    },
+                )
+            })
+            .collect();
+        let mut models: Vec<SymbolModel> = (0..3).map(|_| SymbolModel::new(5)).collect();
+        let mut tables = SymbolTables::new(3, 5);
+        let (mut e1, mut e2) = (RangeEncoder::new(), RangeEncoder::new());
+        let (mut c1, mut c2) = (CostCounter::new(), CostCounter::new());
+        for &(t, s) in &symbols {
+            assert_eq!(tables.cost(t, s), models[t].cost(s));
+            c1.encode_symbol(&mut models[t].clone(), s);
+            tables.clone().encode(&mut c2, t, s);
+            e1.encode_symbol(&mut models[t], s);
+            tables.encode(&mut e2, t, s);
+        }
+        assert_eq!(c1.cost(), c2.cost());
+        let bytes = e1.finish();
+        assert_eq!(bytes, e2.finish());
+        let mut tables = SymbolTables::new(3, 5);
+        let mut d = RangeDecoder::new(&bytes).unwrap();
+        for &(t, s) in &symbols {
+            assert_eq!(tables.decode(&mut d, t), s);
+        }
+        d.finish().unwrap();
+        // Out-of-range tables and symbols are clamped, garbage never panics.
+        let mut tables = SymbolTables::new(2, 70);
+        let mut d = RangeDecoder::new(&[0, 255, 255, 255, 255, 1, 2]).unwrap();
+        for _ in 0..100 {
+            assert!(tables.decode(&mut d, 9) < 64);
+        }
+        let mut none = SymbolTables::new(0, 5);
+        assert_eq!(none.len(), 1);
+        none.encode(&mut CostCounter::new(), 3, 4);
     }
 
     #[derive(Debug, Clone)]

@@ -33,6 +33,16 @@
 //!   vertices left unused. This is how originals with boundaries are coded: the retiler
 //!   closes their holes, retiles, and flags the triangles over the holes (whet-swing
 //!   `holes.rs`);
+//! * kinds 3 and 4: kinds 0 and 2 with each index coded as the residual of the fan-normal
+//!   prediction ([`predict_swing`]), one bit tree per bucket of the prediction;
+//! * kinds 5 and 6 (format 1.2): kinds 3 and 4 with the predicted
+//!   angle scaled by [`PREDICTION_SCALE`] ([`predict_swing_scaled`]) and the residuals coded
+//!   through adaptive frequency tables instead of bit trees;
+//! * kinds 7 and 8, **what the encoder writes** (format 1.2): kinds 5 and 6 with the
+//!   connectivity coded inside the walk, label by label in creation order, in the context of
+//!   the geometry rebuilt around each gate ([`front`]); the connectivity section holds only
+//!   the triangle count. The encoder falls back to kinds 5 and 6 if that walk does not
+//!   reproduce the retiled mesh;
 //! * kind 1, explicit: the exact mode's position coder on the kept retiled triangles,
 //!   positions quantized to `quant_bits` — only the safety net for a failed encoder
 //!   self-check (a retiler bug), never written otherwise.
@@ -42,10 +52,16 @@
 use crate::exact::{code_positions, ResidualReader, ResidualWriter};
 use crate::surface_filter::{self, SurfaceFilter};
 use crate::{EncodeReport, Error, Quantizer};
-use whet_bits::{BitModel, BitSink, BitTree, RangeDecoder, RangeEncoder};
+use whet_bits::{BitModel, BitSink, BitTree, RangeDecoder, RangeEncoder, SymbolModel};
 use whet_edgebreaker::{Clers, Connectivity, ConnectivityLimits, Step};
 use whet_format::{tag, Container, Header, Mode, SectionKind, Version};
 use whet_mesh::{Aabb, DVec3, ManifoldRepair, Mesh, VertexId};
+
+#[path = "swing_front.rs"]
+mod front;
+
+/// The format version of geometry kinds 5 and 6.
+const VERSION_1_2: Version = Version::new(1, 2);
 
 /// Fewest angle bits a stream may use.
 pub const MIN_ANGLE_BITS: u32 = 3;
@@ -57,9 +73,56 @@ const KIND_SWING: u8 = 0;
 const KIND_EXPLICIT: u8 = 1;
 const KIND_SWING_CUT: u8 = 2;
 /// Kinds 0 and 2 with the swing indices coded as residuals of the fan-normal prediction
-/// ([`predict_swing`]); what the encoder writes.
+/// ([`predict_swing`]), one bit tree per bucket of the prediction.
 const KIND_SWING_PRED: u8 = 3;
 const KIND_SWING_PRED_CUT: u8 = 4;
+/// Kinds 3 and 4 with the prediction scaled ([`predict_swing_scaled`]) and the residuals
+/// coded through adaptive frequency tables; what the encoder writes (format 1.2).
+const KIND_SWING_SCALED: u8 = 5;
+const KIND_SWING_SCALED_CUT: u8 = 6;
+/// Kinds 5 and 6 with the connectivity coded in the walk ([`front`]); what the encoder
+/// writes (format 1.2).
+const KIND_SWING_FORWARD: u8 = 7;
+const KIND_SWING_FORWARD_CUT: u8 = 8;
+
+/// How a stream codes its swing indices (by geometry kind).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum IndexCoding {
+    /// Kinds 0 and 2: the zigzagged index through one bit tree.
+    Order0,
+    /// Kinds 3 and 4: the residual of [`predict_swing`], a bit tree per bucket.
+    Predicted,
+    /// Kinds 5 and 6: the residual of [`predict_swing_scaled`], a frequency table per bucket.
+    Scaled,
+}
+
+impl IndexCoding {
+    /// The coding of geometry kind `kind` and whether the kind carries deletion flags
+    /// (`None`: not a swing-index kind).
+    fn of_kind(kind: u8) -> Option<(IndexCoding, bool)> {
+        match kind {
+            KIND_SWING => Some((IndexCoding::Order0, false)),
+            KIND_SWING_CUT => Some((IndexCoding::Order0, true)),
+            KIND_SWING_PRED => Some((IndexCoding::Predicted, false)),
+            KIND_SWING_PRED_CUT => Some((IndexCoding::Predicted, true)),
+            KIND_SWING_SCALED => Some((IndexCoding::Scaled, false)),
+            KIND_SWING_SCALED_CUT => Some((IndexCoding::Scaled, true)),
+            _ => None,
+        }
+    }
+
+    /// The geometry kind of this coding, with or without deletion flags.
+    fn kind(self, cutting: bool) -> u8 {
+        match (self, cutting) {
+            (IndexCoding::Order0, false) => KIND_SWING,
+            (IndexCoding::Order0, true) => KIND_SWING_CUT,
+            (IndexCoding::Predicted, false) => KIND_SWING_PRED,
+            (IndexCoding::Predicted, true) => KIND_SWING_PRED_CUT,
+            (IndexCoding::Scaled, false) => KIND_SWING_SCALED,
+            (IndexCoding::Scaled, true) => KIND_SWING_SCALED_CUT,
+        }
+    }
+}
 
 // --- Exact arithmetic helpers --------------------------------------------------------------
 // Spelled out so that the evaluation order is fixed by this file, not by a library version.
@@ -393,34 +456,116 @@ pub struct SwingEncoded {
 // --- Swing index models --------------------------------------------------------------------
 
 /// Contexts of the swing index coder. Kinds 0 and 2 code the zigzagged index order-0
-/// through one adaptive bit tree. Kinds 3 and 4 code the residual `q - pred` of the
-/// fan-normal prediction ([`predict_swing`]), wrapped into the index range and zigzagged,
-/// through one bit tree per bucket of the prediction (the bit length of the zigzagged
-/// prediction, capped at 7): flat regions (prediction 0) and folds (large predictions) keep
-/// apart. Measured (docs/swing.md): 5-9 % fewer bits on smooth scans, 8-10 % on CAD parts.
-/// The parent triangle's index, the previous index or the parent's label as contexts cost
-/// more in learning than they save (within ±2 %).
+/// through one adaptive bit tree. Kinds 3 to 6 code the residual `q - pred` of the
+/// fan-normal prediction, wrapped into the index range and zigzagged, through one model per
+/// bucket of the prediction (the bit length of the zigzagged prediction, capped at 7): flat
+/// regions (prediction 0) and folds (large predictions) keep apart. Measured
+/// (docs/swing.md): 5-9 % fewer bits on smooth scans, 8-10 % on CAD parts. The parent
+/// triangle's index, the previous index or the parent's label as contexts cost more in
+/// learning than they save (within ±2 %). Kinds 5 and 6 scale the prediction and count
+/// symbols in frequency tables, whose estimates settle faster and closer than the bit trees'
+/// fixed-rate probabilities: 4-6 % fewer bits at 6 angle bits (docs/swing.md).
 struct SwingModels {
-    trees: Vec<BitTree>,
+    models: Vec<IndexModel>,
 }
 
 /// Buckets of the prediction ([`SwingModels`]).
 const PRED_BUCKETS: usize = 8;
 
 impl SwingModels {
-    fn new(bits: u32, predict: bool) -> Self {
-        let n = if predict { PRED_BUCKETS } else { 1 };
+    fn new(bits: u32, coding: IndexCoding) -> Self {
+        let n = match coding {
+            IndexCoding::Order0 => 1,
+            _ => PRED_BUCKETS,
+        };
         SwingModels {
-            trees: (0..n).map(|_| BitTree::new(bits)).collect(),
+            models: (0..n).map(|_| IndexModel::new(bits, coding)).collect(),
         }
     }
 
-    /// The tree for prediction `pred` (the only tree without prediction).
+    /// The model for prediction `pred` (the only model without prediction).
     #[inline]
-    fn tree(&mut self, pred: i32) -> &mut BitTree {
+    fn model(&mut self, pred: i32) -> &mut IndexModel {
         let len = (32 - zigzag(pred).leading_zeros()) as usize;
-        let k = len.min(self.trees.len() - 1);
-        &mut self.trees[k]
+        let k = len.min(self.models.len() - 1);
+        &mut self.models[k]
+    }
+}
+
+/// Symbols of a frequency table ([`IndexModel::Table`]); with more than 6 angle bits the
+/// last one is an escape followed by the value through a bit tree.
+const TABLE_SYMBOLS: u32 = 64;
+
+/// The adaptive code of one zigzagged swing index or residual (`bits` bits).
+#[derive(Clone, Debug)]
+enum IndexModel {
+    /// Bit by bit, each bit's probability moving a fixed fraction towards what it sees
+    /// (kinds 0 to 4).
+    Tree(BitTree),
+    /// One symbol of an adaptive frequency table (kinds 5 and 6): the value itself when it
+    /// is below `2^bits` ≤ 64, else values from 63 up as the escape symbol 63 followed by the
+    /// value through `escape`.
+    Table {
+        symbols: SymbolModel,
+        escape: BitTree,
+        escapes: bool,
+    },
+}
+
+impl IndexModel {
+    fn new(bits: u32, coding: IndexCoding) -> Self {
+        match coding {
+            IndexCoding::Scaled => {
+                let escapes = bits > TABLE_SYMBOLS.trailing_zeros();
+                let n = if escapes { TABLE_SYMBOLS } else { 1 << bits };
+                IndexModel::Table {
+                    symbols: SymbolModel::new(n as usize),
+                    escape: BitTree::new(if escapes { bits } else { 1 }),
+                    escapes,
+                }
+            }
+            _ => IndexModel::Tree(BitTree::new(bits)),
+        }
+    }
+
+    /// Codes `z` (below `2^bits` of the stream).
+    #[inline]
+    fn encode<S: BitSink>(&mut self, sink: &mut S, z: u32) {
+        match self {
+            IndexModel::Tree(tree) => sink.encode_tree(tree, z),
+            IndexModel::Table {
+                symbols,
+                escape,
+                escapes,
+            } => {
+                if *escapes && z >= TABLE_SYMBOLS - 1 {
+                    sink.encode_symbol(symbols, (TABLE_SYMBOLS - 1) as usize);
+                    sink.encode_tree(escape, z);
+                } else {
+                    sink.encode_symbol(symbols, z as usize);
+                }
+            }
+        }
+    }
+
+    /// Decodes a value coded by [`IndexModel::encode`] (below `2^bits`, whatever the input).
+    #[inline]
+    fn decode(&mut self, dec: &mut RangeDecoder<'_>) -> u32 {
+        match self {
+            IndexModel::Tree(tree) => dec.decode_tree(tree),
+            IndexModel::Table {
+                symbols,
+                escape,
+                escapes,
+            } => {
+                let s = dec.decode_symbol(symbols) as u32;
+                if *escapes && s == TABLE_SYMBOLS - 1 {
+                    dec.decode_tree(escape)
+                } else {
+                    s
+                }
+            }
+        }
     }
 }
 
@@ -445,11 +590,36 @@ fn atan_unit(z: f64) -> f64 {
 /// is taken; a zero or non-finite normal predicts 0. Encoder and decoder both call this
 /// on decoded data only (the walk), with the arithmetic spelled out.
 pub fn predict_swing(frame: &SwingFrame, normal: DVec3, table: &AngleTable) -> i32 {
+    // |θ| ≤ π/2: the index is within the range for every table (at least 3 bits).
+    (predicted_angle(frame, normal) * table.inverse_step()).round() as i32
+}
+
+/// How much farther than the fan normals say the surface is predicted to bend on
+/// ([`predict_swing_scaled`]; exactly representable, so `θ · 1.75` rounds the same
+/// everywhere).
+pub const PREDICTION_SCALE: f64 = 1.75;
+
+/// The prediction of kinds 5 and 6: [`predict_swing`]'s angle times [`PREDICTION_SCALE`],
+/// rounded and clamped into the index range. The fan normal averages the triangles already
+/// built around the gate, so the plane it describes lies between the parent's and the tip
+/// triangle's: the surface goes on bending by about twice the angle it shows. Measured
+/// (`swing_ctx`; 6 angle bits, L = 0.85 % of the diagonal): 1.5, 1.75 and 2 all save 2-5 %
+/// of the index bits over 1, 1.75 the most on average.
+pub fn predict_swing_scaled(frame: &SwingFrame, normal: DVec3, table: &AngleTable) -> i32 {
+    let q = (predicted_angle(frame, normal) * PREDICTION_SCALE * table.inverse_step()).round();
+    // |θ| · 1.75 ≤ 2.75 rad: within the i32 range; the clamp keeps it in the index range.
+    (q as i32).clamp(table.min_index(), table.max_index())
+}
+
+/// The angle `θ` in `[-π/2, π/2]` of the tip direction perpendicular to `normal` (0 when
+/// there is none), with the arithmetic of docs/format.md.
+#[inline]
+fn predicted_angle(frame: &SwingFrame, normal: DVec3) -> f64 {
     // Direction cos θ e1 + sin θ e2 ⟂ normal  <=>  (x, y) = (e2·n, -e1·n) ∥ (cos θ, sin θ).
     let mut x = dot(frame.e2, normal);
     let mut y = -dot(frame.e1, normal);
     if !(x.is_finite() && y.is_finite()) {
-        return 0;
+        return 0.0;
     }
     if x < 0.0 {
         x = -x;
@@ -458,15 +628,17 @@ pub fn predict_swing(frame: &SwingFrame, normal: DVec3, table: &AngleTable) -> i
     let ay = y.abs();
     let t = if ay <= x {
         if x == 0.0 {
-            return 0;
+            return 0.0;
         }
         atan_unit(ay / x)
     } else {
         std::f64::consts::FRAC_PI_2 - atan_unit(x / ay)
     };
-    let theta = if y < 0.0 { -t } else { t };
-    // |θ| ≤ π/2: the index is within the range for every table (at least 3 bits).
-    (theta * table.inverse_step()).round() as i32
+    if y < 0.0 {
+        -t
+    } else {
+        t
+    }
 }
 
 /// `x` wrapped into the index range of `bits` angle bits.
@@ -501,7 +673,7 @@ trait SwingIo {
     fn index(
         &mut self,
         v: VertexId,
-        tree: &mut BitTree,
+        model: &mut IndexModel,
         pred: i32,
         bits: u32,
         q: &mut i32,
@@ -528,7 +700,7 @@ impl SwingIo for SwingWriter<'_> {
     fn index(
         &mut self,
         v: VertexId,
-        tree: &mut BitTree,
+        model: &mut IndexModel,
         pred: i32,
         bits: u32,
         q: &mut i32,
@@ -537,7 +709,7 @@ impl SwingIo for SwingWriter<'_> {
             Some(&VertexSource::Swing(i)) => {
                 *q = i;
                 let mask = (1u32 << bits) - 1;
-                BitSink::encode_tree(self.sink, tree, zigzag(wrap_index(i - pred, bits)) & mask);
+                model.encode(self.sink, zigzag(wrap_index(i - pred, bits)) & mask);
                 Ok(())
             }
             _ => Err(Error::Corrupt(format!(
@@ -562,12 +734,12 @@ impl SwingIo for SwingReader<'_, '_> {
     fn index(
         &mut self,
         _v: VertexId,
-        tree: &mut BitTree,
+        model: &mut IndexModel,
         pred: i32,
         bits: u32,
         q: &mut i32,
     ) -> Result<(), Error> {
-        *q = wrap_index(pred + unzigzag(self.dec.decode_tree(tree)), bits);
+        *q = wrap_index(pred + unzigzag(model.decode(self.dec)), bits);
         Ok(())
     }
 }
@@ -576,28 +748,28 @@ impl SwingIo for SwingReader<'_, '_> {
 /// in creation order and the triangles in traversal order as `[tip, n(tip), p(tip)]` in
 /// creation indices, which is the output mesh of a closed connectivity (the traversal's
 /// vertex order is the output order), so neither needs a remapping pass afterwards. The same
-/// code runs in the encoder and the decoder. With `predict` (kinds 3 and 4) every swing
-/// index is coded as the residual of [`predict_swing`] from the normals of the triangles
-/// reconstructed so far.
+/// code runs in the encoder and the decoder. With prediction (kinds 3 to 6) every swing
+/// index is coded as the residual of [`predict_swing`] (or [`predict_swing_scaled`]) from the
+/// normals of the triangles reconstructed so far.
 fn walk<I: SwingIo>(
     conn: &Connectivity,
     params: &SwingParams,
     io: &mut I,
     positions: &mut Vec<DVec3>,
     triangles: &mut Vec<[u32; 3]>,
-    predict: bool,
+    coding: IndexCoding,
 ) -> Result<Vec<DVec3>, Error> {
     let table = &conn.table;
     let nv = table.vertex_count();
     let bits = params.quantizer.bits;
     let angle_bits = params.angles.bits();
-    let mut models = SwingModels::new(angle_bits, predict);
+    let mut models = SwingModels::new(angle_bits, coding);
     // Creation index of each table vertex (u32::MAX until created).
     let mut rank = vec![u32::MAX; nv];
     positions.clear();
     positions.reserve(nv);
     // Per created vertex: the sum of the cross products of its reconstructed triangles.
-    let mut fan = if predict {
+    let mut fan = if coding != IndexCoding::Order0 {
         vec![DVec3::ZERO; nv]
     } else {
         Vec::new()
@@ -658,15 +830,20 @@ fn walk<I: SwingIo>(
                         ));
                         return;
                     };
-                    let pred = if fan.is_empty() {
-                        0
-                    } else {
-                        let n = add(fan[ra as usize], fan[rb as usize]);
-                        predict_swing(&frame, n, &params.angles)
+                    let pred = match coding {
+                        IndexCoding::Order0 => 0,
+                        IndexCoding::Predicted => {
+                            let n = add(fan[ra as usize], fan[rb as usize]);
+                            predict_swing(&frame, n, &params.angles)
+                        }
+                        IndexCoding::Scaled => {
+                            let n = add(fan[ra as usize], fan[rb as usize]);
+                            predict_swing_scaled(&frame, n, &params.angles)
+                        }
                     };
                     let mut q = 0i32;
-                    let tree = models.tree(pred);
-                    if let Err(e) = io.index(v, tree, pred, angle_bits, &mut q) {
+                    let model = models.model(pred);
+                    if let Err(e) = io.index(v, model, pred, angle_bits, &mut q) {
                         failure = Some(e);
                         return;
                     }
@@ -750,6 +927,272 @@ pub fn encode_retiled(
     params: &SwingParams,
     info: &SwingStreamInfo<'_>,
 ) -> Result<SwingEncoded, Error> {
+    if let Some(enc) = encode_forward(retiled, params, info)? {
+        return Ok(enc);
+    }
+    encode_retiled_as(retiled, params, info, IndexCoding::Scaled)
+}
+
+/// The writer of kinds 7 and 8: labels, S tips, seeds and indices from the retiled mesh.
+struct FrontWriter<'a> {
+    inner: SwingWriter<'a>,
+    labels: &'a [Clers],
+    next_label: usize,
+    triangles: &'a [[u32; 3]],
+    /// Directed edge -> triangle of the whole retiled mesh, built at the first S.
+    edges: Option<std::collections::HashMap<u64, u32>>,
+    /// What the labels and S tips cost, in 1/`COST_ONE` bits.
+    connectivity_cost: u64,
+}
+
+impl SwingIo for FrontWriter<'_> {
+    fn seed(&mut self, v: VertexId, bits: u32, grid: &mut [i32; 3]) {
+        self.inner.seed(v, bits, grid)
+    }
+    fn index(
+        &mut self,
+        v: VertexId,
+        model: &mut IndexModel,
+        pred: i32,
+        bits: u32,
+        q: &mut i32,
+    ) -> Result<(), Error> {
+        self.inner.index(v, model, pred, bits, q)
+    }
+}
+
+impl front::FrontIo for FrontWriter<'_> {
+    fn label(&mut self, tables: &mut whet_bits::SymbolTables, ctx: usize) -> Result<Clers, Error> {
+        let label = *self.labels.get(self.next_label).ok_or_else(|| {
+            Error::Corrupt("the walk needs more labels than the retiler made".into())
+        })?;
+        self.next_label += 1;
+        self.connectivity_cost += tables.cost(ctx, label as usize) as u64;
+        tables.encode(self.inner.sink, ctx, label as usize);
+        Ok(label)
+    }
+
+    fn split_target(
+        &mut self,
+        front: &front::Front,
+        models: &mut front::SplitModels,
+        candidates: &mut [front::Candidate],
+        triangle: usize,
+        vertices: usize,
+    ) -> Result<u32, Error> {
+        let mismatch = || Error::Corrupt("the walk's S does not match the retiled mesh".into());
+        let [w, a, _] = *self.triangles.get(triangle).ok_or_else(mismatch)?;
+        let triangles = self.triangles;
+        let edges = self.edges.get_or_insert_with(|| {
+            let mut m = std::collections::HashMap::with_capacity(3 * triangles.len());
+            for (i, t) in triangles.iter().enumerate() {
+                for k in 0..3 {
+                    m.insert(((t[k] as u64) << 32) | t[(k + 1) % 3] as u64, i as u32);
+                }
+            }
+            m
+        });
+        // The tip's node is the one whose loop edge w -> x the S cut off from its wedge: turn
+        // around w from the S triangle across its edge to a, through the triangles built after
+        // it, to the first one built before it; the edge crossed last is w -> x.
+        let mut from = a;
+        let mut x = None;
+        for _ in 0..256 {
+            let &t = edges
+                .get(&(((from as u64) << 32) | w as u64))
+                .ok_or_else(mismatch)?;
+            if (t as usize) < triangle {
+                x = Some(from);
+                break;
+            }
+            let tri = triangles[t as usize];
+            let k = tri.iter().position(|&u| u == w).ok_or_else(mismatch)?;
+            from = tri[(k + 1) % 3];
+        }
+        let node = front
+            .node_towards(w, x.ok_or_else(mismatch)?)
+            .ok_or_else(mismatch)?;
+        let sink = &mut *self.inner.sink;
+        if let Some(me) = candidates.iter().find(|c| c.2 == node).copied() {
+            let rank = candidates
+                .iter()
+                .filter(|c| front::candidate_order(c, &me).is_lt())
+                .count();
+            self.connectivity_cost += models.rank.cost(rank as u32) as u64;
+            models.rank.encode(sink, rank as u32);
+        } else {
+            // A tip on another loop (a handle closes): the vertex, then which of its nodes.
+            let escape = candidates.len() as u32;
+            let which = front
+                .live_nodes(w)
+                .iter()
+                .position(|&m| m == node)
+                .ok_or_else(mismatch)? as u32;
+            let bits = front::vertex_bits(vertices);
+            self.connectivity_cost += (models.rank.cost(escape)
+                + models.which.cost(which)
+                + bits * whet_bits::COST_ONE) as u64;
+            models.rank.encode(sink, escape);
+            sink.encode_direct(w, bits);
+            models.which.encode(sink, which);
+        }
+        Ok(node)
+    }
+}
+
+/// The reader of kinds 7 and 8.
+struct FrontReader<'a, 'b> {
+    inner: SwingReader<'a, 'b>,
+}
+
+impl SwingIo for FrontReader<'_, '_> {
+    fn seed(&mut self, v: VertexId, bits: u32, grid: &mut [i32; 3]) {
+        self.inner.seed(v, bits, grid)
+    }
+    fn index(
+        &mut self,
+        v: VertexId,
+        model: &mut IndexModel,
+        pred: i32,
+        bits: u32,
+        q: &mut i32,
+    ) -> Result<(), Error> {
+        self.inner.index(v, model, pred, bits, q)
+    }
+}
+
+impl front::FrontIo for FrontReader<'_, '_> {
+    fn label(&mut self, tables: &mut whet_bits::SymbolTables, ctx: usize) -> Result<Clers, Error> {
+        let s = tables.decode(self.inner.dec, ctx);
+        Clers::from_index(s).ok_or_else(|| Error::Corrupt("a label out of range".into()))
+    }
+
+    fn split_target(
+        &mut self,
+        front: &front::Front,
+        models: &mut front::SplitModels,
+        candidates: &mut [front::Candidate],
+        _triangle: usize,
+        vertices: usize,
+    ) -> Result<u32, Error> {
+        let dec = &mut *self.inner.dec;
+        let rank = models.rank.decode(dec) as usize;
+        if rank < candidates.len() {
+            let (_, nth, _) = candidates.select_nth_unstable_by(rank, front::candidate_order);
+            return Ok(nth.2);
+        }
+        if rank > candidates.len() {
+            return Err(Error::Corrupt("an S tip rank past its loop".into()));
+        }
+        let w = dec.decode_direct(front::vertex_bits(vertices));
+        let which = models.which.decode(dec) as usize;
+        if w as usize >= vertices {
+            return Err(Error::Corrupt("an S tip vertex not yet created".into()));
+        }
+        front
+            .live_nodes(w)
+            .get(which)
+            .copied()
+            .ok_or_else(|| Error::Corrupt("an S tip vertex without that front node".into()))
+    }
+}
+
+/// Kinds 7 and 8, or `None` when the forward walk does not reproduce the retiled mesh (a
+/// retiler state the walk does not mirror; the caller writes kinds 5 and 6 instead).
+fn encode_forward(
+    retiled: &RetiledMesh,
+    params: &SwingParams,
+    info: &SwingStreamInfo<'_>,
+) -> Result<Option<SwingEncoded>, Error> {
+    let n = retiled.triangles.len();
+    let cutting = retiled.deleted.iter().any(|&d| d);
+    if cutting && retiled.deleted.len() != n {
+        return Err(Error::Parameter(
+            "one deletion flag per retiled triangle is needed".into(),
+        ));
+    }
+    if retiled.components == 0 || n == 0 || retiled.positions.len() > u32::MAX as usize / 2 {
+        return Ok(None);
+    }
+    let mut range = RangeEncoder::new();
+    let mut io = FrontWriter {
+        inner: SwingWriter {
+            sink: &mut range,
+            sources: &retiled.sources,
+            bad_seed: false,
+        },
+        labels: &retiled.labels,
+        next_label: 0,
+        triangles: &retiled.triangles,
+        edges: None,
+        connectivity_cost: 0,
+    };
+    let Ok(walked) = front::front_walk(&mut io, params, retiled.components, n, n) else {
+        return Ok(None);
+    };
+    let same_positions = walked.positions.len() == retiled.positions.len()
+        && walked
+            .positions
+            .iter()
+            .zip(&retiled.positions)
+            .all(|(p, r)| p.to_array().map(f64::to_bits) == r.to_array().map(f64::to_bits));
+    if io.inner.bad_seed
+        || io.next_label != retiled.labels.len()
+        || walked.triangles != retiled.triangles
+        || !same_positions
+    {
+        return Ok(None);
+    }
+    let connectivity_cost = io.connectivity_cost;
+    let mut mesh = Mesh::new(walked.positions, walked.triangles);
+    if cutting {
+        code_cut_flags(&mut range, &retiled.deleted);
+        mesh = cut(mesh, &retiled.deleted);
+        info.filter.apply(&mut mesh);
+    } else {
+        info.filter.apply_closed(&mut mesh, walked.fan);
+    }
+    let mut geometry = vec![if cutting {
+        KIND_SWING_FORWARD_CUT
+    } else {
+        KIND_SWING_FORWARD
+    }];
+    geometry.extend_from_slice(&range.finish());
+    let mut connectivity = Vec::new();
+    whet_format::write_varint(&mut connectivity, n as u64);
+    let mut clers_histogram = [0usize; 5];
+    for &l in &retiled.labels {
+        clers_histogram[l as usize] += 1;
+    }
+    // One range-coded stream holds labels and geometry: the labels' share is priced.
+    let connectivity_bits =
+        connectivity.len() as u64 * 8 + connectivity_cost.div_ceil(whet_bits::COST_ONE as u64);
+    let geometry_bits = (geometry.len() as u64 * 8).saturating_sub(connectivity_bits);
+    write_stream(
+        mesh,
+        connectivity,
+        geometry,
+        StreamReport {
+            components: retiled.components,
+            clers_histogram,
+            connectivity_bits,
+            geometry_bits,
+        },
+        params,
+        info,
+        SwingGeometry::Swing,
+    )
+    .map(Some)
+}
+
+/// [`encode_retiled`] with the swing indices coded by `coding` (the tests write the older
+/// kinds with it, which decoders keep reading).
+fn encode_retiled_as(
+    retiled: &RetiledMesh,
+    params: &SwingParams,
+    info: &SwingStreamInfo<'_>,
+    coding: IndexCoding,
+) -> Result<SwingEncoded, Error> {
     let nv = retiled.positions.len();
     let cutting = retiled.deleted.iter().any(|&d| d);
     if cutting && retiled.deleted.len() != retiled.triangles.len() {
@@ -789,7 +1232,7 @@ pub fn encode_retiled(
             sources: &retiled.sources,
             bad_seed: false,
         };
-        let walked = walk(conn, params, &mut io, &mut positions, &mut tris, true);
+        let walked = walk(conn, params, &mut io, &mut positions, &mut tris, coding);
         // The traversal's vertex order is the retiler's (checked above), so creation order
         // is the retiled mesh's own order.
         let exact = walked.is_ok()
@@ -806,14 +1249,12 @@ pub fn encode_retiled(
                 code_cut_flags(&mut range, &retiled.deleted);
                 mesh = cut(mesh, &retiled.deleted);
                 info.filter.apply(&mut mesh);
-            } else if let Ok(fan) = walked {
+            } else if let (Ok(fan), true) = (walked, coding != IndexCoding::Order0) {
                 info.filter.apply_closed(&mut mesh, fan);
-            }
-            geometry.push(if cutting {
-                KIND_SWING_PRED_CUT
             } else {
-                KIND_SWING_PRED
-            });
+                info.filter.apply(&mut mesh);
+            }
+            geometry.push(coding.kind(cutting));
             geometry.extend_from_slice(&range.finish());
             decoded = Some(mesh);
         } else {
@@ -843,9 +1284,42 @@ pub fn encode_retiled(
         decoded = Some(mesh);
     }
     let decoded = decoded.unwrap_or_default();
-    let clers_histogram = enc.histogram();
-    let components = enc.connectivity.starts.len();
+    let report = StreamReport {
+        components: enc.connectivity.starts.len(),
+        clers_histogram: enc.histogram(),
+        connectivity_bits: enc.bytes.len() as u64 * 8,
+        geometry_bits: geometry.len() as u64 * 8,
+    };
+    write_stream(
+        decoded,
+        enc.bytes,
+        geometry,
+        report,
+        params,
+        info,
+        geometry_kind,
+    )
+}
 
+/// Counts for [`EncodeReport`] that depend on how the connectivity was coded.
+struct StreamReport {
+    components: usize,
+    clers_histogram: [usize; 5],
+    connectivity_bits: u64,
+    geometry_bits: u64,
+}
+
+/// The container around a swing stream's two sections, and the encoder's report.
+fn write_stream(
+    decoded: Mesh,
+    connectivity: Vec<u8>,
+    geometry: Vec<u8>,
+    counts: StreamReport,
+    params: &SwingParams,
+    info: &SwingStreamInfo<'_>,
+    geometry_kind: SwingGeometry,
+) -> Result<SwingEncoded, Error> {
+    let components = counts.components;
     let (min, max) = (params.bbox.min.to_array(), params.bbox.max.to_array());
     let mut header = Header::new(
         Mode::Swing,
@@ -857,6 +1331,11 @@ pub fn encode_retiled(
     .with(tag::QUANT_BITS, params.quantizer.bits as u64)
     .with(tag::EDGE_LENGTH, params.edge_length)
     .with(tag::ANGLE_BITS, params.angles.bits() as u64);
+    if geometry.first().is_some_and(|&k| k >= KIND_SWING_SCALED) && header.version < VERSION_1_2 {
+        // Geometry kinds 5 and 6 are format 1.2 (docs/format.md section 6): older readers
+        // refuse them by kind.
+        header = header.with_version(VERSION_1_2);
+    }
     if !info.filter.is_none() {
         // The filter fields are format 1.1 (docs/format.md section 6): a 1.0 reader refuses
         // them as unknown required tags.
@@ -868,20 +1347,18 @@ pub fn encode_retiled(
             .with(tag::FILTER_SMOOTHED, info.filter.smoothed);
     }
     header.set_bbox(min, max);
-    let connectivity_bits = enc.bytes.len() as u64 * 8;
-    let geometry_bits = geometry.len() as u64 * 8;
     let container = Container::new(header)
-        .with_section(SectionKind::CONNECTIVITY, enc.bytes)
+        .with_section(SectionKind::CONNECTIVITY, connectivity)
         .with_section(SectionKind::GEOMETRY, geometry);
     let bytes = container.to_bytes()?;
     let report = EncodeReport {
         bytes: bytes.len(),
         vertices: decoded.positions.len(),
         triangles: decoded.triangles.len(),
-        connectivity_bits,
-        geometry_bits,
+        connectivity_bits: counts.connectivity_bits,
+        geometry_bits: counts.geometry_bits,
         components,
-        clers_histogram,
+        clers_histogram: counts.clers_histogram,
         vertex_order: Vec::new(),
         repair: *info.repair,
         dropped_unused_vertices: info.dropped_unused_vertices,
@@ -1033,6 +1510,17 @@ pub(crate) fn decode_swing(
     let geom = container
         .section(SectionKind::GEOMETRY)
         .ok_or(Error::MissingSection("geometry"))?;
+    if let Some(&kind @ (KIND_SWING_FORWARD | KIND_SWING_FORWARD_CUT)) = geom.first() {
+        return decode_forward(
+            conn_bytes,
+            &geom[1..],
+            kind == KIND_SWING_FORWARD_CUT,
+            &params,
+            components,
+            filter,
+            opts,
+        );
+    }
     // The connectivity may hold more triangles than the output (dummy fans of the explicit
     // kind, triangles deleted over holes): bounded by the caller's face limit.
     let conn_limits = ConnectivityLimits::DEFAULT.with_max_triangles(limits.max_faces);
@@ -1051,8 +1539,8 @@ pub(crate) fn decode_swing(
     let (&kind, payload) = geom.split_first().ok_or(Error::Truncated("geometry"))?;
     let nv = conn.table.vertex_count();
     let mut dec = RangeDecoder::new(payload).map_err(|_| Error::Truncated("geometry"))?;
-    match kind {
-        KIND_SWING | KIND_SWING_CUT | KIND_SWING_PRED | KIND_SWING_PRED_CUT => {
+    match (kind, IndexCoding::of_kind(kind)) {
+        (_, Some((coding, cutting))) => {
             if conn.is_dummy.iter().any(|&d| d) {
                 return Err(Error::Corrupt(
                     "swing geometry on an open connectivity".into(),
@@ -1064,9 +1552,8 @@ pub(crate) fn decode_swing(
                 dec: &mut dec,
                 max_level: params.quantizer.max_level(),
             };
-            let predict = kind == KIND_SWING_PRED || kind == KIND_SWING_PRED_CUT;
-            let fan = walk(&conn, &params, &mut io, &mut positions, &mut tris, predict)?;
-            let flags = if kind == KIND_SWING_CUT || kind == KIND_SWING_PRED_CUT {
+            let fan = walk(&conn, &params, &mut io, &mut positions, &mut tris, coding)?;
+            let flags = if cutting {
                 decode_cut_flags(&mut dec, tris.len())
             } else {
                 Vec::new()
@@ -1086,7 +1573,7 @@ pub(crate) fn decode_swing(
             if opts.surface_filter {
                 // As the encoder does: the walk's fan sums on a closed (uncut) predicted
                 // mesh, else the filter's own normals.
-                if kind == KIND_SWING_PRED {
+                if !cutting && coding != IndexCoding::Order0 {
                     filter.apply_closed(&mut mesh, fan);
                 } else {
                     filter.apply(&mut mesh);
@@ -1094,7 +1581,7 @@ pub(crate) fn decode_swing(
             }
             Ok(mesh)
         }
-        KIND_EXPLICIT => {
+        (KIND_EXPLICIT, None) => {
             let mut q = vec![[0i32; 3]; nv];
             let mut io = ResidualReader {
                 dec: &mut dec,
@@ -1124,10 +1611,78 @@ pub(crate) fn decode_swing(
             }
             Ok(mesh)
         }
-        other => Err(Error::Corrupt(format!(
-            "unknown swing geometry kind {other}"
+        (other, None) => Err(Error::Corrupt(format!(
+            "unknown swing geometry kind {other} (this whet reads kinds 0 to {KIND_SWING_FORWARD_CUT}; \
+             a newer whet may have written it)"
         ))),
     }
+}
+
+/// Decodes geometry kinds 7 (`cutting` false) and 8: the triangle count from the
+/// connectivity section, then the forward walk over the geometry payload.
+fn decode_forward(
+    conn_bytes: &[u8],
+    payload: &[u8],
+    cutting: bool,
+    params: &SwingParams,
+    components: u64,
+    filter: SurfaceFilter,
+    opts: &crate::DecodeOptions,
+) -> Result<Mesh, Error> {
+    let mut pos = 0;
+    let n = whet_format::read_varint(conn_bytes, &mut pos)?;
+    if pos != conn_bytes.len() {
+        return Err(Error::Corrupt(
+            "connectivity section has trailing bytes".into(),
+        ));
+    }
+    // The walk may hold more triangles than the output (those deleted over holes): bounded
+    // by the caller's face limit.
+    let max = opts.limits.max_faces;
+    if n > max {
+        return Err(whet_format::Error::LimitExceeded {
+            what: "swing triangle count",
+            limit: max,
+            value: n,
+        }
+        .into());
+    }
+    // Every component has at least two triangles (a pillow: the seed and its back face).
+    if components == 0 || components.saturating_mul(2) > n {
+        return Err(Error::Corrupt(format!(
+            "{components} components cannot hold {n} triangles"
+        )));
+    }
+    let mut dec = RangeDecoder::new(payload).map_err(|_| Error::Truncated("geometry"))?;
+    let mut io = FrontReader {
+        inner: SwingReader {
+            dec: &mut dec,
+            max_level: params.quantizer.max_level(),
+        },
+    };
+    // A retiled triangle costs about a bit and a half; 64 per byte is far beyond any stream.
+    let capacity = payload.len().saturating_mul(64).saturating_add(1024);
+    let walked = front::front_walk(&mut io, params, components as usize, n as usize, capacity)?;
+    let flags = if cutting {
+        decode_cut_flags(&mut dec, walked.triangles.len())
+    } else {
+        Vec::new()
+    };
+    if dec.finish().is_err() {
+        return Err(Error::Truncated("geometry"));
+    }
+    if walked.positions.iter().any(|p| !p.is_finite()) {
+        return Err(Error::Corrupt("a decoded position is not finite".into()));
+    }
+    let mut mesh = cut(Mesh::new(walked.positions, walked.triangles), &flags);
+    if opts.surface_filter {
+        if cutting {
+            filter.apply(&mut mesh);
+        } else {
+            filter.apply_closed(&mut mesh, walked.fan);
+        }
+    }
+    Ok(mesh)
 }
 
 #[cfg(test)]
@@ -1239,9 +1794,16 @@ mod tests {
         .unwrap();
         assert_eq!(raw.positions, retiled.positions);
         let header = crate::peek_header(&enc.bytes).unwrap();
-        assert_eq!(header.version, Version::new(1, 1));
-        // Without a filter the stream stays 1.0 and has no filter field.
-        let plain = encode_retiled(&retiled, &params, &info()).unwrap();
+        assert_eq!(header.version, VERSION_1_2);
+        // Geometry kind 3 with a filter is format 1.1; without a filter it stays 1.0 and
+        // has no filter field.
+        let kind3 =
+            encode_retiled_as(&retiled, &params, &with_filter, IndexCoding::Predicted).unwrap();
+        assert_eq!(
+            crate::peek_header(&kind3.bytes).unwrap().version,
+            Version::new(1, 1)
+        );
+        let plain = encode_retiled_as(&retiled, &params, &info(), IndexCoding::Predicted).unwrap();
         assert_eq!(
             crate::peek_header(&plain.bytes).unwrap().version,
             Version::CURRENT
@@ -1274,6 +1836,120 @@ mod tests {
         let back = crate::decode(&enc.bytes, &crate::DecodeOptions::DEFAULT).unwrap();
         assert_eq!(back.triangles.len(), 3);
         assert_eq!(back, enc.decoded);
+    }
+
+    /// The geometry kind byte of a swing stream.
+    fn kind_of(bytes: &[u8]) -> u8 {
+        let c = whet_format::parse(bytes, &crate::Limits::DEFAULT).unwrap();
+        c.section(SectionKind::GEOMETRY).unwrap()[0]
+    }
+
+    #[test]
+    fn every_index_coding_round_trips_with_and_without_deletions() {
+        // Folds from flat to past a right angle, both ways; 3 bits (the prediction's
+        // clamp), 6 (tables without escape) and 9 (tables with escapes).
+        let filter = SurfaceFilter::from_factors(0.25, 0.125);
+        for bits in [3, 6, 9] {
+            for q in [-20, -5, 0, 3, 17] {
+                let (mut retiled, mut params) = tetrahedron(q);
+                params = SwingParams::new(1.0, bits, &params.bbox, 16).unwrap();
+                let q = q.clamp(params.angles.min_index(), params.angles.max_index());
+                let frame = params
+                    .frame(
+                        retiled.positions[0],
+                        retiled.positions[2],
+                        retiled.positions[1],
+                    )
+                    .unwrap();
+                retiled.positions[3] = frame.tip(&params.angles, q);
+                retiled.sources[3] = VertexSource::Swing(q);
+                for deleted in [vec![], vec![false, false, true, false]] {
+                    retiled.deleted = deleted;
+                    let cutting = !retiled.deleted.is_empty();
+                    for coding in [
+                        IndexCoding::Order0,
+                        IndexCoding::Predicted,
+                        IndexCoding::Scaled,
+                    ] {
+                        let info = SwingStreamInfo { filter, ..info() };
+                        let enc = encode_retiled_as(&retiled, &params, &info, coding).unwrap();
+                        assert_eq!(enc.geometry, SwingGeometry::Swing);
+                        assert_eq!(kind_of(&enc.bytes), coding.kind(cutting));
+                        assert_eq!(
+                            IndexCoding::of_kind(coding.kind(cutting)),
+                            Some((coding, cutting))
+                        );
+                        let back =
+                            crate::decode(&enc.bytes, &crate::DecodeOptions::DEFAULT).unwrap();
+                        assert_eq!(back, enc.decoded, "bits {bits} q {q} {coding:?}");
+                        let raw = crate::decode(
+                            &enc.bytes,
+                            &crate::DecodeOptions::DEFAULT.with_surface_filter(false),
+                        )
+                        .unwrap();
+                        if !cutting {
+                            assert_eq!(raw.positions, retiled.positions);
+                        }
+                    }
+                    // What the encoder writes: kind 7, or 8 with deletions.
+                    let info = SwingStreamInfo { filter, ..info() };
+                    let enc = encode_retiled(&retiled, &params, &info).unwrap();
+                    let expected = if cutting {
+                        KIND_SWING_FORWARD_CUT
+                    } else {
+                        KIND_SWING_FORWARD
+                    };
+                    assert_eq!(kind_of(&enc.bytes), expected, "bits {bits} q {q}");
+                    let back = crate::decode(&enc.bytes, &crate::DecodeOptions::DEFAULT).unwrap();
+                    assert_eq!(back, enc.decoded, "bits {bits} q {q} forward");
+                    let mut unfiltered =
+                        Mesh::new(retiled.positions.clone(), retiled.triangles.clone());
+                    if cutting {
+                        unfiltered = cut(unfiltered, &retiled.deleted);
+                    }
+                    let raw = crate::decode(
+                        &enc.bytes,
+                        &crate::DecodeOptions::DEFAULT.with_surface_filter(false),
+                    )
+                    .unwrap();
+                    assert_eq!(raw, unfiltered);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_scaled_prediction_stays_in_the_index_range() {
+        // A normal lying in the parent's plane, pointing away from the gate: the tip is
+        // predicted to fold a right angle, which 1.75 times takes past the range of 3 bits.
+        let a = DVec3::new(0.0, 0.0, 0.0);
+        let b = DVec3::new(1.0, 0.0, 0.0);
+        let c = DVec3::new(0.5, -0.8, 0.0);
+        let f = SwingFrame::new(a, b, c, 1.0).unwrap();
+        for bits in MIN_ANGLE_BITS..=MAX_ANGLE_BITS {
+            let t = AngleTable::new(bits).unwrap();
+            for n in [
+                DVec3::Y,
+                -DVec3::Y,
+                DVec3::new(0.0, 1.0, 1.0),
+                DVec3::Z,
+                DVec3::ZERO,
+            ] {
+                let p = predict_swing_scaled(&f, n, &t);
+                assert!(
+                    p >= t.min_index() && p <= t.max_index(),
+                    "bits {bits} {n:?}: {p}"
+                );
+                let plain = predict_swing(&f, n, &t);
+                // Same sign and at least as far as the plain prediction, within the range.
+                assert!(p.signum() == plain.signum() && p.abs() >= plain.abs().min(t.max_index()));
+            }
+        }
+        // 45 degrees of fold predict 78.75 degrees.
+        let t = AngleTable::new(8).unwrap();
+        let n = DVec3::new(0.0, -1.0, 1.0);
+        assert_eq!(predict_swing(&f, n, &t), 32);
+        assert_eq!(predict_swing_scaled(&f, n, &t), 56);
     }
 
     #[test]

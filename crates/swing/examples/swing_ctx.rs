@@ -118,6 +118,39 @@ fn main() {
         // What the stream codes (kinds 3 and 4): the residual, one tree per bucket of the
         // prediction.
         let shipped = run(&|r| (bl(zz(r.3)).min(7), r.3), 8);
+        // Count-based alternative: one 64-symbol frequency model per bucket, escape at 63.
+        let inv = 1.0 / params.angles.step();
+        let freq_models =
+            |nctx: usize, ctxf: &dyn Fn(usize) -> usize, predf: &dyn Fn(usize) -> i32| {
+                let mut ms: Vec<whet_bits::SymbolModel> =
+                    (0..nctx).map(|_| whet_bits::SymbolModel::new(64)).collect();
+                let mut esc = BitTree::new(bits);
+                let mut c = CostCounter::new();
+                let half = 1i32 << (bits - 1);
+                for (i, row) in rows.iter().enumerate() {
+                    let p = predf(i);
+                    let d = ((row.0 - p + half).rem_euclid(1 << bits)) - half;
+                    let z = zz(d) & ((1u32 << bits) - 1);
+                    let m = &mut ms[ctxf(i)];
+                    if z < 63 {
+                        c.encode_symbol(m, z as usize);
+                    } else {
+                        c.encode_symbol(m, 63);
+                        c.encode_tree(&mut esc, z);
+                    }
+                }
+                c.bits() / n
+            };
+        let freq8 = freq_models(8, &|i| bl(zz(rows[i].3)).min(7), &|i| rows[i].3);
+        let freq1 = freq_models(1, &|_| 0, &|i| rows[i].3);
+        print!("{name}: bit trees {shipped:.3}  frequency models per bucket {freq8:.3}  one frequency model {freq1:.3}");
+        let half = 1i32 << (bits - 1);
+        for lam in [1.5, 1.75, 2.0] {
+            let sp = |i: usize| ((lam * pred_theta[i] * inv).round() as i32).clamp(-half, half - 1);
+            let f = freq_models(8, &|i| bl(zz(sp(i))).min(7), &sp);
+            print!("  scaled x{lam} {f:.3}");
+        }
+        println!();
         let avg = run(
             &|r| {
                 let p = match (r.1, r.4) {
@@ -140,7 +173,6 @@ fn main() {
         );
         // Scaled predictions: the fan normal lags behind the tip (it averages the built
         // side), so the surface bends on by more than the angle it predicts.
-        let inv = 1.0 / params.angles.step();
         for lam in [1.0, 1.25, 1.5, 1.75, 2.0] {
             let mut trees: Vec<BitTree> = (0..8).map(|_| BitTree::new(bits)).collect();
             let mut c = CostCounter::new();

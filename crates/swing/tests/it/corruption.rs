@@ -63,8 +63,14 @@ fn damaged_geometry_never_panics() {
             "geometry cut to {n}"
         );
     }
-    // An unknown geometry kind.
-    assert!(decode(&with_geometry(&good, |g| g[0] = 7), &DecodeOptions::DEFAULT).is_err());
+    // An unknown geometry kind, and the payload read as another kind.
+    for kind in [5, 6, 9, 255] {
+        let err = decode(
+            &with_geometry(&good, |g| g[0] = kind),
+            &DecodeOptions::DEFAULT,
+        );
+        assert!(err.is_err(), "kind {kind}");
+    }
 }
 
 #[test]

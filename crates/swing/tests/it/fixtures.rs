@@ -27,6 +27,8 @@ fn small_fixtures_round_trip_at_a_coarse_length() {
         ("cube.off", 0.05, Some(0)),
         ("screwdriver.off", 0.03, None),
         ("sledge.off", 0.04, None),
+        // Four handles: the forward walk's S tips on other loops (its escape code).
+        ("fertility.off", 0.02, Some(4)),
     ] {
         let out = round_trip(&load(name), fraction);
         assert_swing(&out);
@@ -69,7 +71,8 @@ fn every_fixture_retiles_regularly() {
 /// makes the retiling markedly more regular and its connectivity cheaper, at an unchanged
 /// error per byte. Measured by this test on spot at L = 2 %: valence 6 0.887 with the
 /// bias, 0.773 without; C+R 0.976 vs 0.956; 0.351 vs 0.578 connectivity bits per
-/// triangle. The tolerances leave room for retiler changes that keep the effect.
+/// triangle with the Edgebreaker kinds, 0.247 vs 0.300 with the forward kinds (7 and 8).
+/// The tolerances leave room for retiler changes that keep the effect.
 #[test]
 fn valence_bias_makes_the_retiling_regular_and_cheaper() {
     use whet_swing::{Rate, RetileTuning, SwingOptions};
@@ -90,8 +93,10 @@ fn valence_bias_makes_the_retiling_regular_and_cheaper() {
     eprintln!("no bias: C+R {cr0:.3} v6 {v0:.3} {bpt0:.3} bpt; bias: {cr:.3} {v:.3} {bpt:.3}");
     assert!(v >= 0.85 && v >= v0 + 0.05, "valence 6: {v} vs {v0}");
     assert!(cr >= 0.95 && cr >= cr0, "C+R: {cr} vs {cr0}");
+    // The forward kinds code the labels in the context of the geometry, which takes much
+    // of the irregular retiling's cost away too (0.247 against 0.300 bits per triangle).
     assert!(
-        bpt <= 0.4 && bpt <= 0.7 * bpt0,
+        bpt <= 0.3 && bpt <= 0.9 * bpt0,
         "bits per triangle: {bpt} vs {bpt0}"
     );
 }

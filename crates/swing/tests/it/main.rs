@@ -33,6 +33,15 @@ pub fn round_trip(mesh: &Mesh, fraction: f64) -> SwingOutput {
 /// [`round_trip`] with options.
 pub fn round_trip_with(mesh: &Mesh, opts: &SwingOptions) -> SwingOutput {
     let out = encode(mesh, opts).unwrap();
+    if out.geometry == SwingGeometry::Swing {
+        // The forward kinds (docs/format.md: 7, or 8 with deletions): the connectivity is
+        // coded inside the walk; the Edgebreaker kinds are only a fallback.
+        assert!(
+            matches!(geometry_kind(&out.bytes), 7 | 8),
+            "kind {}",
+            geometry_kind(&out.bytes)
+        );
+    }
     let back = decode(&out.bytes, &DecodeOptions::DEFAULT).unwrap();
     assert_eq!(back.triangles, out.retiled.triangles);
     assert_eq!(bits(&back), bits(&out.retiled));
@@ -40,6 +49,12 @@ pub fn round_trip_with(mesh: &Mesh, opts: &SwingOptions) -> SwingOutput {
     assert!(report.manifold && report.oriented, "{report:?}");
     assert!(back.validate().is_ok());
     out
+}
+
+/// The geometry kind of a swing stream (the first byte of its geometry section).
+pub fn geometry_kind(bytes: &[u8]) -> u8 {
+    let c = whet_format::parse(bytes, &whet_format::Limits::DEFAULT).unwrap();
+    c.section(whet_format::SectionKind::GEOMETRY).unwrap()[0]
 }
 
 /// Asserts the swing geometry (not the explicit fallback) was used.
