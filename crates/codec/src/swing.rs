@@ -1647,6 +1647,15 @@ fn decode_forward(
         }
         .into());
     }
+    // Vertex and node ids are u32: a caller's raised face limit cannot take them past it.
+    if n > u64::from(u32::MAX / 4) {
+        return Err(whet_format::Error::LimitExceeded {
+            what: "swing triangle count (32-bit indices)",
+            limit: u64::from(u32::MAX / 4),
+            value: n,
+        }
+        .into());
+    }
     // Every component has at least two triangles (a pillow: the seed and its back face).
     if components == 0 || components.saturating_mul(2) > n {
         return Err(Error::Corrupt(format!(

@@ -277,7 +277,7 @@ pub(super) fn front_walk<I: FrontIo>(
     // Loop steps spent listing S candidates: bounded, so that a hostile stream cannot make
     // the walk quadratic.
     let mut split_work: usize = 0;
-    let split_budget = 64 * triangles + (1 << 20);
+    let split_budget = triangles.saturating_mul(64).saturating_add(1 << 20);
     // Adds triangle `t`; a triangle repeating a vertex (only a corrupt stream makes one:
     // the retiler's front never meets itself that way) is an error.
     let add_triangle = |t: [u32; 3],

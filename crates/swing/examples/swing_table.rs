@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! cargo run --release -p whet-swing --example swing_table -- [--bpv R | --fraction F | --bytes N]
-//!     [--angle-bits B] [--samples S] [--valence-bias DEG] mesh.off...
+//!     [--angle-bits B] [--samples S] [--valence-bias DEG] [--no-surface-filter] mesh.off...
 //! ```
 //! Mesh names without a slash are looked up in the shared fixtures.
 #![allow(clippy::unwrap_used)] // a measurement tool: a failure is a crash with a message
@@ -16,6 +16,7 @@ fn main() {
     let mut args = std::env::args().skip(1);
     let mut rate = Rate::BitsPerVertex(0.8);
     let mut bits = SwingOptions::DEFAULT_ANGLE_BITS;
+    let mut filter = true;
     let mut samples = 1_000_000usize;
     let mut meshes = Vec::new();
     let mut tuning = whet_swing::RetileTuning::DEFAULT;
@@ -39,6 +40,7 @@ fn main() {
                     .with_valence_bias(args.next().unwrap().parse::<f64>().unwrap().to_radians())
             }
             "--snap" => tuning = tuning.with_snap(args.next().unwrap().parse().unwrap()),
+            "--no-surface-filter" => filter = false,
             m => meshes.push(m.to_string()),
         }
     }
@@ -57,6 +59,7 @@ fn main() {
             .with_rate(rate)
             .with_angle_bits(bits)
             .with_metro_samples(samples.min(300_000))
+            .with_surface_filter(filter)
             .with_tuning(tuning);
         let t0 = Instant::now();
         let out = match encode(&mesh, &opts) {
