@@ -32,8 +32,9 @@ pub struct DecodeArgs {
     #[arg(long)]
     levels: Option<u32>,
     /// Swing streams: leave out the surface filter the stream carries (the retiled vertices
-    /// stay on the original surface). `--sharpen` always leaves it out: EdgeSharpener
-    /// extrapolates planes from those vertices.
+    /// stay on the original surface). `--sharpen` always leaves it out before sharpening
+    /// (EdgeSharpener extrapolates planes from those vertices) and applies the stream's
+    /// filter for after sharpening to the vertices it left alone; with this flag, neither.
     #[arg(long)]
     no_surface_filter: bool,
 }
@@ -57,7 +58,15 @@ pub fn run(args: &DecodeArgs) -> CliResult {
     })?;
     let mesh = if args.sharpen {
         let opts = super::sharpen::sharpen_options(&args.method, args.smooth_factor)?;
-        let s = super::sharpen::run_sharpen(&mesh, &opts)?;
+        let mut s = super::sharpen::run_sharpen(&mesh, &opts)?;
+        if !args.no_surface_filter {
+            // A swing stream's filter for after sharpening: the smooth parts the sharpener
+            // left alone get the surface filter fitted for them (docs/swing.md section 2).
+            if let Ok(c) = whet_format::parse(&bytes, &whet_format::Limits::DEFAULT) {
+                whet_codec::SurfaceFilter::after_sharpening_of(&c.header)
+                    .apply_after_sharpening(&mesh, &mut s.mesh);
+            }
+        }
         match args.bend {
             Some(levels) if levels > 8 => {
                 return Err(Failure::input(anyhow::anyhow!(

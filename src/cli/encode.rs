@@ -327,6 +327,10 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh) -> CliResult {
                 "normal": out.surface_filter.factors().0,
                 "smoothed": out.surface_filter.factors().1,
             },
+            "sharpened_filter": {
+                "normal": out.sharpened_filter.factors().0,
+                "smoothed": out.sharpened_filter.factors().1,
+            },
             "search": out.search.iter().map(|&(f, b)| json!([f, b])).collect::<Vec<_>>(),
             "angle_trials": out.angle_trials.iter().map(|t| json!({
                 "angle_bits": t.angle_bits,

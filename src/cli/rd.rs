@@ -186,12 +186,25 @@ fn sharpened(mesh: &Mesh) -> Result<whet_sharpen::Sharpened, String> {
     }
 }
 
+/// [`sharpened`] as `whet decode --sharpen` does it: then the stream's filter for after
+/// sharpening (swing streams that carry one) on the vertices the sharpener left alone.
+fn sharpened_from_stream(mesh: &Mesh, bytes: &[u8]) -> Result<whet_sharpen::Sharpened, String> {
+    let mut s = sharpened(mesh)?;
+    if let Ok(c) = whet_format::parse(bytes, &whet_format::Limits::DEFAULT) {
+        whet_codec::SurfaceFilter::after_sharpening_of(&c.header)
+            .apply_after_sharpening(mesh, &mut s.mesh);
+    }
+    Ok(s)
+}
+
 fn stage_by_name(name: &str) -> Result<Stage, Failure> {
     match name {
         "decoded" => Ok(Stage::decoded()),
-        "sharpened" => Ok(Stage::new("sharpened", |m| sharpened(m).map(|s| s.mesh))),
-        "bent" => Ok(Stage::new("bent", |m| {
-            let s = sharpened(m)?;
+        "sharpened" => Ok(Stage::with_stream("sharpened", |m, b| {
+            sharpened_from_stream(m, b).map(|s| s.mesh)
+        })),
+        "bent" => Ok(Stage::with_stream("bent", |m, b| {
+            let s = sharpened_from_stream(m, b)?;
             let tags = super::sharpen::tag_edges(&s.tags);
             whet_bend::bend_levels(&s.mesh, &tags, 1)
                 .map(|b| b.mesh)

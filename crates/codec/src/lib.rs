@@ -46,7 +46,7 @@ pub use exact::ExactPayloads;
 pub use fuzz::{fuzz_decode, fuzz_exact_payloads, fuzz_swing_payloads, swing_payload_seed};
 pub use parallelogram::{average, candidates, gate_fallback, MAX_CANDIDATES};
 pub use quantize::Quantizer;
-pub use surface_filter::{FilterFields, SurfaceFilter};
+pub use surface_filter::{untouched_by_sharpening, FilterFields, SurfaceFilter};
 pub use swing::{
     encode_retiled, AngleTable, RetiledMesh, SwingEncoded, SwingFrame, SwingGeometry, SwingParams,
     SwingStreamInfo, VertexSource,

@@ -114,6 +114,78 @@ impl SurfaceFilter {
     }
 }
 
+/// Which vertices of `sharpened` (EdgeSharpener's output from `raw`) the filter may still
+/// move after sharpening: those of `raw` that kept their position bit for bit and share
+/// no triangle with a moved or new vertex. Around the sharpened features nothing moves, so
+/// the planes the sharpener extrapolated stay put.
+pub fn untouched_by_sharpening(raw: &Mesh, sharpened: &Mesh) -> Vec<bool> {
+    let n0 = raw.positions.len();
+    let n = sharpened.positions.len();
+    let moved: Vec<bool> = (0..n)
+        .map(|v| {
+            v >= n0
+                || raw.positions[v].to_array().map(f64::to_bits)
+                    != sharpened.positions[v].to_array().map(f64::to_bits)
+        })
+        .collect();
+    let mut free: Vec<bool> = moved.iter().map(|&m| !m).collect();
+    for t in &sharpened.triangles {
+        let Some(c) = corners(t, n) else {
+            continue;
+        };
+        if c.iter().any(|&v| moved[v]) {
+            for v in c {
+                free[v] = false;
+            }
+        }
+    }
+    free
+}
+
+impl SurfaceFilter {
+    /// Moves the vertices of `sharpened` (EdgeSharpener's output from the unfiltered decoded
+    /// mesh `raw`) that the sharpener left alone ([`untouched_by_sharpening`]) by the
+    /// filter's fields of `raw`: the surface filter of the smooth parts, with the factors
+    /// the encoder fitted on its own sharpened output (header fields 17 and 19). Nothing
+    /// moves when it is [`Self::NONE`].
+    pub fn apply_after_sharpening(&self, raw: &Mesh, sharpened: &mut Mesh) {
+        if self.is_none() {
+            return;
+        }
+        let (a, b) = self.factors();
+        let fields = FilterFields::new(raw);
+        let free = untouched_by_sharpening(raw, sharpened);
+        for (v, p) in sharpened.positions.iter_mut().enumerate() {
+            if !free[v] || v >= fields.normal.len() {
+                continue;
+            }
+            let moved = *p + a * fields.normal[v] + b * fields.smoothed[v];
+            if moved.is_finite() {
+                *p = moved;
+            }
+        }
+    }
+
+    /// The filter a swing stream's header gives for after sharpening (fields 17 and 19);
+    /// [`Self::NONE`] for other streams, without the fields, or with a factor out of
+    /// range.
+    pub fn after_sharpening_of(header: &whet_format::Header) -> SurfaceFilter {
+        let get = |t| header.get_i64(t).unwrap_or(0);
+        let f = SurfaceFilter {
+            normal: get(whet_format::tag::SHARPENED_FILTER_NORMAL),
+            smoothed: get(whet_format::tag::SHARPENED_FILTER_SMOOTHED),
+        };
+        let coded = -MAX_CODED..=MAX_CODED;
+        if header.mode != whet_format::Mode::Swing
+            || !coded.contains(&f.normal)
+            || !coded.contains(&f.smoothed)
+        {
+            return SurfaceFilter::NONE;
+        }
+        f
+    }
+}
+
 /// The two displacement fields of a mesh (per vertex, along its normal), before any factor:
 /// what the encoder fits the factors on (computed as [`SurfaceFilter::apply`] does).
 #[derive(Clone, Debug)]
@@ -247,6 +319,63 @@ mod tests {
             assert!((p.length() - 1.25).abs() < 1e-12, "{p:?}");
             assert!((p.normalize() - *q).length() < 1e-12);
         }
+    }
+
+    #[test]
+    fn after_sharpening_only_vertices_away_from_the_sharpened_part_move() {
+        let raw = whet_testkit::meshes::icosphere(2);
+        let n0 = raw.positions.len();
+        // A stand-in for EdgeSharpener's output: vertex 0 moved, a new vertex on a new
+        // triangle with vertices 5 and 6 (the sharpener appends what it adds).
+        let mut sharp = raw.clone();
+        sharp.positions[0] *= 1.01;
+        sharp.positions.push(DVec3::new(0.0, 0.0, 2.0));
+        sharp.triangles.push([5, 6, n0 as u32]);
+        let free = untouched_by_sharpening(&raw, &sharp);
+        assert!(!free[0] && !free[5] && !free[6] && !free[n0]);
+        let ring_of_0: Vec<u32> = raw
+            .triangles
+            .iter()
+            .filter(|t| t.contains(&0))
+            .flatten()
+            .copied()
+            .collect();
+        for v in 0..n0 {
+            let expected = !(ring_of_0.contains(&(v as u32)) || v == 5 || v == 6);
+            assert_eq!(free[v], expected, "vertex {v}");
+        }
+        let filter = SurfaceFilter::from_factors(0.25, 0.0);
+        let mut out = sharp.clone();
+        filter.apply_after_sharpening(&raw, &mut out);
+        let mut expected = raw.clone();
+        filter.apply(&mut expected);
+        for v in 0..out.positions.len() {
+            if free[v] {
+                // The fields are the unfiltered mesh's: exactly what the filter does there.
+                assert!((out.positions[v] - expected.positions[v]).length() < 1e-12);
+            } else {
+                assert_eq!(out.positions[v], sharp.positions[v], "vertex {v}");
+            }
+        }
+        // No filter, no move; an exact or unfiltered stream's header gives none.
+        let mut same = sharp.clone();
+        SurfaceFilter::NONE.apply_after_sharpening(&raw, &mut same);
+        assert_eq!(same, sharp);
+        let header = whet_format::Header::new(whet_format::Mode::Exact, 0, 0)
+            .with(whet_format::tag::SHARPENED_FILTER_NORMAL, 100i64);
+        assert!(SurfaceFilter::after_sharpening_of(&header).is_none());
+        let header = whet_format::Header::new(whet_format::Mode::Swing, 0, 0)
+            .with(whet_format::tag::SHARPENED_FILTER_NORMAL, MAX_CODED + 1);
+        assert!(SurfaceFilter::after_sharpening_of(&header).is_none());
+        let header = whet_format::Header::new(whet_format::Mode::Swing, 0, 0)
+            .with(whet_format::tag::SHARPENED_FILTER_SMOOTHED, -7i64);
+        assert_eq!(
+            SurfaceFilter::after_sharpening_of(&header),
+            SurfaceFilter {
+                normal: 0,
+                smoothed: -7
+            }
+        );
     }
 
     #[test]

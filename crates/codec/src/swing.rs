@@ -914,6 +914,9 @@ pub struct SwingStreamInfo<'a> {
     pub dropped_unused_vertices: usize,
     /// The surface filter the decoder applies to its output ([`SurfaceFilter::NONE`]: none).
     pub filter: SurfaceFilter,
+    /// The surface filter for after EdgeSharpener ([`SurfaceFilter::apply_after_sharpening`];
+    /// optional header fields 17 and 19, written when not [`SurfaceFilter::NONE`]).
+    pub sharpened_filter: SurfaceFilter,
 }
 
 /// Writes the swing stream of a retiled mesh, after checking that Edgebreaker reproduces the
@@ -1346,6 +1349,15 @@ fn write_stream(
             .with(tag::FILTER_NORMAL, info.filter.normal)
             .with(tag::FILTER_SMOOTHED, info.filter.smoothed);
     }
+    if !info.sharpened_filter.is_none() {
+        // Optional (odd) tags: a reader that does not know them skips them.
+        header = header
+            .with(tag::SHARPENED_FILTER_NORMAL, info.sharpened_filter.normal)
+            .with(
+                tag::SHARPENED_FILTER_SMOOTHED,
+                info.sharpened_filter.smoothed,
+            );
+    }
     header.set_bbox(min, max);
     let container = Container::new(header)
         .with_section(SectionKind::CONNECTIVITY, connectivity)
@@ -1769,6 +1781,7 @@ mod tests {
             repair: REPAIR.get_or_init(ManifoldRepair::default),
             dropped_unused_vertices: 0,
             filter: SurfaceFilter::NONE,
+            sharpened_filter: SurfaceFilter::NONE,
         }
     }
 
@@ -1804,6 +1817,27 @@ mod tests {
         assert_eq!(raw.positions, retiled.positions);
         let header = crate::peek_header(&enc.bytes).unwrap();
         assert_eq!(header.version, VERSION_1_2);
+        // The filter for after sharpening: optional fields, read back as written, absent
+        // (no filter) unless given.
+        let parsed = |bytes: &[u8]| {
+            SurfaceFilter::after_sharpening_of(
+                &whet_format::parse(bytes, &crate::Limits::DEFAULT)
+                    .unwrap()
+                    .header,
+            )
+        };
+        assert_eq!(parsed(&enc.bytes), SurfaceFilter::NONE);
+        let after = SurfaceFilter::from_factors(-0.25, 0.5);
+        let both = SwingStreamInfo {
+            sharpened_filter: after,
+            ..with_filter
+        };
+        let enc2 = encode_retiled(&retiled, &params, &both).unwrap();
+        assert_eq!(parsed(&enc2.bytes), after);
+        assert_eq!(
+            crate::decode(&enc2.bytes, &crate::DecodeOptions::DEFAULT).unwrap(),
+            enc.decoded
+        );
         // Geometry kind 3 with a filter is format 1.1; without a filter it stays 1.0 and
         // has no filter field.
         let kind3 =

@@ -150,9 +150,15 @@ pub mod tag {
     /// i64 (format 1.1): factor of the one-ring mean of the normal Laplacian in the swing
     /// decoder's surface filter, in units of 1/1024 (swing; absent: 0).
     pub const FILTER_SMOOTHED: u64 = 16;
+    /// i64 (format 1.2, optional): factor of the normal Laplacian in the surface filter
+    /// applied after EdgeSharpener to the vertices it left in place (swing; absent: 0).
+    pub const SHARPENED_FILTER_NORMAL: u64 = 17;
+    /// i64 (format 1.2, optional): factor of the one-ring mean in that filter (swing;
+    /// absent: 0).
+    pub const SHARPENED_FILTER_SMOOTHED: u64 = 19;
 
     /// Every tag this crate knows, with its name and value type.
-    pub const KNOWN: [(u64, &str, ValueType); 9] = [
+    pub const KNOWN: [(u64, &str, ValueType); 11] = [
         (ENCODER, "encoder", ValueType::Bytes),
         (COMPONENT_COUNT, "component_count", ValueType::U64),
         (QUANT_BITS, "quant_bits", ValueType::U64),
@@ -162,6 +168,16 @@ pub mod tag {
         (SUBDIV_LEVELS, "subdiv_levels", ValueType::U64),
         (FILTER_NORMAL, "filter_normal", ValueType::I64),
         (FILTER_SMOOTHED, "filter_smoothed", ValueType::I64),
+        (
+            SHARPENED_FILTER_NORMAL,
+            "sharpened_filter_normal",
+            ValueType::I64,
+        ),
+        (
+            SHARPENED_FILTER_SMOOTHED,
+            "sharpened_filter_smoothed",
+            ValueType::I64,
+        ),
     ];
 
     /// Name and type of a known tag.

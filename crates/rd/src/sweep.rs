@@ -27,9 +27,11 @@ pub struct Stage {
     /// Name shown in tables and legends (`decoded`, `sharpened`, `bent`).
     pub name: String,
     /// The stage; it receives the decoded mesh ([`Codec::decode`]'s, or for a
-    /// post-processing stage [`Codec::decode_for_stages`]' when the codec has one).
+    /// post-processing stage [`Codec::decode_for_stages`]' when the codec has one) and the
+    /// stream it came from (a stage may read what the stream carries for it, e.g. a swing
+    /// stream's filter for after sharpening).
     #[allow(clippy::type_complexity)]
-    pub apply: Box<dyn Fn(&Mesh) -> Result<Mesh, String> + Sync + Send>,
+    pub apply: Box<dyn Fn(&Mesh, &[u8]) -> Result<Mesh, String> + Sync + Send>,
     /// Whether the stage starts from [`Codec::decode_for_stages`] (post-processing) rather
     /// than from [`Codec::decode`] (the identity stage).
     pub post_processing: bool,
@@ -40,7 +42,7 @@ impl Stage {
     pub fn decoded() -> Stage {
         Stage {
             name: "decoded".into(),
-            apply: Box::new(|m| Ok(m.clone())),
+            apply: Box::new(|m, _| Ok(m.clone())),
             post_processing: false,
         }
     }
@@ -49,6 +51,18 @@ impl Stage {
     pub fn new(
         name: impl Into<String>,
         f: impl Fn(&Mesh) -> Result<Mesh, String> + Sync + Send + 'static,
+    ) -> Stage {
+        Stage {
+            name: name.into(),
+            apply: Box::new(move |m, _| f(m)),
+            post_processing: true,
+        }
+    }
+
+    /// A named post-processing stage that also reads the stream.
+    pub fn with_stream(
+        name: impl Into<String>,
+        f: impl Fn(&Mesh, &[u8]) -> Result<Mesh, String> + Sync + Send + 'static,
     ) -> Stage {
         Stage {
             name: name.into(),
@@ -268,7 +282,7 @@ pub fn run_point(
                 _ => &decoded,
             };
             let t = Instant::now();
-            let mesh = match (stage.apply)(input) {
+            let mesh = match (stage.apply)(input, &bytes) {
                 Ok(m) => m,
                 Err(e) => {
                     p.error = Some(format!("{}: {e}", stage.name));

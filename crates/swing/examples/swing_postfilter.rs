@@ -55,18 +55,39 @@ fn main() {
         for v in (0..n0).filter(|&v| !touched[v]) {
             post.positions[v] += a * fields.normal[v] + b * fields.smoothed[v];
         }
+        // Factors fitted on the sharpened mesh itself (the fields masked to the vertices
+        // the sharpener left alone).
+        let bvh = whet_metro::Bvh::new(&mesh);
+        let l = out.edge_length;
+        let (mut f0, mut f1) = (
+            vec![whet_mesh::DVec3::ZERO; sharp.positions.len()],
+            vec![whet_mesh::DVec3::ZERO; sharp.positions.len()],
+        );
+        for v in (0..n0).filter(|&v| !touched[v]) {
+            f0[v] = fields.normal[v];
+            f1[v] = fields.smoothed[v];
+        }
+        let fitted = whet_swing::fit_displacements(&sharp, &f0, &f1, |p| {
+            bvh.closest_point_within(p, 2.0 * l).map(|c| c.point)
+        });
+        let (a2, b2) = fitted.factors();
+        let mut post_fit = sharp.clone();
+        for v in 0..post_fit.positions.len() {
+            post_fit.positions[v] += a2 * f0[v] + b2 * f1[v];
+        }
         let m = MetroOptions::DEFAULT.with_samples(300_000);
         let e = |x: &whet_mesh::Mesh| {
             let r = metro(&mesh, x, &m).unwrap().symmetric;
             format!("{:.4} {:.3}", r.rms_pct, r.max_pct)
         };
         println!(
-            "{} {bpv}: unfiltered {} filtered {} sharpened {} sharpened+filter {}",
+            "{} {bpv}: unfiltered {} filtered {} sharpened {} sharpened+filter {} sharpened+fitted ({a2:.3}, {b2:.3}) {}",
             args[0],
             e(&raw),
             e(&filtered),
             e(&sharp),
-            e(&post)
+            e(&post),
+            e(&post_fit)
         );
     }
 }

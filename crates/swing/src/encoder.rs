@@ -211,6 +211,9 @@ pub struct SwingOutput {
     pub angle_trials: Vec<AngleTrial>,
     /// The surface filter the stream carries ([`SurfaceFilter::NONE`]: none).
     pub surface_filter: SurfaceFilter,
+    /// The surface filter for after EdgeSharpener carried in the stream (optional header
+    /// fields 17 and 19; `SurfaceFilter::apply_after_sharpening`).
+    pub sharpened_filter: SurfaceFilter,
 }
 
 impl SwingOutput {
@@ -469,6 +472,7 @@ impl SwingEncoder {
             repair: &prep.repair,
             dropped_unused_vertices: prep.dropped,
             filter: retiled.filter,
+            sharpened_filter: retiled.sharpened_filter,
         };
         let enc: SwingEncoded = encode_retiled(&retiled.mesh, &params, &info)?;
         Ok(SwingOutput {
@@ -486,6 +490,7 @@ impl SwingEncoder {
             search: Vec::new(),
             angle_trials: Vec::new(),
             surface_filter: info.filter,
+            sharpened_filter: info.sharpened_filter,
         })
     }
 
@@ -568,6 +573,7 @@ impl SwingEncoder {
             ErrorOf::Decoded => &out.retiled,
             ErrorOf::Sharpened => {
                 // `whet decode --sharpen`: the mesh without its surface filter, sharpened.
+                // (then the stream's filter for after sharpening, as `whet decode --sharpen`)
                 let input = if out.surface_filter.is_none() {
                     &out.retiled
                 } else {
@@ -577,7 +583,11 @@ impl SwingEncoder {
                 };
                 match whet_sharpen::sharpen(input, &whet_sharpen::SharpenOptions::DEFAULT) {
                     Ok(s) => {
-                        sharpened = s.mesh;
+                        sharpened = {
+                            let mut m = s.mesh;
+                            out.sharpened_filter.apply_after_sharpening(input, &mut m);
+                            m
+                        };
                         &sharpened
                     }
                     // A retiled mesh is a valid manifold; should the sharpener refuse one

@@ -35,10 +35,27 @@ const PATTERN: [[f64; 3]; 4] = [
 /// surface are not what the filter can fix).
 pub fn fit_surface_filter(
     decoded: &Mesh,
-    mut closest: impl FnMut(DVec3) -> Option<DVec3>,
+    closest: impl FnMut(DVec3) -> Option<DVec3>,
 ) -> SurfaceFilter {
     let fields = FilterFields::new(decoded);
+    fit_displacements(decoded, &fields.normal, &fields.smoothed, closest)
+}
+
+/// The factors `(a, b)` that best fit `mesh`, its vertices moved by `a · first + b ·
+/// second` (one displacement of each field per vertex), to the original surface: the fit
+/// of [`fit_surface_filter`] for any two fields, e.g. the filter's fields of the unfiltered
+/// mesh restricted to the vertices EdgeSharpener left in place.
+pub fn fit_displacements(
+    mesh: &Mesh,
+    first: &[DVec3],
+    second: &[DVec3],
+    mut closest: impl FnMut(DVec3) -> Option<DVec3>,
+) -> SurfaceFilter {
+    let decoded = mesh;
     let pos = &decoded.positions;
+    if first.len() < pos.len() || second.len() < pos.len() {
+        return SurfaceFilter::NONE;
+    }
     let total = decoded.triangles.len() * PATTERN.len();
     // An odd stride cycles through the four pattern points (an even one would keep to one
     // or two of them).
@@ -70,7 +87,7 @@ pub fn fit_surface_filter(
             continue;
         };
         let r = (c - p).dot(nf);
-        let (x0, x1) = (mix(&fields.normal), mix(&fields.smoothed));
+        let (x0, x1) = (mix(first), mix(second));
         if !(r.is_finite() && x0.is_finite() && x1.is_finite()) {
             continue;
         }

@@ -28,7 +28,7 @@ mod surface;
 pub use encoder::{
     encode, valence6_fraction, AngleTrial, ErrorOf, Rate, SwingEncoder, SwingOptions, SwingOutput,
 };
-pub use filter_fit::fit_surface_filter;
+pub use filter_fit::{fit_displacements, fit_surface_filter};
 pub use retiler::{retile, RetileStats, RetileTuning, Retiled};
 
 /// Why a mesh could not be encoded in the swing mode.

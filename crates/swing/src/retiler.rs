@@ -176,6 +176,10 @@ pub struct Retiled {
     pub stats: RetileStats,
     /// The surface filter fitted to the original ([`SurfaceFilter::NONE`] unless asked for).
     pub filter: SurfaceFilter,
+    /// The filter for after EdgeSharpener (`SurfaceFilter::apply_after_sharpening`), fitted
+    /// on the retiling sharpened with whet-sharpen's defaults, as `whet decode --sharpen`
+    /// does ([`SurfaceFilter::NONE`] unless asked for).
+    pub sharpened_filter: SurfaceFilter,
 }
 
 const NONE: u32 = u32::MAX;
@@ -387,7 +391,7 @@ pub(crate) fn retile_fitted(
         None => Vec::new(),
     };
     r.stats.deleted_triangles = deleted.iter().filter(|&&d| d).count();
-    let filter = if fit {
+    let (filter, sharpened_filter) = if fit {
         // The decoder's output: the kept triangles (unused vertices do not matter to the
         // filter). Closest points on the original only, not on the filler over its holes.
         let kept = whet_mesh::Mesh::new(
@@ -401,11 +405,12 @@ pub(crate) fn retile_fitted(
         );
         let filler = filler.unwrap_or(&[]);
         let surf = &*r.surf;
-        crate::fit_surface_filter(&kept, |p| {
-            surf.closest_point(p, 2.0 * l, |t| !filler.get(t).copied().unwrap_or(false))
-        })
+        let closest =
+            |p| surf.closest_point(p, 2.0 * l, |t| !filler.get(t).copied().unwrap_or(false));
+        let filter = crate::fit_surface_filter(&kept, closest);
+        (filter, fit_after_sharpening(&kept, closest))
     } else {
-        SurfaceFilter::NONE
+        (SurfaceFilter::NONE, SurfaceFilter::NONE)
     };
     Ok(Retiled {
         mesh: RetiledMesh {
@@ -418,7 +423,35 @@ pub(crate) fn retile_fitted(
         },
         stats: r.stats,
         filter,
+        sharpened_filter,
     })
+}
+
+/// The factors of the filter for after sharpening: `kept` (the unfiltered decoded mesh)
+/// sharpened with whet-sharpen's defaults, the filter's fields of `kept` on the vertices
+/// the sharpener left alone, fitted to the original (docs/swing.md section 2). On a smooth
+/// part the sharpener changes little and the fit finds the decoded filter again; on a CAD
+/// part it fits the flat faces between the restored creases. No filter when the sharpener
+/// refuses the mesh.
+fn fit_after_sharpening(
+    kept: &whet_mesh::Mesh,
+    closest: impl FnMut(DVec3) -> Option<DVec3>,
+) -> SurfaceFilter {
+    let Ok(sharp) = whet_sharpen::sharpen(kept, &whet_sharpen::SharpenOptions::DEFAULT) else {
+        return SurfaceFilter::NONE;
+    };
+    let sharp = sharp.mesh;
+    let free = whet_codec::untouched_by_sharpening(kept, &sharp);
+    let fields = whet_codec::FilterFields::new(kept);
+    let n = sharp.positions.len();
+    let (mut first, mut second) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
+    for v in 0..n.min(fields.normal.len()) {
+        if free[v] {
+            first[v] = fields.normal[v];
+            second[v] = fields.smoothed[v];
+        }
+    }
+    crate::fit_displacements(&sharp, &first, &second, closest)
 }
 
 impl Retiler<'_, '_> {
