@@ -936,19 +936,14 @@ pub fn encode_retiled(
     encode_retiled_as(retiled, params, info, IndexCoding::Scaled)
 }
 
-/// The writer of kinds 7 and 8: labels, S tips, seeds and indices from the retiled mesh.
-struct FrontWriter<'a> {
-    inner: SwingWriter<'a>,
-    labels: &'a [Clers],
-    next_label: usize,
-    triangles: &'a [[u32; 3]],
-    /// Directed edge -> triangle of the whole retiled mesh, built at the first S.
-    edges: Option<std::collections::HashMap<u64, u32>>,
-    /// What the labels and S tips cost, in 1/`COST_ONE` bits.
-    connectivity_cost: u64,
+/// A seed and index coder `inner` with what a forward walk needs besides (kinds 7 and 8):
+/// `state` for the labels and S tips.
+struct Forward<W, S> {
+    inner: W,
+    state: S,
 }
 
-impl SwingIo for FrontWriter<'_> {
+impl<W: SwingIo, S> SwingIo for Forward<W, S> {
     fn seed(&mut self, v: VertexId, bits: u32, grid: &mut [i32; 3]) {
         self.inner.seed(v, bits, grid)
     }
@@ -964,13 +959,34 @@ impl SwingIo for FrontWriter<'_> {
     }
 }
 
+/// The writer of kinds 7 and 8: labels, S tips, seeds and indices from the retiled mesh.
+type FrontWriter<'a> = Forward<SwingWriter<'a>, LabelSource<'a>>;
+
+/// The reader of kinds 7 and 8.
+type FrontReader<'a, 'b> = Forward<SwingReader<'a, 'b>, ()>;
+
+/// Where the writer of kinds 7 and 8 takes labels and S tips from.
+struct LabelSource<'a> {
+    labels: &'a [Clers],
+    next_label: usize,
+    triangles: &'a [[u32; 3]],
+    /// Directed edge -> triangle of the whole retiled mesh, built at the first S.
+    edges: Option<std::collections::HashMap<u64, u32>>,
+    /// What the labels and S tips cost, in 1/`COST_ONE` bits.
+    connectivity_cost: u64,
+}
+
 impl front::FrontIo for FrontWriter<'_> {
     fn label(&mut self, tables: &mut whet_bits::SymbolTables, ctx: usize) -> Result<Clers, Error> {
-        let label = *self.labels.get(self.next_label).ok_or_else(|| {
-            Error::Corrupt("the walk needs more labels than the retiler made".into())
-        })?;
-        self.next_label += 1;
-        self.connectivity_cost += tables.cost(ctx, label as usize) as u64;
+        let label = *self
+            .state
+            .labels
+            .get(self.state.next_label)
+            .ok_or_else(|| {
+                Error::Corrupt("the walk needs more labels than the retiler made".into())
+            })?;
+        self.state.next_label += 1;
+        self.state.connectivity_cost += tables.cost(ctx, label as usize) as u64;
         tables.encode(self.inner.sink, ctx, label as usize);
         Ok(label)
     }
@@ -984,9 +1000,9 @@ impl front::FrontIo for FrontWriter<'_> {
         vertices: usize,
     ) -> Result<u32, Error> {
         let mismatch = || Error::Corrupt("the walk's S does not match the retiled mesh".into());
-        let [w, a, _] = *self.triangles.get(triangle).ok_or_else(mismatch)?;
-        let triangles = self.triangles;
-        let edges = self.edges.get_or_insert_with(|| {
+        let [w, a, _] = *self.state.triangles.get(triangle).ok_or_else(mismatch)?;
+        let triangles = self.state.triangles;
+        let edges = self.state.edges.get_or_insert_with(|| {
             let mut m = std::collections::HashMap::with_capacity(3 * triangles.len());
             for (i, t) in triangles.iter().enumerate() {
                 for k in 0..3 {
@@ -1021,7 +1037,7 @@ impl front::FrontIo for FrontWriter<'_> {
                 .iter()
                 .filter(|c| front::candidate_order(c, &me).is_lt())
                 .count();
-            self.connectivity_cost += models.rank.cost(rank as u32) as u64;
+            self.state.connectivity_cost += models.rank.cost(rank as u32) as u64;
             models.rank.encode(sink, rank as u32);
         } else {
             // A tip on another loop (a handle closes): the vertex, then which of its nodes.
@@ -1032,7 +1048,7 @@ impl front::FrontIo for FrontWriter<'_> {
                 .position(|&m| m == node)
                 .ok_or_else(mismatch)? as u32;
             let bits = front::vertex_bits(vertices);
-            self.connectivity_cost += (models.rank.cost(escape)
+            self.state.connectivity_cost += (models.rank.cost(escape)
                 + models.which.cost(which)
                 + bits * whet_bits::COST_ONE) as u64;
             models.rank.encode(sink, escape);
@@ -1043,29 +1059,13 @@ impl front::FrontIo for FrontWriter<'_> {
     }
 }
 
-/// The reader of kinds 7 and 8.
-struct FrontReader<'a, 'b> {
-    inner: SwingReader<'a, 'b>,
-}
-
-impl SwingIo for FrontReader<'_, '_> {
-    fn seed(&mut self, v: VertexId, bits: u32, grid: &mut [i32; 3]) {
-        self.inner.seed(v, bits, grid)
-    }
-    fn index(
-        &mut self,
-        v: VertexId,
-        model: &mut IndexModel,
-        pred: i32,
-        bits: u32,
-        q: &mut i32,
-    ) -> Result<(), Error> {
-        self.inner.index(v, model, pred, bits, q)
-    }
-}
-
 impl front::FrontIo for FrontReader<'_, '_> {
     fn label(&mut self, tables: &mut whet_bits::SymbolTables, ctx: usize) -> Result<Clers, Error> {
+        // A stream read past its end decodes zeros, which walk on as C after C: stop there
+        // rather than at the announced triangle count (a complete stream never overruns).
+        if self.inner.dec.overran() {
+            return Err(Error::Truncated("geometry"));
+        }
         let s = tables.decode(self.inner.dec, ctx);
         Clers::from_index(s).ok_or_else(|| Error::Corrupt("a label out of range".into()))
     }
@@ -1114,7 +1114,7 @@ fn encode_forward(
             "one deletion flag per retiled triangle is needed".into(),
         ));
     }
-    if retiled.components == 0 || n == 0 || retiled.positions.len() > u32::MAX as usize / 2 {
+    if retiled.components == 0 || n == 0 || n > (u32::MAX / 4) as usize {
         return Ok(None);
     }
     let mut range = RangeEncoder::new();
@@ -1124,11 +1124,13 @@ fn encode_forward(
             sources: &retiled.sources,
             bad_seed: false,
         },
-        labels: &retiled.labels,
-        next_label: 0,
-        triangles: &retiled.triangles,
-        edges: None,
-        connectivity_cost: 0,
+        state: LabelSource {
+            labels: &retiled.labels,
+            next_label: 0,
+            triangles: &retiled.triangles,
+            edges: None,
+            connectivity_cost: 0,
+        },
     };
     let Ok(walked) = front::front_walk(&mut io, params, retiled.components, n, n) else {
         return Ok(None);
@@ -1140,13 +1142,13 @@ fn encode_forward(
             .zip(&retiled.positions)
             .all(|(p, r)| p.to_array().map(f64::to_bits) == r.to_array().map(f64::to_bits));
     if io.inner.bad_seed
-        || io.next_label != retiled.labels.len()
+        || io.state.next_label != retiled.labels.len()
         || walked.triangles != retiled.triangles
         || !same_positions
     {
         return Ok(None);
     }
-    let connectivity_cost = io.connectivity_cost;
+    let connectivity_cost = io.state.connectivity_cost;
     let mut mesh = Mesh::new(walked.positions, walked.triangles);
     if cutting {
         code_cut_flags(&mut range, &retiled.deleted);
@@ -1680,6 +1682,7 @@ fn decode_forward(
             dec: &mut dec,
             max_level: params.quantizer.max_level(),
         },
+        state: (),
     };
     // A retiled triangle costs about a bit and a half; 64 per byte is far beyond any stream.
     let capacity = payload.len().saturating_mul(64).saturating_add(1024);
@@ -1959,6 +1962,39 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn a_forward_stream_cut_short_stops_at_its_end_not_at_its_count() {
+        // A kind 7 stream holding a seed and nothing else, announcing 2^22 triangles: read
+        // past its end, the decoder sees zeros, that is C after C with the predicted index,
+        // each on a valid frame, up to the count (gigabytes at the default limits).
+        let (retiled, params) = tetrahedron(-20);
+        let enc = encode_retiled(&retiled, &params, &info()).unwrap();
+        let c = whet_format::parse(&enc.bytes, &crate::Limits::DEFAULT).unwrap();
+        let mut range = RangeEncoder::new();
+        for source in &retiled.sources[..3] {
+            let VertexSource::Seed(g) = *source else {
+                panic!("the seed comes first")
+            };
+            for x in g {
+                range.encode_direct(x as u32, params.quantizer.bits);
+            }
+        }
+        let mut geometry = vec![KIND_SWING_FORWARD];
+        geometry.extend_from_slice(&range.finish());
+        let mut count = Vec::new();
+        whet_format::write_varint(&mut count, 1 << 22);
+        let bytes = Container::new(c.header.clone())
+            .with_section(SectionKind::CONNECTIVITY, count)
+            .with_section(SectionKind::GEOMETRY, geometry)
+            .to_bytes()
+            .unwrap();
+        let t = std::time::Instant::now();
+        let err = crate::decode(&bytes, &crate::DecodeOptions::DEFAULT).unwrap_err();
+        assert!(err.to_string().contains("truncated"), "{err}");
+        // Stopped within a few labels of its end.
+        assert!(t.elapsed() < std::time::Duration::from_secs(1));
     }
 
     #[test]

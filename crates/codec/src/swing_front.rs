@@ -11,12 +11,15 @@
 //!
 //! * per gate end (`b` with its front neighbour `b⁺`, `a` with `a⁻`): the open angle of the
 //!   candidate closing triangle in 5 bins, the valence the end would close with in 3 bins,
-//!   and the distance from the predicted swing tip to the neighbour in 4 bins;
+//!   and the length of the edge the closing would add in 4 bins (the retiler snaps a swing
+//!   tip that falls near the neighbour; the predicted tip's distance to it codes a little
+//!   better but needs a frame at every gate, docs/swing.md);
 //! * whether the front is a loop of three.
 //!
 //! 7200 contexts of adaptive 5-symbol frequency tables. An S label's tip is coded as the rank
-//! of its node among the nodes of the gate's loop ordered by distance to the predicted tip
-//! (nearly always 0); a tip on another loop (a handle) escapes to its vertex index.
+//! of its node among the other nodes of the gate's loop ordered by distance to the gate's
+//! midpoint (nearly always 0 or 1); a tip on another loop (a handle) escapes to its vertex
+//! index.
 //! docs/swing.md section 2 has the measurements; docs/format.md the normative layout.
 
 use super::*;
@@ -405,10 +408,11 @@ pub(super) fn front_walk<I: FrontIo>(
                     }
                 }
                 Clers::S => {
-                    // The gate's loop from b⁺⁺ to a⁻⁻.
+                    // The gate's loop from b⁺⁺ to a⁻⁻ (none on a loop of three: there the
+                    // tip is on another loop, by escape).
                     candidates.clear();
                     let target = scale(add(pa, pb), 0.5);
-                    let mut m = front.node(xn).next;
+                    let mut m = if three { pn } else { front.node(xn).next };
                     while m != pn {
                         split_work += 1;
                         if split_work > split_budget || m == an {
