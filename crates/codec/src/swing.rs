@@ -167,6 +167,8 @@ fn cross(a: DVec3, b: DVec3) -> DVec3 {
 #[derive(Clone, Debug, PartialEq)]
 pub struct AngleTable {
     bits: u32,
+    /// `2^bits / 2π`, computed once (the same division the prediction used to repeat).
+    inverse_step: f64,
     cos: Vec<f64>,
     sin: Vec<f64>,
 }
@@ -187,7 +189,12 @@ impl AngleTable {
             cos.push(libm::cos(theta));
             sin.push(libm::sin(theta));
         }
-        Some(AngleTable { bits, cos, sin })
+        Some(AngleTable {
+            bits,
+            inverse_step: (1u64 << bits) as f64 / (2.0 * std::f64::consts::PI),
+            cos,
+            sin,
+        })
     }
 
     #[inline]
@@ -222,7 +229,7 @@ impl AngleTable {
     /// `1 / Δ` (the prediction multiplies by it).
     #[inline]
     pub fn inverse_step(&self) -> f64 {
-        (1u64 << self.bits) as f64 / (2.0 * std::f64::consts::PI)
+        self.inverse_step
     }
 
     /// Smallest swing index.
