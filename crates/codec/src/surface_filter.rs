@@ -153,13 +153,14 @@ impl SurfaceFilter {
             return;
         }
         let (a, b) = self.factors();
-        let fields = FilterFields::new(raw);
-        let free = untouched_by_sharpening(raw, sharpened);
-        for (v, p) in sharpened.positions.iter_mut().enumerate() {
-            if !free[v] || v >= fields.normal.len() {
-                continue;
-            }
-            let moved = *p + a * fields.normal[v] + b * fields.smoothed[v];
+        let fields = FilterFields::new(raw).after_sharpening(raw, sharpened);
+        for ((p, d), s) in sharpened
+            .positions
+            .iter_mut()
+            .zip(&fields.normal)
+            .zip(&fields.smoothed)
+        {
+            let moved = *p + a * *d + b * *s;
             if moved.is_finite() {
                 *p = moved;
             }
@@ -204,6 +205,27 @@ impl FilterFields {
         FilterFields {
             normal: normals.iter().zip(&d).map(|(n, d)| *d * *n).collect(),
             smoothed: normals.iter().zip(&s).map(|(n, s)| *s * *n).collect(),
+        }
+    }
+
+    /// These fields (of the unfiltered mesh `raw`) as the filter for after sharpening moves
+    /// the vertices of `sharpened`, EdgeSharpener's output from `raw`: unchanged on the
+    /// vertices [`untouched_by_sharpening`] finds, zero on the others and on new ones. The
+    /// decoder applies them, the encoder fits its factors on them.
+    pub fn after_sharpening(&self, raw: &Mesh, sharpened: &Mesh) -> FilterFields {
+        let free = untouched_by_sharpening(raw, sharpened);
+        let keep = |f: &[DVec3]| -> Vec<DVec3> {
+            free.iter()
+                .enumerate()
+                .map(|(v, &free)| match f.get(v) {
+                    Some(&x) if free => x,
+                    _ => DVec3::ZERO,
+                })
+                .collect()
+        };
+        FilterFields {
+            normal: keep(&self.normal),
+            smoothed: keep(&self.smoothed),
         }
     }
 

@@ -407,8 +407,10 @@ pub(crate) fn retile_fitted(
         let surf = &*r.surf;
         let closest =
             |p| surf.closest_point(p, 2.0 * l, |t| !filler.get(t).copied().unwrap_or(false));
-        let filter = crate::fit_surface_filter(&kept, closest);
-        (filter, fit_after_sharpening(&kept, closest))
+        // One set of fields serves both fits (fit_surface_filter computes the same).
+        let fields = whet_codec::FilterFields::new(&kept);
+        let filter = crate::fit_displacements(&kept, &fields.normal, &fields.smoothed, closest);
+        (filter, fit_after_sharpening(&kept, &fields, closest))
     } else {
         (SurfaceFilter::NONE, SurfaceFilter::NONE)
     };
@@ -435,23 +437,15 @@ pub(crate) fn retile_fitted(
 /// refuses the mesh.
 fn fit_after_sharpening(
     kept: &whet_mesh::Mesh,
+    fields: &whet_codec::FilterFields,
     closest: impl FnMut(DVec3) -> Option<DVec3>,
 ) -> SurfaceFilter {
     let Ok(sharp) = whet_sharpen::sharpen(kept, &whet_sharpen::SharpenOptions::DEFAULT) else {
         return SurfaceFilter::NONE;
     };
     let sharp = sharp.mesh;
-    let free = whet_codec::untouched_by_sharpening(kept, &sharp);
-    let fields = whet_codec::FilterFields::new(kept);
-    let n = sharp.positions.len();
-    let (mut first, mut second) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
-    for v in 0..n.min(fields.normal.len()) {
-        if free[v] {
-            first[v] = fields.normal[v];
-            second[v] = fields.smoothed[v];
-        }
-    }
-    crate::fit_displacements(&sharp, &first, &second, closest)
+    let moved = fields.after_sharpening(kept, &sharp);
+    crate::fit_displacements(&sharp, &moved.normal, &moved.smoothed, closest)
 }
 
 impl Retiler<'_, '_> {
