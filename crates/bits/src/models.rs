@@ -294,8 +294,10 @@ impl SymbolTables {
     pub fn decode(&mut self, dec: &mut RangeDecoder<'_>, table: usize) -> usize {
         let t = table.min(self.total.len() - 1);
         let n = self.symbols;
-        let row = &self.freq[t * n..(t + 1) * n];
-        let s = dec.decode_with(self.total[t], |target| {
+        let total = self.total[t];
+        // One slice for the search and the count (the decoder's hot path: one bounds check).
+        let row = &mut self.freq[t * n..(t + 1) * n];
+        let s = dec.decode_with(total, |target| {
             let mut cum = 0;
             for (s, &f) in row.iter().enumerate() {
                 if target < cum + f {
@@ -306,8 +308,26 @@ impl SymbolTables {
             // target < total: unreachable; answer the last symbol.
             (n - 1, cum - row[n - 1], row[n - 1])
         });
-        self.update(t, s);
+        self.total[t] = Self::count(row, s, total);
         s
+    }
+
+    /// Counts `s` in `row` whose counts sum to `total`; the new total.
+    #[inline]
+    fn count(row: &mut [u32], s: usize, total: u32) -> u32 {
+        if let Some(f) = row.get_mut(s) {
+            *f += SymbolModel::STEP;
+        }
+        let total = total + SymbolModel::STEP;
+        if total <= SymbolModel::LIMIT {
+            return total;
+        }
+        let mut halved = 0;
+        for f in row.iter_mut() {
+            *f = (*f).div_ceil(2);
+            halved += *f;
+        }
+        halved
     }
 
     /// Cost of coding `symbol` with table `table` now, in 1/[`crate::COST_ONE`] bits.
@@ -320,16 +340,7 @@ impl SymbolTables {
     #[inline]
     fn update(&mut self, t: usize, s: usize) {
         let row = &mut self.freq[t * self.symbols..(t + 1) * self.symbols];
-        row[s] += SymbolModel::STEP;
-        self.total[t] += SymbolModel::STEP;
-        if self.total[t] > SymbolModel::LIMIT {
-            let mut total = 0;
-            for f in row.iter_mut() {
-                *f = (*f).div_ceil(2);
-                total += *f;
-            }
-            self.total[t] = total;
-        }
+        self.total[t] = Self::count(row, s, self.total[t]);
     }
 }
 

@@ -738,6 +738,7 @@ impl SwingIo for SwingReader<'_, '_> {
             *c = (self.dec.decode_direct(bits) as i32).min(self.max_level);
         }
     }
+    #[inline]
     fn index(
         &mut self,
         _v: VertexId,
@@ -954,6 +955,7 @@ impl<W: SwingIo, S> SwingIo for Forward<W, S> {
     fn seed(&mut self, v: VertexId, bits: u32, grid: &mut [i32; 3]) {
         self.inner.seed(v, bits, grid)
     }
+    #[inline]
     fn index(
         &mut self,
         v: VertexId,
@@ -1067,6 +1069,7 @@ impl front::FrontIo for FrontWriter<'_> {
 }
 
 impl front::FrontIo for FrontReader<'_, '_> {
+    #[inline]
     fn label(&mut self, tables: &mut whet_bits::SymbolTables, ctx: usize) -> Result<Clers, Error> {
         // A stream read past its end decodes zeros, which walk on as C after C: stop there
         // rather than at the announced triangle count (a complete stream never overruns).

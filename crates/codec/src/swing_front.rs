@@ -213,11 +213,9 @@ const COS70_SQUARED: f64 = 0.116_977_778_440_511_06;
 /// The valence bin of a vertex with `k` built triangles, were it closed by one more.
 #[inline]
 fn valence_bin(k: u32) -> usize {
-    match k + 1 {
-        0..=4 => 0,
-        5 => 1,
-        _ => 2,
-    }
+    // Closing would give k + 1 triangles: 0 under 5, 1 at 5, 2 above (without branches:
+    // the bin is data, not control flow).
+    (k >= 4) as usize + (k >= 5) as usize
 }
 
 /// The length bin of the edge a closing triangle would add between the far gate end `o` and
@@ -226,15 +224,64 @@ fn valence_bin(k: u32) -> usize {
 fn length_bin(o: DVec3, w: DVec3, inv_l2: f64) -> usize {
     let d = sub(o, w);
     let d2 = dot(d, d) * inv_l2;
-    if d2 < 1.0 {
-        0
-    } else if d2 < 1.44 {
-        1
-    } else if d2 < 2.0 {
-        2
-    } else {
-        3
+    // Counted without branches (the bin is data for the label's coder; branching on it
+    // mispredicts); NaN falls in the last bin, as a long edge.
+    let d2 = if d2.is_nan() { f64::INFINITY } else { d2 };
+    (d2 >= 1.0) as usize + (d2 >= 1.44) as usize + (d2 >= 2.0) as usize
+}
+
+/// The mesh a walk rebuilds, with the per-vertex sums its contexts and predictions read.
+struct Rebuilt {
+    positions: Vec<DVec3>,
+    triangles: Vec<[u32; 3]>,
+    /// Per vertex, the sum of its triangles' cross products.
+    fan: Vec<DVec3>,
+    /// Per vertex, its triangles (at most the triangle count, which the caller bounds far
+    /// below `u32::MAX`).
+    built: Vec<u32>,
+}
+
+impl Rebuilt {
+    /// Room for about `triangles` triangles (a retiling has about half as many vertices).
+    fn with_capacity(triangles: usize) -> Rebuilt {
+        let vertices = triangles / 2 + 3;
+        Rebuilt {
+            positions: Vec::with_capacity(vertices),
+            triangles: Vec::with_capacity(triangles),
+            fan: Vec::with_capacity(vertices),
+            built: Vec::with_capacity(vertices),
+        }
     }
+
+    #[inline]
+    fn add_vertex(&mut self, p: DVec3) {
+        self.positions.push(p);
+        self.fan.push(DVec3::ZERO);
+        self.built.push(0);
+    }
+
+    /// Adds triangle `t` of existing vertices; a triangle repeating a vertex (only a corrupt
+    /// stream makes one: the retiler's front never meets itself that way) is an error.
+    #[inline(always)]
+    fn add_triangle(&mut self, t: [u32; 3]) -> Result<(), Error> {
+        let [i, j, k] = t.map(|v| v as usize);
+        if i == j || j == k || k == i {
+            return Err(repeated_vertex());
+        }
+        let (p0, p1, p2) = (self.positions[i], self.positions[j], self.positions[k]);
+        let n = cross(sub(p1, p0), sub(p2, p0));
+        for v in [i, j, k] {
+            self.fan[v] = add(self.fan[v], n);
+            self.built[v] += 1;
+        }
+        self.triangles.push(t);
+        Ok(())
+    }
+}
+
+#[cold]
+fn repeated_vertex() -> Error {
+    Error::Corrupt("swing connectivity: a triangle repeats a vertex".into())
 }
 
 /// What [`front_walk`] rebuilt.
@@ -272,53 +319,26 @@ pub(super) fn front_walk<I: FrontIo>(
     let mut front = Front::default();
     // A retiling has about half as many vertices as triangles.
     let reserve = triangles.min(capacity);
-    let mut positions: Vec<DVec3> = Vec::with_capacity(reserve / 2 + 3);
-    let mut tris: Vec<[u32; 3]> = Vec::with_capacity(reserve);
-    let mut fan: Vec<DVec3> = Vec::with_capacity(reserve / 2 + 3);
-    let mut built: Vec<u32> = Vec::with_capacity(reserve / 2 + 3);
+    let mut out = Rebuilt::with_capacity(reserve);
     let mut candidates: Vec<Candidate> = Vec::new();
     // Loop steps spent listing S candidates: bounded, so that a hostile stream cannot make
     // the walk quadratic.
     let mut split_work: usize = 0;
     let split_budget = triangles.saturating_mul(64).saturating_add(1 << 20);
-    // Adds triangle `t`; a triangle repeating a vertex (only a corrupt stream makes one:
-    // the retiler's front never meets itself that way) is an error.
-    let add_triangle = |t: [u32; 3],
-                        positions: &[DVec3],
-                        tris: &mut Vec<[u32; 3]>,
-                        fan: &mut Vec<DVec3>,
-                        built: &mut Vec<u32>|
-     -> Result<(), Error> {
-        if t[0] == t[1] || t[1] == t[2] || t[2] == t[0] {
-            return Err(Error::Corrupt(
-                "swing connectivity: a triangle repeats a vertex".into(),
-            ));
-        }
-        let [p0, p1, p2] = t.map(|v| positions[v as usize]);
-        let n = cross(sub(p1, p0), sub(p2, p0));
-        for v in t {
-            fan[v as usize] = add(fan[v as usize], n);
-            built[v as usize] = built[v as usize].saturating_add(1);
-        }
-        tris.push(t);
-        Ok(())
-    };
     for _ in 0..components {
-        if tris.len() + 1 > triangles {
+        if out.triangles.len() + 1 > triangles {
             return Err(corrupt("more triangles than announced"));
         }
         // The seed [x0, x1, x2]; the loop x0 -> x2 -> x1 -> x0, first gate x0 -> x2.
-        let first = positions.len() as u32;
+        let first = out.positions.len() as u32;
         for k in 0..3u32 {
             let mut g = [0i32; 3];
             io.seed(VertexId(first + k), bits, &mut g);
-            positions.push(params.quantizer.dequantize(g));
-            fan.push(DVec3::ZERO);
-            built.push(0);
+            out.add_vertex(params.quantizer.dequantize(g));
             front.add_vertex();
         }
         let (x0, x1, x2) = (first, first + 1, first + 2);
-        add_triangle([x0, x1, x2], &positions, &mut tris, &mut fan, &mut built)?;
+        out.add_triangle([x0, x1, x2])?;
         let n0 = front.add_node(x0, x1);
         let n2 = front.add_node(x2, x0);
         let n1 = front.add_node(x1, x2);
@@ -327,7 +347,7 @@ pub(super) fn front_walk<I: FrontIo>(
         front.link(n1, n0);
         let mut gate = n0;
         loop {
-            if tris.len() >= triangles {
+            if out.triangles.len() >= triangles {
                 return Err(corrupt("more triangles than announced"));
             }
             let an = gate;
@@ -339,39 +359,38 @@ pub(super) fn front_walk<I: FrontIo>(
             let (a, b) = (node_a.v, node_b.v);
             let (x, p) = (front.node(xn).v, front.node(pn).v);
             let three = xn == pn;
-            let (pa, pb) = (positions[a as usize], positions[b as usize]);
-            let (px, pp) = (positions[x as usize], positions[p as usize]);
+            let (pa, pb) = (out.positions[a as usize], out.positions[b as usize]);
+            let (px, pp) = (out.positions[x as usize], out.positions[p as usize]);
             // Gate end b closes with b⁺ (R), gate end a with a⁻ (L).
             let tri_r = cross(sub(pa, px), sub(pb, px));
             let tri_l = cross(sub(pa, pp), sub(pb, pp));
-            let side_b = (wedge_bin(pb, pa, px, tri_r, fan[b as usize]) * 3
-                + valence_bin(built[b as usize]))
+            let side_b = (wedge_bin(pb, pa, px, tri_r, out.fan[b as usize]) * 3
+                + valence_bin(out.built[b as usize]))
                 * 4
                 + length_bin(pa, px, inv_l2);
-            let side_a = (wedge_bin(pa, pb, pp, tri_l, fan[a as usize]) * 3
-                + valence_bin(built[a as usize]))
+            let side_a = (wedge_bin(pa, pb, pp, tri_l, out.fan[a as usize]) * 3
+                + valence_bin(out.built[a as usize]))
                 * 4
                 + length_bin(pb, pp, inv_l2);
             let ctx = (side_a * SIDE_CONTEXTS + side_b) * 2 + three as usize;
             let label = io.label(&mut labels, ctx)?;
             let next = match label {
                 Clers::C => {
-                    let Some(frame) = params.frame(pa, pb, positions[node_a.opp as usize]) else {
+                    let Some(frame) = params.frame(pa, pb, out.positions[node_a.opp as usize])
+                    else {
                         return Err(corrupt("a C on a gate without a swing (2L or flat)"));
                     };
                     let pred = predict_swing_scaled(
                         &frame,
-                        add(fan[a as usize], fan[b as usize]),
+                        add(out.fan[a as usize], out.fan[b as usize]),
                         &params.angles,
                     );
-                    let v = positions.len() as u32;
+                    let v = out.positions.len() as u32;
                     let mut q = 0i32;
                     io.index(VertexId(v), models.model(pred), pred, angle_bits, &mut q)?;
-                    positions.push(frame.tip(&params.angles, q));
-                    fan.push(DVec3::ZERO);
-                    built.push(0);
+                    out.add_vertex(frame.tip(&params.angles, q));
                     front.add_vertex();
-                    add_triangle([v, a, b], &positions, &mut tris, &mut fan, &mut built)?;
+                    out.add_triangle([v, a, b])?;
                     // Loop a -> v -> b: edge a -> v faces b, edge v -> b faces a.
                     front.nodes[an as usize].opp = b;
                     let vn = front.add_node(v, a);
@@ -388,13 +407,13 @@ pub(super) fn front_walk<I: FrontIo>(
                         }));
                     }
                     if label == Clers::L {
-                        add_triangle([p, a, b], &positions, &mut tris, &mut fan, &mut built)?;
+                        out.add_triangle([p, a, b])?;
                         front.nodes[an as usize].alive = false;
                         front.nodes[pn as usize].opp = a;
                         front.link(pn, bn);
                         Some(pn)
                     } else {
-                        add_triangle([x, a, b], &positions, &mut tris, &mut fan, &mut built)?;
+                        out.add_triangle([x, a, b])?;
                         front.nodes[bn as usize].alive = false;
                         if label == Clers::R {
                             front.nodes[an as usize].opp = b;
@@ -418,7 +437,7 @@ pub(super) fn front_walk<I: FrontIo>(
                         if split_work > split_budget || m == an {
                             return Err(corrupt("a front loop does not close"));
                         }
-                        let d = sub(positions[front.node(m).v as usize], target);
+                        let d = sub(out.positions[front.node(m).v as usize], target);
                         candidates.push((dot(d, d), candidates.len() as u32, m));
                         m = front.node(m).next;
                     }
@@ -426,8 +445,8 @@ pub(super) fn front_walk<I: FrontIo>(
                         &front,
                         &mut split,
                         &mut candidates,
-                        tris.len(),
-                        positions.len(),
+                        out.triangles.len(),
+                        out.positions.len(),
                     )?;
                     let node_w = *front
                         .nodes
@@ -437,7 +456,7 @@ pub(super) fn front_walk<I: FrontIo>(
                         return Err(corrupt("an S tip that is not another front node"));
                     }
                     let w = node_w.v;
-                    add_triangle([w, a, b], &positions, &mut tris, &mut fan, &mut built)?;
+                    out.add_triangle([w, a, b])?;
                     // W keeps its predecessor and gets b; a new node for w gets W's old
                     // successor and predecessor a.
                     let wnext = node_w.next;
@@ -460,12 +479,12 @@ pub(super) fn front_walk<I: FrontIo>(
             }
         }
     }
-    if tris.len() != triangles {
+    if out.triangles.len() != triangles {
         return Err(corrupt("fewer triangles than announced"));
     }
     Ok(FrontWalk {
-        positions,
-        triangles: tris,
-        fan,
+        positions: out.positions,
+        triangles: out.triangles,
+        fan: out.fan,
     })
 }
