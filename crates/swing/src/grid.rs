@@ -103,12 +103,21 @@ impl Cells {
 }
 
 impl Cells {
-    /// The keys of the cells overlapping the ball of radius `r` around `p`, with the squared
-    /// distance from `p` to each cell, nearest first (so a nearest-item search can stop as
-    /// soon as the next cell lies farther than the best item found).
-    pub fn by_distance(&self, p: DVec3, r: f64, out: &mut Vec<(f64, u64)>) {
+    /// The keys of the cells at squared distance at most `r2` from `p` (leaving out cell
+    /// `skip`), with that squared distance, nearest first (so a nearest-item search can stop
+    /// as soon as the next cell lies farther than the best item found).
+    pub fn by_squared_distance(
+        &self,
+        p: DVec3,
+        r2: f64,
+        skip: Option<u64>,
+        out: &mut Vec<(f64, u64)>,
+    ) {
         out.clear();
-        let d = DVec3::splat(r);
+        // The box of the ball, a hair wider so that rounding in the root cannot drop a cell
+        // at distance exactly `sqrt(r2)` (the test below is on squared distances).
+        let d = DVec3::splat(r2.sqrt() * (1.0 + 1e-9));
+        let r2 = r2.max(0.0);
         let a = self.cell(p - d);
         let b = self.cell(p + d);
         let size = 1.0 / self.inv;
@@ -130,8 +139,9 @@ impl Cells {
                 for k in a[2]..=b[2] {
                     let gz = gap(p.z, self.origin.z, k);
                     let d2 = gx * gx + gy * gy + gz * gz;
-                    if d2 <= r * r {
-                        out.push((d2, Self::key([i, j, k])));
+                    let key = Self::key([i, j, k]);
+                    if d2 <= r2 && Some(key) != skip {
+                        out.push((d2, key));
                     }
                 }
             }
@@ -150,23 +160,40 @@ pub(crate) struct StaticGrid {
 impl StaticGrid {
     /// Builds the grid from each item's box.
     pub fn build(cells: Cells, boxes: impl Iterator<Item = (DVec3, DVec3)>) -> StaticGrid {
-        let mut pairs: Vec<(u64, u32)> = Vec::new();
+        // (cell, item) in item order, each cell numbered at its first item; then a counting
+        // sort by cell, which keeps every cell's items in increasing order (what queries
+        // iterate, so the order of their results is fixed) without sorting the pairs.
+        let mut number: FastMap<u64, u32> = FastMap::default();
+        let mut keys: Vec<u64> = Vec::new();
+        let mut pairs: Vec<(u32, u32)> = Vec::new();
         for (id, (lo, hi)) in boxes.enumerate() {
-            cells.for_box(lo, hi, |k| pairs.push((k, id as u32)));
+            cells.for_box(lo, hi, |k| {
+                let next = keys.len() as u32;
+                let cell = *number.entry(k).or_insert(next);
+                if cell == next {
+                    keys.push(k);
+                }
+                pairs.push((cell, id as u32));
+            });
         }
-        pairs.sort_unstable();
+        let mut start = vec![0u32; keys.len() + 1];
+        for &(cell, _) in &pairs {
+            start[cell as usize + 1] += 1;
+        }
+        for c in 0..keys.len() {
+            start[c + 1] += start[c];
+        }
+        let mut fill = start.clone();
+        let mut items = vec![0u32; pairs.len()];
+        for &(cell, id) in &pairs {
+            let slot = &mut fill[cell as usize];
+            items[*slot as usize] = id;
+            *slot += 1;
+        }
         let mut ranges: FastMap<u64, (u32, u32)> = FastMap::default();
-        ranges.reserve(pairs.len() / 4 + 1);
-        let mut items = Vec::with_capacity(pairs.len());
-        let mut i = 0;
-        while i < pairs.len() {
-            let k = pairs[i].0;
-            let start = items.len() as u32;
-            while i < pairs.len() && pairs[i].0 == k {
-                items.push(pairs[i].1);
-                i += 1;
-            }
-            ranges.insert(k, (start, items.len() as u32));
+        ranges.reserve(keys.len());
+        for (c, &k) in keys.iter().enumerate() {
+            ranges.insert(k, (start[c], start[c + 1]));
         }
         StaticGrid {
             cells,
@@ -259,5 +286,55 @@ mod tests {
         g.near(DVec3::ZERO, 1.0, |id| found.push(id));
         found.sort();
         assert_eq!(found, vec![0, 2]);
+    }
+
+    #[test]
+    fn static_grid_lists_each_cells_items_in_increasing_order() {
+        // Boxes of several sizes, some spanning many cells; against a brute force over
+        // every item and every cell of its box.
+        let cells = Cells::new(DVec3::ZERO, 1.0);
+        let boxes: Vec<(DVec3, DVec3)> = (0..200)
+            .map(|i| {
+                let f = i as f64;
+                let lo = DVec3::new((f * 0.37) % 5.0, (f * 0.61) % 4.0, (f * 0.83) % 3.0);
+                (lo, lo + DVec3::splat(0.2 + (f * 0.13) % 2.0))
+            })
+            .collect();
+        let grid = StaticGrid::build(cells, boxes.iter().copied());
+        let mut expected: std::collections::BTreeMap<u64, Vec<u32>> = Default::default();
+        for (id, &(lo, hi)) in boxes.iter().enumerate() {
+            cells.for_box(lo, hi, |k| expected.entry(k).or_default().push(id as u32));
+        }
+        for (k, items) in &expected {
+            assert_eq!(grid.cell_items(*k), items.as_slice());
+        }
+        assert_eq!(
+            grid.items.len(),
+            expected.values().map(Vec::len).sum::<usize>()
+        );
+        assert!(grid.cell_items(Cells::key([40, 40, 40])).is_empty());
+    }
+
+    #[test]
+    fn cells_by_squared_distance_are_those_within_it_nearest_first() {
+        let cells = Cells::new(DVec3::ZERO, 1.0);
+        let p = DVec3::new(0.3, 0.9, 0.5);
+        let mut out = Vec::new();
+        cells.by_squared_distance(p, 0.2, None, &mut out);
+        // The home cell, the +y neighbour (0.1 away), the -x one (0.3 away) and the cell
+        // diagonal to both (squared 0.1); the z neighbours are 0.5 away.
+        let keys: Vec<u64> = out.iter().map(|c| c.1).collect();
+        assert_eq!(
+            keys,
+            vec![
+                Cells::key([0, 0, 0]),
+                Cells::key([0, 1, 0]),
+                Cells::key([-1, 0, 0]),
+                Cells::key([-1, 1, 0]),
+            ]
+        );
+        assert!(out.windows(2).all(|w| w[0].0 <= w[1].0));
+        cells.by_squared_distance(p, 0.2, Some(Cells::key([0, 0, 0])), &mut out);
+        assert_eq!(out.len(), 3);
     }
 }

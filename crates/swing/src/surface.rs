@@ -302,16 +302,10 @@ impl<'m> Surface<'m> {
         accept: impl Fn(usize) -> bool,
     ) -> Option<(f64, DVec3, u32)> {
         let mesh = self.mesh;
-        let mut cells = std::mem::take(&mut *self.cell_scratch.borrow_mut());
-        self.grid.cells.by_distance(p, radius, &mut cells);
         let mut best: Option<(f64, DVec3, u32)> = None;
         let limit = radius * radius;
-        for &(cell_d2, key) in &cells {
-            let bound = best.map_or(limit, |b| b.0);
-            if cell_d2 > bound {
-                break;
-            }
-            for &t in self.grid.cell_items(key) {
+        let scan = |items: &[u32], best: &mut Option<(f64, DVec3, u32)>| {
+            for &t in items {
                 let ti = t as usize;
                 if !accept(ti) {
                     continue;
@@ -326,14 +320,31 @@ impl<'m> Surface<'m> {
                 }
                 let x = closest_point_on_triangle(p, a, b, c);
                 let dist = (x - p).length_squared();
-                let better = match best {
+                let better = match *best {
                     None => dist <= limit,
                     Some((bd, _, bt)) => dist < bd || (dist == bd && t < bt),
                 };
                 if better {
-                    best = Some((dist, x, t));
+                    *best = Some((dist, x, t));
                 }
             }
+        };
+        // The cell holding `p` first: its best triangle usually bounds the search so tightly
+        // that no other cell is listed. The answer (the least distance, then the least
+        // triangle index, within `radius`) does not depend on the order cells are visited.
+        let home = Cells::key(self.grid.cells.cell(p));
+        scan(self.grid.cell_items(home), &mut best);
+        let mut cells = std::mem::take(&mut *self.cell_scratch.borrow_mut());
+        let bound = best.map_or(limit, |b| b.0);
+        self.grid
+            .cells
+            .by_squared_distance(p, bound, Some(home), &mut cells);
+        for &(cell_d2, key) in &cells {
+            let bound = best.map_or(limit, |b| b.0);
+            if cell_d2 > bound {
+                break;
+            }
+            scan(self.grid.cell_items(key), &mut best);
         }
         *self.cell_scratch.borrow_mut() = cells;
         best
@@ -366,5 +377,46 @@ impl<'m> Surface<'m> {
         radius: f64,
     ) -> Option<(DVec3, u32)> {
         self.nearest(p, comp, radius).map(|(_, x, t)| (x, t))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The nearest triangle by brute force: least squared distance within `radius`, ties to
+    /// the least index.
+    fn brute_nearest(mesh: &Mesh, p: DVec3, radius: f64) -> Option<(f64, u32)> {
+        let mut best: Option<(f64, u32)> = None;
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            let [a, b, c] = tri.map(|v| mesh.positions[v as usize]);
+            let d = (closest_point_on_triangle(p, a, b, c) - p).length_squared();
+            if d <= radius * radius && best.is_none_or(|(bd, _)| d < bd) {
+                best = Some((d, t as u32));
+            }
+        }
+        best
+    }
+
+    #[test]
+    fn nearest_matches_a_brute_force_search() {
+        // A sphere finer than the cells, points near it, inside it and far from it, radii
+        // that reach several cells or none.
+        let mesh = whet_testkit::meshes::icosphere(4);
+        let surf = Surface::new(&mesh, 0.3);
+        let mut checked = 0;
+        for i in 0..400 {
+            let f = i as f64;
+            let dir = DVec3::new((f * 0.731).sin(), (f * 1.37).cos(), (f * 0.417).sin())
+                .normalize_or_zero();
+            let p = dir * (0.2 + (f * 0.0113) % 1.6);
+            for radius in [0.05, 0.3, 1.0] {
+                let got = surf.nearest_where(p, radius, |_| true);
+                let want = brute_nearest(&mesh, p, radius);
+                assert_eq!(got.map(|g| (g.0, g.2)), want, "p {p:?} radius {radius}");
+                checked += want.is_some() as usize;
+            }
+        }
+        assert!(checked > 400, "{checked}");
     }
 }
