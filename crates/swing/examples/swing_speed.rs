@@ -11,32 +11,10 @@
 //! for `cargo run --release -p whet-codec --example decode_file -- <path>`.
 #![allow(clippy::unwrap_used)] // a measurement tool
 
-use std::collections::HashMap;
 use std::time::Instant;
 use whet_codec::{decode, DecodeOptions};
-use whet_mesh::Mesh;
 use whet_swing::{encode, Rate, SwingOptions};
-
-/// 1-to-4 midpoint subdivision (flat: the surface does not change, only the triangle count).
-fn split(m: &Mesh) -> Mesh {
-    let mut pos = m.positions.clone();
-    let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
-    let mut tris = Vec::with_capacity(m.triangles.len() * 4);
-    let mut get = |a: u32, b: u32, pos: &mut Vec<whet_mesh::DVec3>| {
-        let k = (a.min(b), a.max(b));
-        *mid.entry(k).or_insert_with(|| {
-            pos.push((pos[a as usize] + pos[b as usize]) * 0.5);
-            (pos.len() - 1) as u32
-        })
-    };
-    for &[a, b, c] in &m.triangles {
-        let ab = get(a, b, &mut pos);
-        let bc = get(b, c, &mut pos);
-        let ca = get(c, a, &mut pos);
-        tris.extend_from_slice(&[[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]);
-    }
-    Mesh::new(pos, tris)
-}
+use whet_testkit::meshes::split4;
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -48,7 +26,7 @@ fn main() {
         None => {
             let a =
                 whet_io::read_path(&whet_testkit::shared_fixture("armadillo.off"), None).unwrap();
-            (split(&split(&a)), 0.0037)
+            (split4(&split4(&a)), 0.0037)
         }
     };
     eprintln!(
