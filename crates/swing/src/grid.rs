@@ -46,6 +46,10 @@ const AXIS_BITS: u32 = 21;
 const AXIS_HALF: i64 = 1 << (AXIS_BITS - 1);
 const AXIS_MASK: u64 = (1 << AXIS_BITS) - 1;
 
+/// Most cells a triangle is registered in by its bounding box alone (a 4 x 4 x 4 block):
+/// more than any triangle of an original finer than the cells spans.
+const BOX_CELLS: u64 = 64;
+
 /// The mapping from positions to cells.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Cells {
@@ -85,6 +89,60 @@ impl Cells {
     pub fn key(c: [i64; 3]) -> u64 {
         let f = |v: i64| ((v + AXIS_HALF) as u64) & AXIS_MASK;
         (f(c[0]) << (2 * AXIS_BITS)) | (f(c[1]) << AXIS_BITS) | f(c[2])
+    }
+
+    /// Number of cells overlapping the box `[lo, hi]` (saturating).
+    fn box_cells(&self, lo: DVec3, hi: DVec3) -> u64 {
+        let (a, b) = (self.cell(lo), self.cell(hi));
+        (0..3).fold(1u64, |n, i| {
+            n.saturating_mul((b[i] - a[i] + 1).max(0) as u64)
+        })
+    }
+
+    /// Calls `f` with the keys of cells that together cover triangle `t`: the cells of its
+    /// box when they are few, as for any triangle of an original finer than the cells.
+    /// A larger triangle is split at its edge midpoints, recursively, until each piece's box
+    /// is small, so the cells follow the triangle instead of filling its box: a face
+    /// spanning the mesh, at a fine edge length, covers on the order of its area over the
+    /// cell size squared, not its box's volume (which ran to billions of cells). Keys come
+    /// sorted, each once, for the large ones.
+    pub fn for_triangle(&self, t: [DVec3; 3], mut f: impl FnMut(u64)) {
+        let (lo, hi) = (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2]));
+        if self.box_cells(lo, hi) <= BOX_CELLS {
+            self.for_box(lo, hi, f);
+            return;
+        }
+        let mut keys = Vec::new();
+        let mut pieces = vec![(t, 0u32)];
+        while let Some((p, depth)) = pieces.pop() {
+            let (lo, hi) = (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
+            // Depth 40 halves any finite extent far below one cell of the 2^21 per axis.
+            if self.box_cells(lo, hi) <= BOX_CELLS
+                || depth >= 40
+                || !(lo.is_finite() && hi.is_finite())
+            {
+                self.for_box(lo, hi, |k| keys.push(k));
+                continue;
+            }
+            let m = [
+                (p[0] + p[1]) * 0.5,
+                (p[1] + p[2]) * 0.5,
+                (p[2] + p[0]) * 0.5,
+            ];
+            for q in [
+                [p[0], m[0], m[2]],
+                [m[0], p[1], m[1]],
+                [m[2], m[1], p[2]],
+                [m[0], m[1], m[2]],
+            ] {
+                pieces.push((q, depth + 1));
+            }
+        }
+        keys.sort_unstable();
+        keys.dedup();
+        for k in keys {
+            f(k);
+        }
     }
 
     /// Calls `f` with the key of every cell overlapping the box `[lo, hi]`.
@@ -158,16 +216,17 @@ pub(crate) struct StaticGrid {
 }
 
 impl StaticGrid {
-    /// Builds the grid from each item's box.
-    pub fn build(cells: Cells, boxes: impl Iterator<Item = (DVec3, DVec3)>) -> StaticGrid {
+    /// Builds the grid of triangles (items numbered in order), each in the cells
+    /// [`Cells::for_triangle`] gives.
+    pub fn build(cells: Cells, triangles: impl Iterator<Item = [DVec3; 3]>) -> StaticGrid {
         // (cell, item) in item order, each cell numbered at its first item; then a counting
         // sort by cell, which keeps every cell's items in increasing order (what queries
         // iterate, so the order of their results is fixed) without sorting the pairs.
         let mut number: FastMap<u64, u32> = FastMap::default();
         let mut keys: Vec<u64> = Vec::new();
         let mut pairs: Vec<(u32, u32)> = Vec::new();
-        for (id, (lo, hi)) in boxes.enumerate() {
-            cells.for_box(lo, hi, |k| {
+        for (id, t) in triangles.enumerate() {
+            cells.for_triangle(t, |k| {
                 let next = keys.len() as u32;
                 let cell = *number.entry(k).or_insert(next);
                 if cell == next {
@@ -290,20 +349,21 @@ mod tests {
 
     #[test]
     fn static_grid_lists_each_cells_items_in_increasing_order() {
-        // Boxes of several sizes, some spanning many cells; against a brute force over
-        // every item and every cell of its box.
+        // Triangles of several sizes, some spanning many cells; against a brute force over
+        // every item and the cells `for_triangle` gives it.
         let cells = Cells::new(DVec3::ZERO, 1.0);
-        let boxes: Vec<(DVec3, DVec3)> = (0..200)
+        let triangles: Vec<[DVec3; 3]> = (0..200)
             .map(|i| {
                 let f = i as f64;
-                let lo = DVec3::new((f * 0.37) % 5.0, (f * 0.61) % 4.0, (f * 0.83) % 3.0);
-                (lo, lo + DVec3::splat(0.2 + (f * 0.13) % 2.0))
+                let a = DVec3::new((f * 0.37) % 5.0, (f * 0.61) % 4.0, (f * 0.83) % 3.0);
+                let size = 0.2 + (f * 0.13) % 2.0 + if i % 50 == 7 { 9.0 } else { 0.0 };
+                [a, a + DVec3::X * size, a + DVec3::new(0.3, 1.0, 0.7) * size]
             })
             .collect();
-        let grid = StaticGrid::build(cells, boxes.iter().copied());
+        let grid = StaticGrid::build(cells, triangles.iter().copied());
         let mut expected: std::collections::BTreeMap<u64, Vec<u32>> = Default::default();
-        for (id, &(lo, hi)) in boxes.iter().enumerate() {
-            cells.for_box(lo, hi, |k| expected.entry(k).or_default().push(id as u32));
+        for (id, &t) in triangles.iter().enumerate() {
+            cells.for_triangle(t, |k| expected.entry(k).or_default().push(id as u32));
         }
         for (k, items) in &expected {
             assert_eq!(grid.cell_items(*k), items.as_slice());
@@ -313,6 +373,42 @@ mod tests {
             expected.values().map(Vec::len).sum::<usize>()
         );
         assert!(grid.cell_items(Cells::key([40, 40, 40])).is_empty());
+    }
+
+    #[test]
+    fn a_large_triangle_is_in_every_cell_it_crosses_and_few_others() {
+        let cells = Cells::new(DVec3::ZERO, 1.0);
+        for t in [
+            // A face across a 100-cell box, a needle along its diagonal, a flat one.
+            [
+                DVec3::ZERO,
+                DVec3::new(100.0, 0.0, 0.0),
+                DVec3::new(0.0, 100.0, 100.0),
+            ],
+            [
+                DVec3::ZERO,
+                DVec3::splat(100.0),
+                DVec3::splat(100.0) + DVec3::X * 1e-3,
+            ],
+            [
+                DVec3::new(0.5, 0.5, 0.5),
+                DVec3::new(60.5, 0.5, 0.5),
+                DVec3::new(0.5, 60.5, 0.5),
+            ],
+        ] {
+            let mut keys = std::collections::HashSet::new();
+            cells.for_triangle(t, |k| assert!(keys.insert(k)));
+            let n = 400;
+            for i in 0..=n {
+                for j in 0..=n - i {
+                    let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
+                    let p = t[0] + (t[1] - t[0]) * u + (t[2] - t[0]) * v;
+                    assert!(keys.contains(&Cells::key(cells.cell(p))), "{p:?}");
+                }
+            }
+            // Area over cell size squared, not the box's up to 10^6 cells.
+            assert!(keys.len() < 60_000, "{}", keys.len());
+        }
     }
 
     #[test]

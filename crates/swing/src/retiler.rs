@@ -90,6 +90,11 @@ pub struct RetileTuning {
     /// its vertex's valence 6 or more, and shrinks by it when the valence would stay
     /// under 6.
     pub valence_bias: f64,
+    /// Largest retiling attempted: an edge length at which the original's area would need
+    /// more triangles than this (`2.4 A / L²`) is refused before any work, so an absurdly
+    /// short `L` gets an error instead of exhausting memory (the retiler needs about
+    /// 450 bytes per retiled triangle).
+    pub max_triangles: usize,
 }
 
 impl RetileTuning {
@@ -107,6 +112,7 @@ impl RetileTuning {
         bridge: 0.35,
         off_surface: 0.35,
         valence_bias: 45.0 * PI / 180.0,
+        max_triangles: 1 << 24,
     };
 }
 
@@ -127,6 +133,12 @@ impl RetileTuning {
     /// Sets the valence bias of the closing angle (radians).
     pub const fn with_valence_bias(mut self, bias: f64) -> Self {
         self.valence_bias = bias;
+        self
+    }
+
+    /// Sets the largest retiling attempted (triangles expected from the area).
+    pub const fn with_max_triangles(mut self, triangles: usize) -> Self {
+        self.max_triangles = triangles;
         self
     }
 
@@ -308,6 +320,18 @@ pub(crate) fn retile_fitted(
     fit: bool,
 ) -> Result<Retiled, Error> {
     let l = params.edge_length;
+    // Expected triangles: 2.4 · area / L² (algorithms.md 1.9). Checked first: the grid of
+    // the original and the retiling both grow with it.
+    let mesh_area = mesh.area();
+    let expected = 2.4 * mesh_area / (l * l);
+    if expected.is_nan() || expected > tune.max_triangles as f64 {
+        return Err(Error::Parameter(format!(
+            "an edge length of {l:e} would retile this mesh (area {mesh_area:e}) into about \
+             {expected:.3e} triangles, more than the limit of {}: choose a longer edge length \
+             or a lower rate",
+            tune.max_triangles
+        )));
+    }
     // Originals with boundaries: retile the surface with its holes capped, then delete the
     // retiled triangles over the caps (holes.rs).
     let capped = crate::holes::cap_holes(mesh, l);

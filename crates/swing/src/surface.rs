@@ -91,10 +91,9 @@ impl<'m> Surface<'m> {
         let cells = Cells::new(bbox.min, cell.max(1e-300));
         let grid = StaticGrid::build(
             cells,
-            mesh.triangles.iter().map(|t| {
-                let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
-                (a.min(b).min(c), a.max(b).max(c))
-            }),
+            mesh.triangles
+                .iter()
+                .map(|t| t.map(|v| mesh.positions[v as usize])),
         );
         Surface {
             mesh,

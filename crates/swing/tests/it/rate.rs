@@ -88,6 +88,49 @@ fn bad_rates_are_parameter_errors() {
 }
 
 #[test]
+fn edge_lengths_too_short_for_the_mesh_are_refused_before_any_work() {
+    // A tetrahedron of four faces each spanning the whole box. At 1e-5 of the diagonal it
+    // would need about 1.9e10 triangles: refused at once, by the area law. (Before the
+    // check, and before the grid followed large faces, 1e-3 alone took minutes and 14 GB
+    // in the original's grid.)
+    let tet = whet_mesh::Mesh::new(
+        vec![
+            whet_mesh::DVec3::ZERO,
+            whet_mesh::DVec3::X,
+            whet_mesh::DVec3::Y,
+            whet_mesh::DVec3::Z,
+        ],
+        vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+    );
+    for rate in [Rate::EdgeLength(1e-5), Rate::TargetBytes(1 << 40)] {
+        let start = std::time::Instant::now();
+        let e = encode(&tet, &SwingOptions::DEFAULT.with_rate(rate)).unwrap_err();
+        assert!(
+            matches!(e, whet_swing::Error::Parameter(_)),
+            "{rate:?}: {e}"
+        );
+        assert!(e.to_string().contains("more than the limit"), "{e}");
+        // Generous: a refusal is instant, a started retiling takes minutes.
+        assert!(start.elapsed().as_secs() < 30, "{rate:?}");
+    }
+    // The limit is a tuning knob: a lower one refuses a length the default accepts.
+    let tight = whet_swing::RetileTuning::DEFAULT.with_max_triangles(1000);
+    let e = encode(
+        &tet,
+        &SwingOptions::DEFAULT
+            .with_rate(Rate::EdgeLength(0.02))
+            .with_tuning(tight),
+    )
+    .unwrap_err();
+    assert!(matches!(e, whet_swing::Error::Parameter(_)), "{e}");
+    encode(
+        &tet,
+        &SwingOptions::DEFAULT.with_rate(Rate::EdgeLength(0.02)),
+    )
+    .unwrap();
+}
+
+#[test]
 fn automatic_angle_bits_climb_on_flat_parts_and_stay_low_on_smooth_ones() {
     // cad_box_hole: flat faces predict their swing angles almost exactly, so extra angle
     // bits are nearly free there and remove the quantization noise the sharpener leaves
