@@ -12,7 +12,7 @@ fn main() -> ExitCode {
     match cli::run(args) {
         Ok(()) => ExitCode::SUCCESS,
         Err(failure) => {
-            eprintln!("whet: {:#}", failure.error);
+            eprintln!("whet: {}", cli::error_chain(&failure.error));
             ExitCode::from(failure.code)
         }
     }

@@ -97,6 +97,24 @@ impl Failure {
 
 pub type CliResult<T = ()> = Result<T, Failure>;
 
+/// The message of `error` with its causes, `: `-separated, leaving out a cause whose text
+/// the message already holds: the library errors quote their source (`I/O error: {0}`) so
+/// that they read whole on their own, and anyhow's chain would print it a second time.
+pub fn error_chain(error: &anyhow::Error) -> String {
+    let mut out = String::new();
+    for cause in error.chain() {
+        let text = cause.to_string();
+        if out.contains(&text) {
+            continue;
+        }
+        if !out.is_empty() {
+            out.push_str(": ");
+        }
+        out.push_str(&text);
+    }
+    out
+}
+
 pub fn run(cli: Cli) -> CliResult {
     match cli.command {
         Command::Info(a) => info::run(&a),
@@ -161,5 +179,24 @@ pub fn write_stdout(text: &str) {
         }
         eprintln!("whet: cannot write to stdout: {e}");
         std::process::exit(EXIT_FAILURE as i32);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_cause_the_message_quotes_is_printed_once() {
+        let io = std::io::Error::new(std::io::ErrorKind::NotFound, "no such file");
+        let read = whet_io::Error::from(io);
+        let e = anyhow::Error::new(read).context("cannot read x.off");
+        assert_eq!(
+            error_chain(&e),
+            "cannot read x.off: I/O error: no such file"
+        );
+        // A cause that adds something is kept.
+        let e = anyhow::anyhow!("inner detail").context("outer");
+        assert_eq!(error_chain(&e), "outer: inner detail");
     }
 }

@@ -246,13 +246,31 @@ pub fn bend(mesh: &Mesh, sharp_edges: &[[u32; 2]]) -> Result<Bent, Error> {
     tagged.dedup();
     let is_tagged = |a: u32, b: u32| tagged.binary_search(&edge_key(a, b)).is_ok();
 
+    // A pillow: two triangles over the same three vertices, back to back (whet-swing codes a
+    // component smaller than L that way). Split, they would give every inner edge four
+    // triangles (both halves share the edge points), so they pass through unchanged.
+    let pillow: Vec<bool> = (0..table.triangle_count())
+        .map(|t| {
+            let first = table
+                .opposite(CornerId(3 * t as u32))
+                .map(|o| o.index() / 3);
+            first.is_some()
+                && (1..3).all(|k| {
+                    table
+                        .opposite(CornerId((3 * t + k) as u32))
+                        .map(|o| o.index() / 3)
+                        == first
+                })
+        })
+        .collect();
+
     // Edges: one id per undirected edge, assigned to both corners facing it.
     let mut edge_of_corner = vec![NONE; nc];
     let mut edge_corner: Vec<u32> = Vec::with_capacity(nc / 2 + 1);
     let mut sharp_corner = vec![false; nc];
     let mut sharp_nbrs: Vec<Vec<u32>> = vec![Vec::new(); nv];
     for c in table.corners() {
-        if edge_of_corner[c.index()] != NONE {
+        if edge_of_corner[c.index()] != NONE || pillow[c.index() / 3] {
             continue;
         }
         let id = edge_corner.len() as u32;
@@ -305,6 +323,10 @@ pub fn bend(mesh: &Mesh, sharp_edges: &[[u32; 2]]) -> Result<Bent, Error> {
         let c0 = CornerId((3 * t) as u32);
         let (c1, c2) = (table.next(c0), table.prev(c0));
         let [v0, v1, v2] = [c0, c1, c2].map(|c| table.vertex(c).0);
+        if pillow[t] {
+            triangles.push([v0, v1, v2]);
+            continue;
+        }
         // The edge point facing corner c lies between the other two vertices.
         let m = |c: CornerId| nv as u32 + edge_of_corner[c.index()];
         let (m12, m20, m01) = (m(c0), m(c1), m(c2));
@@ -323,6 +345,16 @@ pub fn bend(mesh: &Mesh, sharp_edges: &[[u32; 2]]) -> Result<Bent, Error> {
             let m = (nv + id) as u32;
             out_sharp.push([a.min(m), a.max(m)]);
             out_sharp.push([b.min(m), b.max(m)]);
+        }
+    }
+    // A pillow's tagged edges stay tagged (the pillow is unchanged).
+    for c in table.corners() {
+        if pillow[c.index() / 3] && table.opposite(c).is_some_and(|o| c.0 < o.0) {
+            let a = table.vertex(table.next(c)).0;
+            let b = table.vertex(table.prev(c)).0;
+            if is_tagged(a, b) {
+                out_sharp.push([a.min(b), a.max(b)]);
+            }
         }
     }
     out_sharp.sort_unstable();

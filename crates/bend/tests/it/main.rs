@@ -236,3 +236,44 @@ fn tags_that_are_not_edges_are_ignored_and_bad_input_refused() {
     nan.positions[0].x = f64::NAN;
     assert!(bend(&nan, &[]).is_err());
 }
+
+#[test]
+fn a_pillow_component_passes_through_and_the_rest_bends_as_alone() {
+    // whet-swing codes a component smaller than L as a pillow: two triangles over the same
+    // three vertices. Splitting it gave each inner edge four triangles, and the next level
+    // refused the mesh.
+    let sphere = icosphere(1);
+    let n = sphere.positions.len() as u32;
+    let mut both = sphere.clone();
+    both.positions.extend([
+        DVec3::new(3.0, 0.0, 0.0),
+        DVec3::new(4.0, 0.0, 0.0),
+        DVec3::new(3.0, 1.0, 0.0),
+    ]);
+    both.triangles
+        .extend([[n, n + 1, n + 2], [n + 1, n, n + 2]]);
+    let tags = [[n, n + 1]];
+    let alone = bend_levels(&sphere, &[], 3).unwrap();
+    let out = bend_levels(&both, &tags, 3).unwrap();
+    let r = out.mesh.topology_report();
+    assert!(r.manifold && r.oriented, "{r:?}");
+    // The sphere part: the same triangles and positions as bending it alone, the pillow
+    // after it, unchanged, with its tag.
+    let pillow_tris: Vec<[u32; 3]> = out
+        .mesh
+        .triangles
+        .iter()
+        .filter(|t| t.iter().all(|&v| (n..n + 3).contains(&v)))
+        .copied()
+        .collect();
+    assert_eq!(pillow_tris, vec![[n, n + 1, n + 2], [n + 1, n, n + 2]]);
+    assert_eq!(
+        out.mesh.triangles.len(),
+        alone.mesh.triangles.len() + 2,
+        "only the pillow is left unsplit"
+    );
+    for p in &alone.mesh.positions {
+        assert!(out.mesh.positions.contains(p), "{p:?}");
+    }
+    assert!(out.sharp_edges.contains(&[n, n + 1]));
+}
