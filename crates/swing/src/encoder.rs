@@ -295,8 +295,15 @@ impl SwingEncoder {
         let diagonal = p.mesh.diagonal();
         if diagonal.is_nan() || diagonal <= 0.0 {
             return Err(Error::InvalidInput(
-                "the mesh has no extent (all vertices coincide)".into(),
+                "the mesh has no extent (all vertices coincide, or its size underflows)".into(),
             ));
+        }
+        // Lengths, areas and the seed grid are all measured against the diagonal.
+        if diagonal.is_infinite() || !p.mesh.area().is_finite() {
+            return Err(Error::InvalidInput(format!(
+                "the mesh is too large to retile: its bounding-box diagonal or area overflows \
+                 (diagonal {diagonal:e}); scale it down, or use --mode exact"
+            )));
         }
         let prep = Prepared {
             area: p.mesh.area(),

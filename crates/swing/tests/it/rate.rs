@@ -131,6 +131,32 @@ fn edge_lengths_too_short_for_the_mesh_are_refused_before_any_work() {
 }
 
 #[test]
+fn meshes_whose_size_overflows_or_underflows_are_input_errors() {
+    let tet = |s: f64| {
+        whet_mesh::Mesh::new(
+            vec![
+                whet_mesh::DVec3::ZERO,
+                whet_mesh::DVec3::X * s,
+                whet_mesh::DVec3::Y * s,
+                whet_mesh::DVec3::Z * s,
+            ],
+            vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+        )
+    };
+    for (scale, says) in [
+        (1e300, "too large"),
+        (1e200, "too large"),
+        (1e-300, "no extent"),
+    ] {
+        let e = encode(&tet(scale), &SwingOptions::DEFAULT).unwrap_err();
+        assert!(e.is_input_error(), "{scale}: {e}");
+        assert!(e.to_string().contains(says), "{scale}: {e}");
+    }
+    encode(&tet(1e30), &SwingOptions::DEFAULT).unwrap();
+    encode(&tet(1e-30), &SwingOptions::DEFAULT).unwrap();
+}
+
+#[test]
 fn automatic_angle_bits_climb_on_flat_parts_and_stay_low_on_smooth_ones() {
     // cad_box_hole: flat faces predict their swing angles almost exactly, so extra angle
     // bits are nearly free there and remove the quantization noise the sharpener leaves
