@@ -506,8 +506,13 @@ impl SwingEncoder {
     /// resolve thin parts better, so the retries lean that way).
     fn encode_near(&self, prep: &Prepared, fraction: f64) -> Result<SwingOutput, Error> {
         const FACTORS: [f64; 8] = [1.0, 0.985, 1.015, 0.96, 0.93, 0.9, 0.85, 0.8];
+        let floor = self.min_fraction(prep);
         let mut last = None;
         for k in FACTORS {
+            // A retry never goes under the retiling size limit (the first try reports it).
+            if k != 1.0 && fraction * k < floor {
+                continue;
+            }
             match self.encode_at(prep, fraction * k) {
                 Ok(out) => return Ok(out),
                 Err(e @ (Error::Stuck(_) | Error::Internal(_))) => last = Some(e),
@@ -515,6 +520,14 @@ impl SwingEncoder {
             }
         }
         Err(last.unwrap_or_else(|| Error::Stuck("no retiling succeeded".into())))
+    }
+
+    /// The shortest edge-length fraction the retiler accepts on `prep`
+    /// ([`RetileTuning::max_triangles`] by the area law), a hair above: the searches stay at
+    /// or above it, so a target out of reach ends the search with the best stream found.
+    fn min_fraction(&self, prep: &Prepared) -> f64 {
+        let max = self.opts.tuning.max_triangles.max(1) as f64;
+        (2.4 * prep.area / max).sqrt() / prep.diagonal * (1.0 + 1e-9)
     }
 
     /// First guess of the edge-length fraction for a stream of `bytes`: `T' ≈ 2.4 A / L²`
@@ -538,9 +551,18 @@ impl SwingEncoder {
         let mut search = Vec::new();
         let mut best: Option<SwingOutput> = None;
         let mut prev: Option<(f64, f64)> = None; // (ln L, ln bytes)
-        let mut f = start
-            .filter(|f| f.is_finite() && *f > 0.0)
-            .unwrap_or_else(|| Self::guess_fraction(prep, target));
+        let floor = self.min_fraction(prep);
+        let start = start.filter(|f| f.is_finite() && *f > 0.0);
+        let guess = start.unwrap_or_else(|| Self::guess_fraction(prep, target));
+        // A size the area law puts well past the retiling limit: refused before any work.
+        if start.is_none() && guess < 0.5 * floor {
+            return Err(crate::retiler::too_many_triangles(
+                guess * prep.diagonal,
+                prep.area,
+                self.opts.tuning.max_triangles,
+            ));
+        }
+        let mut f = guess.max(floor);
         for _ in 0..self.opts.max_iterations.max(1) {
             let out = self.encode_near(prep, f)?;
             let size = out.bytes.len();
@@ -565,7 +587,12 @@ impl SwingEncoder {
             prev = Some((x, y));
             let nx = x + (goal - y) / slope;
             // Damp jumps: at most a factor 3 per step.
-            f = nx.clamp(x - 1.1, x + 1.1).exp().clamp(1e-5, 0.7);
+            let next = nx.clamp(x - 1.1, x + 1.1).exp().clamp(1e-5, 0.7);
+            // Past the size limit: the target is out of reach, the best stream stands.
+            if next < floor && f <= floor {
+                break;
+            }
+            f = next.max(floor);
         }
         let mut out = best.ok_or_else(|| Error::Stuck("the size search ran no retiling".into()))?;
         out.search = search;
@@ -618,7 +645,9 @@ impl SwingEncoder {
         let mut best_ok: Option<SwingOutput> = None;
         let mut best_any: Option<SwingOutput> = None;
         // RMS ≈ c L² for flattening-dominated error; start from 1 % of the diagonal.
-        let mut f = 0.01f64;
+        let floor = self.min_fraction(prep);
+        let mut f = 0.01f64.max(floor);
+        let mut limited = false;
         let mut lo_ok = 0.0f64; // largest fraction known to meet the target
         let mut hi_bad = f64::INFINITY; // smallest fraction known to miss it
         for _ in 0..self.opts.max_iterations.max(1) {
@@ -669,16 +698,32 @@ impl SwingEncoder {
             if hi_bad.is_finite() && lo_ok > 0.0 && hi_bad / lo_ok < 1.02 {
                 break;
             }
-            f = next.clamp(1e-5, 0.7);
+            let next = next.clamp(1e-5, 0.7);
+            // Past the size limit: the target is out of reach (the law puts it well past
+            // the limit, or the shortest length allowed was tried).
+            if next < 0.5 * floor || (next < floor && f <= floor) {
+                limited = true;
+                break;
+            }
+            f = next.max(floor);
         }
         let mut out = match best_ok {
             Some(o) => o,
             None => {
+                let limit = if limited {
+                    format!(
+                        "; shorter lengths would need more than the limit of {} retiled \
+                         triangles",
+                        self.opts.tuning.max_triangles
+                    )
+                } else {
+                    String::new()
+                };
                 return Err(Error::Unreachable(format!(
                     "no edge length reached an RMS error of {target} % of the diagonal \
-                     (best: {:.4} %)",
+                     (best: {:.4} %){limit}",
                     best_any.and_then(|o| o.rms_pct).unwrap_or(f64::NAN)
-                )))
+                )));
             }
         };
         out.search = search;

@@ -101,41 +101,45 @@ impl Cells {
 
     /// Calls `f` with the keys of cells that together cover triangle `t`: the cells of its
     /// box when they are few, as for any triangle of an original finer than the cells.
-    /// A larger triangle is split at its edge midpoints, recursively, until each piece's box
-    /// is small, so the cells follow the triangle instead of filling its box: a face
-    /// spanning the mesh, at a fine edge length, covers on the order of its area over the
-    /// cell size squared, not its box's volume (which ran to billions of cells). Keys come
-    /// sorted, each once, for the large ones.
+    /// A larger triangle is cut in two at the middle of its longest edge, recursively,
+    /// until each piece's box is small, so the cells follow the triangle instead of filling
+    /// its box: a face spanning the mesh, at a fine edge length, covers on the order of its
+    /// area over the cell size squared, and a long thin one of its length over the cell
+    /// size, not its box's volume (which ran to billions of cells). Bisecting the longest
+    /// edge keeps the pieces' shapes from degenerating, so their number is proportional
+    /// to those measures (cutting into four similar pieces would make a thin triangle's
+    /// count grow with the square of its length). Keys come sorted, each once, for the
+    /// large ones.
     pub fn for_triangle(&self, t: [DVec3; 3], mut f: impl FnMut(u64)) {
-        let (lo, hi) = (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2]));
-        if self.box_cells(lo, hi) <= BOX_CELLS {
+        let small = |p: &[DVec3; 3]| {
+            let (lo, hi) = (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
+            // Non-finite pieces go to their box at once: `cell` clamps them.
+            (self.box_cells(lo, hi) <= BOX_CELLS || !(lo.is_finite() && hi.is_finite()))
+                .then_some((lo, hi))
+        };
+        if let Some((lo, hi)) = small(&t) {
             self.for_box(lo, hi, f);
             return;
         }
         let mut keys = Vec::new();
         let mut pieces = vec![(t, 0u32)];
         while let Some((p, depth)) = pieces.pop() {
-            let (lo, hi) = (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
-            // Depth 40 halves any finite extent far below one cell of the 2^21 per axis.
-            if self.box_cells(lo, hi) <= BOX_CELLS
-                || depth >= 40
-                || !(lo.is_finite() && hi.is_finite())
-            {
-                self.for_box(lo, hi, |k| keys.push(k));
-                continue;
-            }
-            let m = [
-                (p[0] + p[1]) * 0.5,
-                (p[1] + p[2]) * 0.5,
-                (p[2] + p[0]) * 0.5,
-            ];
-            for q in [
-                [p[0], m[0], m[2]],
-                [m[0], p[1], m[1]],
-                [m[2], m[1], p[2]],
-                [m[0], m[1], m[2]],
-            ] {
-                pieces.push((q, depth + 1));
+            // 128 halvings shrink any finite edge far below one cell of the 2^21 per axis.
+            match small(&p) {
+                Some((lo, hi)) => self.for_box(lo, hi, |k| keys.push(k)),
+                None if depth >= 128 => {
+                    let (lo, hi) = (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
+                    self.for_box(lo, hi, |k| keys.push(k));
+                }
+                None => {
+                    // The longest edge is p[i] -> p[i + 1].
+                    let len = |i: usize| (p[(i + 1) % 3] - p[i]).length_squared();
+                    let i = (0..3).fold(0, |b, i| if len(i) > len(b) { i } else { b });
+                    let (a, b, c) = (p[i], p[(i + 1) % 3], p[(i + 2) % 3]);
+                    let m = (a + b) * 0.5;
+                    pieces.push(([a, m, c], depth + 1));
+                    pieces.push(([m, b, c], depth + 1));
+                }
             }
         }
         keys.sort_unstable();
@@ -172,30 +176,18 @@ impl Cells {
         out: &mut Vec<(f64, u64)>,
     ) {
         out.clear();
-        // The box of the ball, a hair wider so that rounding in the root cannot drop a cell
-        // at distance exactly `sqrt(r2)` (the test below is on squared distances).
-        let d = DVec3::splat(r2.sqrt() * (1.0 + 1e-9));
         let r2 = r2.max(0.0);
-        let a = self.cell(p - d);
-        let b = self.cell(p + d);
-        let size = 1.0 / self.inv;
-        let gap = |x: f64, o: f64, c: i64| {
-            let lo = o + c as f64 * size;
-            let hi = lo + size;
-            if x < lo {
-                lo - x
-            } else if x > hi {
-                x - hi
-            } else {
-                0.0
-            }
-        };
-        for i in a[0]..=b[0] {
-            let gx = gap(p.x, self.origin.x, i);
-            for j in a[1]..=b[1] {
-                let gy = gap(p.y, self.origin.y, j);
-                for k in a[2]..=b[2] {
-                    let gz = gap(p.z, self.origin.z, k);
+        // The cells of the ball's box and one more on every side: `cell`'s rounding and the
+        // gap's may disagree by an ulp at a cell face, and the test below (squared gaps,
+        // the measure a nearest search bounds by) decides.
+        let d = DVec3::splat(r2.sqrt());
+        let (a, b) = (self.cell(p - d), self.cell(p + d));
+        for i in a[0] - 1..=b[0] + 1 {
+            let gx = self.axis_gap(p.x, self.origin.x, i);
+            for j in a[1] - 1..=b[1] + 1 {
+                let gy = self.axis_gap(p.y, self.origin.y, j);
+                for k in a[2] - 1..=b[2] + 1 {
+                    let gz = self.axis_gap(p.z, self.origin.z, k);
                     let d2 = gx * gx + gy * gy + gz * gz;
                     let key = Self::key([i, j, k]);
                     if d2 <= r2 && Some(key) != skip {
@@ -205,6 +197,31 @@ impl Cells {
             }
         }
         out.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+    }
+
+    /// Squared distance from `p` to cell `c` (0 inside it).
+    pub fn squared_gap(&self, p: DVec3, c: [i64; 3]) -> f64 {
+        let g = [
+            self.axis_gap(p.x, self.origin.x, c[0]),
+            self.axis_gap(p.y, self.origin.y, c[1]),
+            self.axis_gap(p.z, self.origin.z, c[2]),
+        ];
+        g[0] * g[0] + g[1] * g[1] + g[2] * g[2]
+    }
+
+    /// Distance along one axis from coordinate `x` to cell `c` of that axis (origin `o`).
+    #[inline]
+    fn axis_gap(&self, x: f64, o: f64, c: i64) -> f64 {
+        let size = 1.0 / self.inv;
+        let lo = o + c as f64 * size;
+        let hi = lo + size;
+        if x < lo {
+            lo - x
+        } else if x > hi {
+            x - hi
+        } else {
+            0.0
+        }
     }
 }
 
@@ -395,6 +412,12 @@ mod tests {
                 DVec3::new(60.5, 0.5, 0.5),
                 DVec3::new(0.5, 60.5, 0.5),
             ],
+            // Long and thin, off the axes: cells in proportion to its length.
+            [
+                DVec3::ZERO,
+                DVec3::new(3000.0, 2000.0, 1000.0),
+                DVec3::new(0.0, 0.7, 0.7),
+            ],
         ] {
             let mut keys = std::collections::HashSet::new();
             cells.for_triangle(t, |k| assert!(keys.insert(k)));
@@ -406,7 +429,8 @@ mod tests {
                     assert!(keys.contains(&Cells::key(cells.cell(p))), "{p:?}");
                 }
             }
-            // Area over cell size squared, not the box's up to 10^6 cells.
+            // Area over cell size squared (or length over cell size), not the box's up to
+            // 6 * 10^9 cells.
             assert!(keys.len() < 60_000, "{}", keys.len());
         }
     }

@@ -302,6 +302,17 @@ struct Retiler<'s, 'm> {
     stats: RetileStats,
 }
 
+/// The error for an edge length `l` at which a surface of area `area` needs more than
+/// `max` retiled triangles by the area law.
+pub(crate) fn too_many_triangles(l: f64, area: f64, max: usize) -> Error {
+    let expected = 2.4 * area / (l * l);
+    Error::Parameter(format!(
+        "an edge length of {l:e} would retile this mesh (area {area:e}) into about \
+         {expected:.3e} triangles, more than the limit of {max}: choose a longer edge length \
+         or a lower rate"
+    ))
+}
+
 /// Retiles `mesh` with the edge length and grids of `params` (see the module docs).
 pub fn retile(
     mesh: &whet_mesh::Mesh,
@@ -325,12 +336,7 @@ pub(crate) fn retile_fitted(
     let mesh_area = mesh.area();
     let expected = 2.4 * mesh_area / (l * l);
     if expected.is_nan() || expected > tune.max_triangles as f64 {
-        return Err(Error::Parameter(format!(
-            "an edge length of {l:e} would retile this mesh (area {mesh_area:e}) into about \
-             {expected:.3e} triangles, more than the limit of {}: choose a longer edge length \
-             or a lower rate",
-            tune.max_triangles
-        )));
+        return Err(too_many_triangles(l, mesh_area, tune.max_triangles));
     }
     // Originals with boundaries: retile the surface with its holes capped, then delete the
     // retiled triangles over the caps (holes.rs).

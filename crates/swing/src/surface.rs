@@ -331,13 +331,19 @@ impl<'m> Surface<'m> {
         // The cell holding `p` first: its best triangle usually bounds the search so tightly
         // that no other cell is listed. The answer (the least distance, then the least
         // triangle index, within `radius`) does not depend on the order cells are visited.
-        let home = Cells::key(self.grid.cells.cell(p));
-        scan(self.grid.cell_items(home), &mut best);
+        // (Only when within `radius` by the cells' own measure: a point beyond the grid's
+        // clamped range lies in no cell.)
+        let home_cell = self.grid.cells.cell(p);
+        let home = Cells::key(home_cell);
+        let scanned = self.grid.cells.squared_gap(p, home_cell) <= limit;
+        if scanned {
+            scan(self.grid.cell_items(home), &mut best);
+        }
         let mut cells = std::mem::take(&mut *self.cell_scratch.borrow_mut());
         let bound = best.map_or(limit, |b| b.0);
         self.grid
             .cells
-            .by_squared_distance(p, bound, Some(home), &mut cells);
+            .by_squared_distance(p, bound, scanned.then_some(home), &mut cells);
         for &(cell_d2, key) in &cells {
             let bound = best.map_or(limit, |b| b.0);
             if cell_d2 > bound {
@@ -417,5 +423,11 @@ mod tests {
             }
         }
         assert!(checked > 400, "{checked}");
+        // Beyond the grid's clamped range (2^20 cells of 0.3): nothing within the radius,
+        // and the border cell the point is clamped into is no answer either. (Radii are at
+        // most a few L: the search enumerates the cells of the radius's box.)
+        for p in [DVec3::new(1e6, 0.0, 0.0), DVec3::new(0.0, -1e7, 3.0)] {
+            assert_eq!(surf.nearest_where(p, 1.0, |_| true).map(|g| g.2), None);
+        }
     }
 }

@@ -113,6 +113,11 @@ fn edge_lengths_too_short_for_the_mesh_are_refused_before_any_work() {
         // Generous: a refusal is instant, a started retiling takes minutes.
         assert!(start.elapsed().as_secs() < 30, "{rate:?}");
     }
+    // An error target the area law puts past the limit: unreachable, and it says why,
+    // after one retiling at 1 % (no probe at a length the limit refuses).
+    let e = encode(&tet, &SwingOptions::DEFAULT.with_rate(Rate::MaxError(1e-7))).unwrap_err();
+    assert!(matches!(e, whet_swing::Error::Unreachable(_)), "{e}");
+    assert!(e.to_string().contains("limit"), "{e}");
     // The limit is a tuning knob: a lower one refuses a length the default accepts.
     let tight = whet_swing::RetileTuning::DEFAULT.with_max_triangles(1000);
     let e = encode(
