@@ -523,11 +523,14 @@ impl SwingEncoder {
     }
 
     /// The shortest edge-length fraction the retiler accepts on `prep`
-    /// ([`RetileTuning::max_triangles`] by the area law), a hair above: the searches stay at
+    /// ([`RetileTuning::max_triangles`] by the area law of the original, before any hole
+    /// is capped), a hair above: the searches stay at
     /// or above it, so a target out of reach ends the search with the best stream found.
     fn min_fraction(&self, prep: &Prepared) -> f64 {
         let max = self.opts.tuning.max_triangles.max(1) as f64;
-        (2.4 * prep.area / max).sqrt() / prep.diagonal * (1.0 + 1e-9)
+        // And 2^-19 of the diagonal, the finest length the retiler's grid indexes.
+        let by_area = (2.4 * prep.area / max).sqrt() / prep.diagonal;
+        by_area.max(1.0 / (1u64 << 19) as f64) * (1.0 + 1e-9)
     }
 
     /// First guess of the edge-length fraction for a stream of `bytes`: `T' ≈ 2.4 A / L²`

@@ -99,48 +99,70 @@ impl Cells {
         })
     }
 
-    /// Calls `f` with the keys of cells that together cover triangle `t`: the cells of its
-    /// box when they are few, as for any triangle of an original finer than the cells.
-    /// A larger triangle is cut in two at the middle of its longest edge, recursively,
-    /// until each piece's box is small, so the cells follow the triangle instead of filling
-    /// its box: a face spanning the mesh, at a fine edge length, covers on the order of its
-    /// area over the cell size squared, and a long thin one of its length over the cell
-    /// size, not its box's volume (which ran to billions of cells). Bisecting the longest
-    /// edge keeps the pieces' shapes from degenerating, so their number is proportional
-    /// to those measures (cutting into four similar pieces would make a thin triangle's
-    /// count grow with the square of its length). Keys come sorted, each once, for the
-    /// large ones.
+    /// Calls `f` with the keys of cells that together cover triangle `t` (every cell the
+    /// triangle meets, and a few more): the cells of its box when they are few, as for any
+    /// triangle of an original finer than the cells. A larger one is covered piece by
+    /// piece, so the cells follow the triangle instead of filling its box (a face spanning
+    /// the mesh at a fine edge length would otherwise fill billions of cells):
+    ///
+    /// * a thin piece, whose height over its longest edge is at most half a cell, lies
+    ///   within that height of the edge: the edge is walked in steps of half a cell and
+    ///   each step registers the cells within the height and half a step of it;
+    /// * a wider piece is cut into four similar halves at its edge midpoints.
+    ///
+    /// Work is in proportion to the area over the cell size squared, or for a thin
+    /// triangle its length over the cell size. Keys come sorted, each once, for the large
+    /// ones. Callers keep the triangle within the grid's unclamped range (the retiler
+    /// refuses lengths under 2^-19 of the diagonal), where a walk has at most a few
+    /// million steps.
     pub fn for_triangle(&self, t: [DVec3; 3], mut f: impl FnMut(u64)) {
-        let small = |p: &[DVec3; 3]| {
-            let (lo, hi) = (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
-            // Non-finite pieces go to their box at once: `cell` clamps them.
-            (self.box_cells(lo, hi) <= BOX_CELLS || !(lo.is_finite() && hi.is_finite()))
-                .then_some((lo, hi))
-        };
-        if let Some((lo, hi)) = small(&t) {
+        let bounds = |p: &[DVec3; 3]| (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
+        let (lo, hi) = bounds(&t);
+        if self.box_cells(lo, hi) <= BOX_CELLS || !(lo.is_finite() && hi.is_finite()) {
             self.for_box(lo, hi, f);
             return;
         }
+        let size = 1.0 / self.inv;
         let mut keys = Vec::new();
-        let mut pieces = vec![(t, 0u32)];
-        while let Some((p, depth)) = pieces.pop() {
-            // 128 halvings shrink any finite edge far below one cell of the 2^21 per axis.
-            match small(&p) {
-                Some((lo, hi)) => self.for_box(lo, hi, |k| keys.push(k)),
-                None if depth >= 128 => {
-                    let (lo, hi) = (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
-                    self.for_box(lo, hi, |k| keys.push(k));
-                }
-                None => {
-                    // The longest edge is p[i] -> p[i + 1].
-                    let len = |i: usize| (p[(i + 1) % 3] - p[i]).length_squared();
-                    let i = (0..3).fold(0, |b, i| if len(i) > len(b) { i } else { b });
-                    let (a, b, c) = (p[i], p[(i + 1) % 3], p[(i + 2) % 3]);
-                    let m = (a + b) * 0.5;
-                    pieces.push(([a, m, c], depth + 1));
-                    pieces.push(([m, b, c], depth + 1));
-                }
+        let mut pieces = vec![t];
+        while let Some(p) = pieces.pop() {
+            let (lo, hi) = bounds(&p);
+            if self.box_cells(lo, hi) <= BOX_CELLS {
+                self.for_box(lo, hi, |k| keys.push(k));
+                continue;
             }
+            // The longest edge a -> b, the third vertex c.
+            let len2 = |i: usize| (p[(i + 1) % 3] - p[i]).length_squared();
+            let i = (0..3).fold(0, |b, i| if len2(i) > len2(b) { i } else { b });
+            let (a, b, c) = (p[i], p[(i + 1) % 3], p[(i + 2) % 3]);
+            let long = len2(i).sqrt();
+            let height = (b - a).cross(c - a).length() / long;
+            let m = [
+                (p[0] + p[1]) * 0.5,
+                (p[1] + p[2]) * 0.5,
+                (p[2] + p[0]) * 0.5,
+            ];
+            // Midpoints that round onto a vertex (a cell under the coordinates' ulp) cannot
+            // shrink the piece: its box is only a few ulps wide.
+            let stuck = (0..3).any(|k| m[k] == p[k] || m[k] == p[(k + 1) % 3]);
+            if height.is_nan() || height <= 0.5 * size || stuck {
+                // Every point of the triangle is within `height` of the longest edge (the
+                // foot of the height falls on it); each lies within `height + step / 2` of
+                // some step point.
+                let steps = (2.0 * long / size).ceil().clamp(1.0, 1e7) as usize;
+                let reach = DVec3::splat(height + 0.5 * long / steps as f64);
+                for k in 0..=steps {
+                    let q = a + (b - a) * (k as f64 / steps as f64);
+                    self.for_box(q - reach, q + reach, |key| keys.push(key));
+                }
+                continue;
+            }
+            pieces.extend([
+                [p[0], m[0], m[2]],
+                [m[0], p[1], m[1]],
+                [m[2], m[1], p[2]],
+                [m[0], m[1], m[2]],
+            ]);
         }
         keys.sort_unstable();
         keys.dedup();

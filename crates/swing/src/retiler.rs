@@ -333,10 +333,16 @@ pub(crate) fn retile_fitted(
     let l = params.edge_length;
     // Expected triangles: 2.4 · area / L² (algorithms.md 1.9). Checked first: the grid of
     // the original and the retiling both grow with it.
-    let mesh_area = mesh.area();
-    let expected = 2.4 * mesh_area / (l * l);
-    if expected.is_nan() || expected > tune.max_triangles as f64 {
-        return Err(too_many_triangles(l, mesh_area, tune.max_triangles));
+    // The grid's cells are indexed by 21 bits per axis around the box's corner: a length
+    // under 2^-19 of the diagonal (far finer than any useful one; only a mesh of almost no
+    // area gets past the size limit below with it) would leave its range.
+    let diagonal = mesh.bounding_box().diagonal();
+    if l.is_nan() || diagonal.is_nan() || l < diagonal / (1u64 << 19) as f64 {
+        return Err(Error::Parameter(format!(
+            "an edge length of {l:e} is under 2^-19 of the mesh's bounding-box diagonal \
+             ({diagonal:e}): finer than the retiler's grid indexes; choose a longer edge \
+             length or a lower rate"
+        )));
     }
     // Originals with boundaries: retile the surface with its holes capped, then delete the
     // retiled triangles over the caps (holes.rs).
@@ -345,6 +351,12 @@ pub(crate) fn retile_fitted(
         Some((m, f)) => (m, Some(f.as_slice())),
         None => (mesh, None),
     };
+    // The caps count: they are retiled too.
+    let mesh_area = mesh.area();
+    let expected = 2.4 * mesh_area / (l * l);
+    if expected.is_nan() || expected > tune.max_triangles as f64 {
+        return Err(too_many_triangles(l, mesh_area, tune.max_triangles));
+    }
     let mut surf = Surface::new(mesh, l);
     let bbox = mesh.bounding_box();
     let mut r = Retiler {

@@ -118,6 +118,24 @@ fn edge_lengths_too_short_for_the_mesh_are_refused_before_any_work() {
     let e = encode(&tet, &SwingOptions::DEFAULT.with_rate(Rate::MaxError(1e-7))).unwrap_err();
     assert!(matches!(e, whet_swing::Error::Unreachable(_)), "{e}");
     assert!(e.to_string().contains("limit"), "{e}");
+    // A mesh of almost no area passes the size limit at any length; the grid's range
+    // refuses lengths under 2^-19 of the diagonal.
+    let sliver = whet_mesh::Mesh::new(
+        vec![
+            whet_mesh::DVec3::ZERO,
+            whet_mesh::DVec3::X,
+            whet_mesh::DVec3::new(0.5, 1e-9, 0.0),
+            whet_mesh::DVec3::new(0.5, 0.0, 1e-9),
+        ],
+        vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+    );
+    let e = encode(
+        &sliver,
+        &SwingOptions::DEFAULT.with_rate(Rate::EdgeLength(1e-7)),
+    )
+    .unwrap_err();
+    assert!(matches!(e, whet_swing::Error::Parameter(_)), "{e}");
+    assert!(e.to_string().contains("2^-19"), "{e}");
     // The limit is a tuning knob: a lower one refuses a length the default accepts.
     let tight = whet_swing::RetileTuning::DEFAULT.with_max_triangles(1000);
     let e = encode(
