@@ -199,16 +199,17 @@ impl Cells {
     ) {
         out.clear();
         let r2 = r2.max(0.0);
-        // The cells of the ball's box and one more on every side: `cell`'s rounding and the
-        // gap's may disagree by an ulp at a cell face, and the test below (squared gaps,
-        // the measure a nearest search bounds by) decides.
-        let d = DVec3::splat(r2.sqrt());
+        // The cells of the ball's box, widened by a millionth of a cell: `cell`'s rounding
+        // and the gap's may disagree by an ulp at a cell face (well under that margin
+        // within the 2^20 cells the retiler keeps its original in), and the test below
+        // (squared gaps, the measure a nearest search bounds by) decides.
+        let d = DVec3::splat(r2.sqrt() + 1e-6 / self.inv);
         let (a, b) = (self.cell(p - d), self.cell(p + d));
-        for i in a[0] - 1..=b[0] + 1 {
+        for i in a[0]..=b[0] {
             let gx = self.axis_gap(p.x, self.origin.x, i);
-            for j in a[1] - 1..=b[1] + 1 {
+            for j in a[1]..=b[1] {
                 let gy = self.axis_gap(p.y, self.origin.y, j);
-                for k in a[2] - 1..=b[2] + 1 {
+                for k in a[2]..=b[2] {
                     let gz = self.axis_gap(p.z, self.origin.z, k);
                     let d2 = gx * gx + gy * gy + gz * gz;
                     let key = Self::key([i, j, k]);
