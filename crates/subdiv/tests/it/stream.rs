@@ -85,6 +85,16 @@ fn damaged_payloads_fail_cleanly() {
         decode_subdiv(&p.control, &p.sharpness, 11, &opts),
         Err(Error::LimitExceeded { .. })
     ));
+    // The bytes subdividing would allocate count too: within the face limit, over the
+    // allocation limit.
+    let mut limits = whet_codec::Limits::DEFAULT;
+    limits.max_alloc_bytes = 1 << 20;
+    let small_alloc = DecodeOptions::DEFAULT.with_limits(limits);
+    match decode_subdiv(&p.control, &p.sharpness, 4, &small_alloc) {
+        Err(Error::LimitExceeded { what, .. }) => assert!(what.contains("bytes"), "{what}"),
+        other => panic!("{other:?}"),
+    }
+    decode_subdiv(&p.control, &p.sharpness, 1, &small_alloc).unwrap();
     let mut limits = whet_codec::Limits::DEFAULT;
     limits.max_faces = 1000;
     let tight = DecodeOptions::DEFAULT.with_limits(limits);
