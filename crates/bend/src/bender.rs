@@ -366,18 +366,20 @@ pub fn bend(mesh: &Mesh, sharp_edges: &[[u32; 2]]) -> Result<Bent, Error> {
 
 /// `levels` levels of [`bend`], propagating the tags.
 pub fn bend_levels(mesh: &Mesh, sharp_edges: &[[u32; 2]], levels: u32) -> Result<Bent, Error> {
+    // Each level makes four triangles of one (a pillow passes through, so this is an upper
+    // bound): the last level's count is checked before the first level runs.
+    let mut triangles = mesh.triangles.len();
+    for _ in 0..levels {
+        match triangles.checked_mul(4) {
+            Some(n) if n <= crate::MAX_OUTPUT_TRIANGLES => triangles = n,
+            _ => return Err(Error::TooLarge { triangles }),
+        }
+    }
     let mut cur = Bent {
         mesh: mesh.clone(),
         sharp_edges: sharp_edges.to_vec(),
     };
     for _ in 0..levels {
-        let triangles = cur.mesh.triangles.len();
-        if triangles
-            .checked_mul(4)
-            .is_none_or(|n| n > u32::MAX as usize / 4)
-        {
-            return Err(Error::TooLarge { triangles });
-        }
         cur = bend(&cur.mesh, &cur.sharp_edges)?;
     }
     Ok(cur)

@@ -277,3 +277,21 @@ fn a_pillow_component_passes_through_and_the_rest_bends_as_alone() {
     }
     assert!(out.sharp_edges.contains(&[n, n + 1]));
 }
+
+#[test]
+fn levels_past_the_output_limit_are_refused_before_any_work() {
+    // 20 triangles times 4^12 is 335M, past 2^28: refused up front (running the first
+    // levels would allocate gigabytes before the last one failed).
+    let ico = icosphere(0);
+    assert_eq!(ico.triangles.len(), 20);
+    match bend_levels(&ico, &[], 12) {
+        Err(whet_bend::Error::TooLarge { triangles }) => {
+            assert!(
+                triangles * 4 > whet_bend::MAX_OUTPUT_TRIANGLES,
+                "{triangles}"
+            );
+        }
+        other => panic!("{:?}", other.map(|b| b.mesh.triangles.len())),
+    }
+    assert_eq!(bend_levels(&ico, &[], 2).unwrap().mesh.triangles.len(), 320);
+}
