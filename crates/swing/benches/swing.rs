@@ -8,12 +8,11 @@
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
 use whet_codec::{decode, DecodeOptions};
 use whet_swing::{encode, Rate, SwingOptions};
-use whet_testkit::meshes::split4;
 
 fn bench(c: &mut Criterion) {
     let armadillo =
         whet_io::read_path(&whet_testkit::shared_fixture("armadillo.off"), None).unwrap();
-    let original = split4(&split4(&armadillo));
+    let original = whet_synth::midpoint_subdivide(&armadillo, 2);
     let opts = SwingOptions::DEFAULT.with_rate(Rate::EdgeLength(0.0037));
     let out = encode(&original, &opts).unwrap();
     let retiled = out.report.triangles;

@@ -14,7 +14,6 @@
 use std::time::Instant;
 use whet_codec::{decode, DecodeOptions};
 use whet_swing::{encode, Rate, SwingOptions};
-use whet_testkit::meshes::split4;
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -26,7 +25,7 @@ fn main() {
         None => {
             let a =
                 whet_io::read_path(&whet_testkit::shared_fixture("armadillo.off"), None).unwrap();
-            (split4(&split4(&a)), 0.0037)
+            (whet_synth::midpoint_subdivide(&a, 2), 0.0037)
         }
     };
     eprintln!(

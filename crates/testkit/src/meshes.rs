@@ -113,28 +113,6 @@ pub fn torus(n: u32, m: u32) -> Mesh {
     Mesh::new(p, t)
 }
 
-/// `mesh` split 1-to-4 at its edge midpoints, flat: the surface does not change, only the
-/// triangle count (four times) and the vertex count (about four times). Benches use it to
-/// make million-triangle originals of a fixture's exact shape.
-pub fn split4(mesh: &Mesh) -> Mesh {
-    let mut pos = mesh.positions.clone();
-    let mut mid: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
-    let mut tris = Vec::with_capacity(mesh.triangles.len() * 4);
-    let mut get = |a: u32, b: u32, pos: &mut Vec<DVec3>| {
-        *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
-            pos.push((pos[a as usize] + pos[b as usize]) * 0.5);
-            (pos.len() - 1) as u32
-        })
-    };
-    for &[a, b, c] in &mesh.triangles {
-        let ab = get(a, b, &mut pos);
-        let bc = get(b, c, &mut pos);
-        let ca = get(c, a, &mut pos);
-        tris.extend_from_slice(&[[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]);
-    }
-    Mesh::new(pos, tris)
-}
-
 /// Open `n x m` grid in the xy plane (one boundary loop).
 pub fn grid(n: u32, m: u32) -> Mesh {
     let mut p = Vec::new();
