@@ -37,6 +37,10 @@ pub struct DecodeArgs {
     /// filter for after sharpening to the vertices it left alone; with this flag, neither.
     #[arg(long)]
     no_surface_filter: bool,
+    /// Most bytes the decoder may allocate (subdiv streams' levels, `--bend`); a stream or a
+    /// level count that needs more is refused before the work starts.
+    #[arg(long, value_name = "BYTES", default_value_t = super::DEFAULT_MAX_MEMORY)]
+    max_memory: u64,
 }
 
 pub fn run(args: &DecodeArgs) -> CliResult {
@@ -45,8 +49,9 @@ pub fn run(args: &DecodeArgs) -> CliResult {
             anyhow::Error::new(e).context(format!("cannot read {}", args.input.display())),
         )
     })?;
-    let opts =
-        DecodeOptions::DEFAULT.with_surface_filter(!(args.no_surface_filter || args.sharpen));
+    let opts = DecodeOptions::DEFAULT
+        .with_surface_filter(!(args.no_surface_filter || args.sharpen))
+        .with_limits(whet_format::Limits::DEFAULT.with_max_alloc_bytes(args.max_memory));
     let mesh = whet::decode_with_levels(&bytes, &opts, args.levels).map_err(|e| {
         let input = e.is_input_error();
         let err = anyhow::Error::new(e).context(format!("cannot decode {}", args.input.display()));
@@ -73,9 +78,12 @@ pub fn run(args: &DecodeArgs) -> CliResult {
                     "--bend {levels}: at most 8 levels"
                 )))
             }
-            Some(levels) => {
-                super::sharpen::run_bend(&s.mesh, &super::sharpen::tag_edges(&s.tags), levels)?
-            }
+            Some(levels) => super::sharpen::run_bend(
+                &s.mesh,
+                &super::sharpen::tag_edges(&s.tags),
+                levels,
+                args.max_memory,
+            )?,
             None => s.mesh,
         }
     } else {

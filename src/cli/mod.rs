@@ -131,6 +131,37 @@ pub fn run(cli: Cli) -> CliResult {
     }
 }
 
+/// Default of the `--max-memory` flags: the decoder's allocation limit
+/// (`whet_format::Limits::DEFAULT`, 4 GiB).
+pub const DEFAULT_MAX_MEMORY: u64 = whet_format::Limits::DEFAULT.max_alloc_bytes;
+
+/// Refuses (exit code 2) an operation whose output of `triangles` triangles would take more
+/// than `max_memory` bytes at `bytes_per_triangle` (the operation's measured peak): a few
+/// levels of subdivision turn a small mesh into one no machine holds, and the allocator would
+/// fail only after minutes of work, or the system would kill the process.
+pub fn check_memory(
+    what: &str,
+    triangles: u64,
+    bytes_per_triangle: u64,
+    max_memory: u64,
+) -> CliResult {
+    let bytes = triangles.saturating_mul(bytes_per_triangle);
+    if bytes > max_memory {
+        return Err(Failure::input(anyhow::anyhow!(
+            "{what} would make {triangles} triangles, about {:.1} GB at {bytes_per_triangle} \
+             bytes each, over --max-memory {max_memory} bytes: use fewer levels or raise \
+             --max-memory",
+            bytes as f64 / 1e9
+        )));
+    }
+    Ok(())
+}
+
+/// Output triangles of `levels` 1-to-4 splits of `triangles` (saturating).
+pub fn split_triangles(triangles: usize, levels: u32) -> u64 {
+    (triangles as u64).saturating_mul(4u64.saturating_pow(levels))
+}
+
 /// Reads a mesh file, mapping unreadable input to exit code 2 with the path in the message.
 pub fn read_mesh(path: &Path, format: Option<whet::io::Format>) -> CliResult<whet::Mesh> {
     whet::io::read_path(path, format).map_err(|e| {

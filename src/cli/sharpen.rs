@@ -136,6 +136,10 @@ pub struct BendArgs {
     /// EdgeSharpener's filter 3bis rule on the input.
     #[arg(long)]
     tags: Option<PathBuf>,
+    /// Refuse to start when the output would need more than this many bytes (estimated from
+    /// the output's triangle count).
+    #[arg(long, value_name = "BYTES", default_value_t = super::DEFAULT_MAX_MEMORY)]
+    max_memory: u64,
 }
 
 /// Sharp edges of `tags` as plain pairs.
@@ -161,7 +165,14 @@ pub fn fallback_tags(mesh: &Mesh) -> CliResult<Vec<[u32; 2]>> {
 }
 
 /// Bends `levels` times; errors are input errors.
-pub fn run_bend(mesh: &Mesh, sharp: &[[u32; 2]], levels: u32) -> CliResult<Mesh> {
+/// Bender, `levels` times, after checking its estimated peak memory against `max_memory`.
+pub fn run_bend(mesh: &Mesh, sharp: &[[u32; 2]], levels: u32, max_memory: u64) -> CliResult<Mesh> {
+    super::check_memory(
+        &format!("{levels} levels of Bender"),
+        super::split_triangles(mesh.triangles.len(), levels),
+        whet_bend::PEAK_BYTES_PER_OUTPUT_TRIANGLE,
+        max_memory,
+    )?;
     whet_bend::bend_levels(mesh, sharp, levels)
         .map(|b| b.mesh)
         .map_err(Failure::input)
@@ -183,7 +194,7 @@ pub fn run_bend_cmd(args: &BendArgs) -> CliResult {
             fallback_tags(&mesh)?
         }
     };
-    let out = run_bend(&mesh, &sharp, args.levels)?;
+    let out = run_bend(&mesh, &sharp, args.levels, args.max_memory)?;
     write_mesh(&args.output, &out, None, &whet::io::WriteOptions::DEFAULT)?;
     eprintln!(
         "{} -> {}: {} levels, {} sharp edges, {} triangles",

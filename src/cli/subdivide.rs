@@ -34,6 +34,10 @@ pub struct SubdivideArgs {
     /// Print one JSON object with the counts.
     #[arg(long)]
     json: bool,
+    /// Refuse to start when the output would need more than this many bytes (estimated from
+    /// the output's triangle count).
+    #[arg(long, value_name = "BYTES", default_value_t = super::DEFAULT_MAX_MEMORY)]
+    max_memory: u64,
 }
 
 pub fn run(args: &SubdivideArgs) -> CliResult {
@@ -44,6 +48,12 @@ pub fn run(args: &SubdivideArgs) -> CliResult {
         )));
     }
     let control = read_mesh(&args.control, None)?;
+    super::check_memory(
+        &format!("{} levels of subdivision", args.levels),
+        super::split_triangles(control.triangles.len(), args.levels),
+        whet_subdiv::SUBDIVISION_BYTES_PER_TRIANGLE,
+        args.max_memory,
+    )?;
     let sharpness = match (&args.sharpness, args.crease_angle) {
         (Some(path), _) => read_sharpness(path, &control)?,
         (None, Some(deg)) => {

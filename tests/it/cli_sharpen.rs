@@ -237,3 +237,62 @@ fn sharpen_normal_filter_on_a_blend() {
     ]);
     assert_eq!(o.status.code(), Some(2));
 }
+
+/// Subdividing commands hold their output's estimated peak memory against `--max-memory`
+/// (default 4 GiB) before they start: three levels of a 12-triangle cube pass the default,
+/// and a 10 kB budget refuses them at once with exit code 2.
+#[test]
+fn subdividing_commands_refuse_outputs_over_max_memory() {
+    let dir = scratch_dir("cli-max-memory");
+    let cube = dir.join("cube.off");
+    std::fs::write(
+        &cube,
+        "OFF\n8 12 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n\
+         3 0 2 1\n3 0 3 2\n3 4 5 6\n3 4 6 7\n3 0 1 5\n3 0 5 4\n\
+         3 1 2 6\n3 1 6 5\n3 2 3 7\n3 2 7 6\n3 3 0 4\n3 3 4 7\n",
+    )
+    .unwrap();
+    let out = dir.join("out.off");
+    // 12 * 4^3 = 768 triangles: 123 kB for the subdivision estimate, 35 kB for Bender's.
+    for (cmd, levels_flag) in [("subdivide", "--levels"), ("bend", "--levels")] {
+        let ok = whet(&[cmd, s(&cube), "-o", s(&out), levels_flag, "3"]);
+        assert!(
+            ok.status.success(),
+            "{cmd}: {}",
+            String::from_utf8_lossy(&ok.stderr)
+        );
+        let refused = whet(&[
+            cmd,
+            s(&cube),
+            "-o",
+            s(&out),
+            levels_flag,
+            "3",
+            "--max-memory",
+            "10000",
+        ]);
+        assert_eq!(refused.status.code(), Some(2), "{cmd}");
+        let err = String::from_utf8_lossy(&refused.stderr);
+        assert!(
+            err.contains("768 triangles") && err.contains("--max-memory"),
+            "{cmd}: {err}"
+        );
+    }
+    // The same check behind `whet decode --sharpen --bend`.
+    let stream = dir.join("cube.whet");
+    let o = whet(&["encode", s(&cube), "-o", s(&stream), "--mode", "exact"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let refused = whet(&[
+        "decode",
+        s(&stream),
+        "-o",
+        s(&out),
+        "--sharpen",
+        "--bend",
+        "3",
+        "--max-memory",
+        "10000",
+    ]);
+    assert_eq!(refused.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("--max-memory"));
+}

@@ -29,6 +29,11 @@ pub use bender::{bend, bend_levels, zorin_weights, Bent};
 /// bunny_dense: 12 GiB at the limit, where 32-bit indices alone would allow 2^30).
 pub const MAX_OUTPUT_TRIANGLES: usize = 1 << 28;
 
+/// Peak bytes [`bend_levels`] holds per output triangle (measured on three levels of
+/// bunny_dense, 1.8M output triangles): what a caller multiplies by the output count to
+/// hold a run against a memory budget before starting it (`whet bend --max-memory`).
+pub const PEAK_BYTES_PER_OUTPUT_TRIANGLE: u64 = 46;
+
 /// Why a mesh could not be bent.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]

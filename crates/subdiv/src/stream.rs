@@ -300,7 +300,7 @@ pub fn decode_subdiv(
 /// peak for `whet decode --levels 6` of the armadillo's stream, 4.1M triangles, with the
 /// output file's writer). Checked against [`whet_codec::Limits::max_alloc_bytes`] before
 /// subdividing: a stream of a few kilobytes can ask for any level count up to the limit.
-const SUBDIVISION_BYTES_PER_TRIANGLE: u64 = 160;
+pub const SUBDIVISION_BYTES_PER_TRIANGLE: u64 = 160;
 
 /// Zero-flag contexts: nonzero edges already coded around this edge, 0, 1, 2+.
 const CONTEXTS: usize = 3;
