@@ -292,6 +292,24 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh) -> CliResult {
     }
     let r = &out.report;
     report_repair(r);
+    let target_bytes = match rate {
+        Rate::BitsPerVertex(bpv) => Some(bpv * out.original_vertices as f64 / 8.0),
+        Rate::TargetBytes(n) => Some(n as f64),
+        _ => None,
+    };
+    if let Some(target) = target_bytes {
+        let off = r.bytes as f64 / target - 1.0;
+        if off.abs() > opts.tolerance {
+            eprintln!(
+                "whet: the size search ended {:.1} % from its target of {:.0} bytes: no edge \
+                 length it tried landed within {:.0} % (at this rate the size does not follow \
+                 the length smoothly, or the retiler got stuck at the lengths between)",
+                100.0 * off,
+                target,
+                100.0 * opts.tolerance
+            );
+        }
+    }
     if let whet_codec::SwingGeometry::Explicit(reason) = &out.geometry {
         eprintln!("whet: swing geometry coded as explicit positions: {reason}");
     }

@@ -566,8 +566,26 @@ impl SwingEncoder {
             ));
         }
         let mut f = guess.max(floor);
+        let mut stuck: Option<Error> = None;
+        let mut stuck_at: Vec<f64> = Vec::new();
         for _ in 0..self.opts.max_iterations.max(1) {
-            let out = self.encode_near(prep, f)?;
+            let out = match self.encode_near(prep, f) {
+                Ok(out) => out,
+                Err(e @ Error::Stuck(_)) => {
+                    // No retiling near this length: the front stalls on features of about
+                    // L's size, which shorter lengths resolve. Go on a step shorter.
+                    stuck = Some(e);
+                    stuck_at.push(f);
+                    match shorter_after_stuck(f, floor) {
+                        Some(next) => {
+                            f = next;
+                            continue;
+                        }
+                        None => break,
+                    }
+                }
+                Err(e) => return Err(e),
+            };
             let size = out.bytes.len();
             search.push((out.edge_length_fraction, size));
             let x = out.edge_length_fraction.ln();
@@ -595,9 +613,25 @@ impl SwingEncoder {
             if next < floor && f <= floor {
                 break;
             }
-            f = next.max(floor);
+            let next = outside_stuck(next.max(floor), &stuck_at, floor);
+            // A length tried already would give the same stream again.
+            if search
+                .iter()
+                .any(|&(tried, _)| (next / tried - 1.0).abs() < 1e-3)
+                || (next / f - 1.0).abs() < 1e-3
+            {
+                break;
+            }
+            f = next;
         }
-        let mut out = best.ok_or_else(|| Error::Stuck("the size search ran no retiling".into()))?;
+        let mut out = match best {
+            Some(out) => out,
+            None => {
+                return Err(
+                    stuck.unwrap_or_else(|| Error::Stuck("the size search ran no retiling".into()))
+                )
+            }
+        };
         out.search = search;
         Ok(out)
     }
@@ -653,8 +687,25 @@ impl SwingEncoder {
         let mut limited = false;
         let mut lo_ok = 0.0f64; // largest fraction known to meet the target
         let mut hi_bad = f64::INFINITY; // smallest fraction known to miss it
+        let mut stuck: Option<Error> = None;
         for _ in 0..self.opts.max_iterations.max(1) {
-            let mut out = self.encode_near(prep, f)?;
+            let mut out = match self.encode_near(prep, f) {
+                Ok(out) => out,
+                Err(e @ Error::Stuck(_)) => {
+                    // As in the size search: a shorter length resolves what stalled the
+                    // front, and costs more bytes, never more error.
+                    stuck = Some(e);
+                    hi_bad = hi_bad.min(f);
+                    match shorter_after_stuck(f, floor) {
+                        Some(next) if next > lo_ok => {
+                            f = next;
+                            continue;
+                        }
+                        _ => break,
+                    }
+                }
+                Err(e) => return Err(e),
+            };
             let rms = self.measure(prep, &out)?;
             out.rms_pct = Some(rms);
             let fr = out.edge_length_fraction;
@@ -712,6 +763,9 @@ impl SwingEncoder {
         }
         let mut out = match best_ok {
             Some(o) => o,
+            None if best_any.is_none() && stuck.is_some() => {
+                return Err(stuck.unwrap_or_else(|| Error::Stuck(String::new())));
+            }
             None => {
                 let limit = if limited {
                     format!(
@@ -734,7 +788,55 @@ impl SwingEncoder {
     }
 }
 
+/// The next length a rate search tries after the retiler got stuck at fraction `f` (with
+/// its retries down to 0.8 f): the next shorter step below those retries, not under the
+/// shortest allowed length `floor`; `None` once `f` is there.
+fn shorter_after_stuck(f: f64, floor: f64) -> Option<f64> {
+    (f > floor).then(|| (0.75 * f).max(floor))
+}
+
+/// `f`, or if [`SwingEncoder::encode_near`] already got stuck around it (the lengths its
+/// retries cover, 0.8 to 1.015 times a stuck length), the next length below them.
+fn outside_stuck(mut f: f64, stuck_at: &[f64], floor: f64) -> f64 {
+    // Each move goes below one more stuck length: at most one pass per stuck length.
+    for _ in 0..=stuck_at.len() {
+        match stuck_at.iter().find(|&&s| f >= 0.79 * s && f <= 1.02 * s) {
+            Some(&s) => f = (0.78 * s).max(floor),
+            None => break,
+        }
+    }
+    f
+}
+
 /// Encodes `mesh` with `opts` (see [`SwingEncoder`]).
 pub fn encode(mesh: &Mesh, opts: &SwingOptions) -> Result<SwingOutput, Error> {
     SwingEncoder::new(*opts).encode(mesh)
+}
+
+#[cfg(test)]
+mod stuck_search_tests {
+    use super::{outside_stuck, shorter_after_stuck};
+
+    fn near(a: f64, b: f64) -> bool {
+        (a - b).abs() < 1e-12
+    }
+
+    #[test]
+    fn after_a_stuck_length_the_search_goes_shorter_down_to_the_floor() {
+        assert!(near(shorter_after_stuck(0.1, 0.01).unwrap(), 0.075));
+        assert!(near(shorter_after_stuck(0.012, 0.01).unwrap(), 0.01));
+        assert_eq!(shorter_after_stuck(0.01, 0.01), None);
+    }
+
+    #[test]
+    fn lengths_the_retries_of_a_stuck_length_covered_are_skipped() {
+        // 0.1 got stuck: its retries covered 0.08 to 0.1015.
+        assert!(near(outside_stuck(0.09, &[0.1], 0.001), 0.078));
+        assert!(near(outside_stuck(0.07, &[0.1], 0.001), 0.07));
+        assert!(near(outside_stuck(0.11, &[0.1], 0.001), 0.11));
+        // A move below one stuck length that lands in another's range moves on below it.
+        assert!(near(outside_stuck(0.1, &[0.1, 0.08], 0.001), 0.78 * 0.08));
+        // Never under the floor.
+        assert!(near(outside_stuck(0.1, &[0.1], 0.09), 0.09));
+    }
 }
