@@ -301,9 +301,8 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh) -> CliResult {
         let off = r.bytes as f64 / target - 1.0;
         if off.abs() > opts.tolerance {
             eprintln!(
-                "whet: the size search ended {:.1} % from its target of {:.0} bytes: no edge \
-                 length it tried landed within {:.0} % (at this rate the size does not follow \
-                 the length smoothly, or the retiler got stuck at the lengths between)",
+                "whet: the size search ended {:+.1} % from its target of {:.0} bytes: no \
+                 edge length it tried landed within {:.0} %; the closest stream was written",
                 100.0 * off,
                 target,
                 100.0 * opts.tolerance

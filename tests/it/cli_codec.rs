@@ -180,3 +180,28 @@ fn swing_filter_after_sharpening() {
     // retiler changes.
     assert!(e_with < 0.95 * e_without, "{e_with} vs {e_without}");
 }
+
+/// A size target no stream can meet (2 bits per vertex of a one-triangle mesh: one byte)
+/// still writes the closest stream, exit code 0, and says how far it is on stderr.
+#[test]
+fn a_missed_size_target_is_written_with_a_warning() {
+    let dir = scratch_dir("cli-missed-size");
+    let tri = dir.join("tri.off");
+    std::fs::write(&tri, "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n").unwrap();
+    let stream = dir.join("tri.whet");
+    let o = whet(&["encode", s(&tri), "-o", s(&stream), "--bpv", "2"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("from its target of 1 bytes") && err.contains("closest stream"),
+        "{err}"
+    );
+    assert!(std::fs::metadata(&stream).unwrap().len() > 1);
+    // A target the search meets prints no such line.
+    let sphere = dir.join("sphere.off");
+    let o = whet(&["synth", "sphere", "-o", s(&sphere), "--resolution", "24"]);
+    assert!(o.status.success());
+    let o = whet(&["encode", s(&sphere), "-o", s(&stream), "--bpv", "4"]);
+    assert!(o.status.success());
+    assert!(!String::from_utf8_lossy(&o.stderr).contains("size search"));
+}
