@@ -157,6 +157,23 @@ pub fn check_memory(
     Ok(())
 }
 
+/// `mesh` itself when it is an oriented manifold, else its [`whet::Mesh::make_manifold`]
+/// repair, said on stderr in the words `whet encode` and `whet sharpen` use: every command
+/// that needs a manifold takes what those two take. `make_manifold` keeps the indices of
+/// the vertices it does not split (a split appends the extra copies), so sidecar files that
+/// name vertices (sharp-edge tags, edge sharpness) still apply.
+pub fn manifold(mesh: whet::Mesh) -> whet::Mesh {
+    match whet_mesh::CornerTable::new(&mesh) {
+        Err(e) if e.is_structural() => {
+            let mut m = mesh;
+            let rep = m.make_manifold();
+            eprintln!("whet: the mesh is not an oriented manifold ({e}); make_manifold {rep}");
+            m
+        }
+        _ => mesh,
+    }
+}
+
 /// Output triangles of `levels` 1-to-4 splits of `triangles` (saturating).
 pub fn split_triangles(triangles: usize, levels: u32) -> u64 {
     (triangles as u64).saturating_mul(4u64.saturating_pow(levels))

@@ -164,7 +164,6 @@ pub fn fallback_tags(mesh: &Mesh) -> CliResult<Vec<[u32; 2]>> {
         .collect())
 }
 
-/// Bends `levels` times; errors are input errors.
 /// Bender, `levels` times, after checking its estimated peak memory against `max_memory`.
 pub fn run_bend(mesh: &Mesh, sharp: &[[u32; 2]], levels: u32, max_memory: u64) -> CliResult<Mesh> {
     super::check_memory(
@@ -179,7 +178,7 @@ pub fn run_bend(mesh: &Mesh, sharp: &[[u32; 2]], levels: u32, max_memory: u64) -
 }
 
 pub fn run_bend_cmd(args: &BendArgs) -> CliResult {
-    let mesh = read_mesh(&args.input, None)?;
+    let mesh = super::manifold(read_mesh(&args.input, None)?);
     if args.levels > 8 {
         return Err(Failure::input(anyhow::anyhow!(
             "--levels {} would multiply the triangles by 4^{}; at most 8",

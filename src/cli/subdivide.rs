@@ -47,7 +47,7 @@ pub fn run(args: &SubdivideArgs) -> CliResult {
             args.levels
         )));
     }
-    let control = read_mesh(&args.control, None)?;
+    let control = super::manifold(read_mesh(&args.control, None)?);
     super::check_memory(
         &format!("{} levels of subdivision", args.levels),
         super::split_triangles(control.triangles.len(), args.levels),

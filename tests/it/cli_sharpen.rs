@@ -296,3 +296,27 @@ fn subdividing_commands_refuse_outputs_over_max_memory() {
     assert_eq!(refused.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&refused.stderr).contains("--max-memory"));
 }
+
+/// `whet bend` and `whet subdivide` take the non-manifold input `whet encode` and `whet
+/// sharpen` take: cut by make_manifold (said on stderr), then refined. Before, both refused a
+/// fin (three triangles on one edge) that the other commands repair.
+#[test]
+fn bend_and_subdivide_repair_non_manifold_input() {
+    let dir = scratch_dir("cli-nonmanifold-refine");
+    let fin = dir.join("fin.off");
+    std::fs::write(
+        &fin,
+        "OFF\n5 3 0\n0 0 0\n1 0 0\n0 1 0\n0 -1 0\n0 0 1\n3 0 1 2\n3 1 0 3\n3 0 1 4\n",
+    )
+    .unwrap();
+    let out = dir.join("out.off");
+    for cmd in ["bend", "subdivide"] {
+        let o = whet(&[cmd, s(&fin), "-o", s(&out), "--levels", "1"]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{cmd}: {err}");
+        assert!(err.contains("make_manifold"), "{cmd}: {err}");
+        let j = whet_json(&["info", s(&out), "--json"]);
+        // Three triangles split once each; the cut fin is a manifold with boundaries.
+        assert_eq!(j["triangles"], 12, "{cmd}: {j}");
+    }
+}

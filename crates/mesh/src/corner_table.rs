@@ -373,18 +373,37 @@ impl CornerTable {
         if open_fans[v] > 1 {
             return Err(fail());
         }
-        // Open fans start at their clockwise end; a closed fan anywhere. Count the fan.
-        let start = CornerId(start);
+        // Open fans start at their clockwise end; a closed fan anywhere. Count the fan,
+        // swinging over the raw arrays with one 32-bit modulo per step: c's own position in
+        // its triangle is known from the step before (the walk runs once per vertex of
+        // every input, so its instructions count).
+        let opposite = self.opposite.as_slice();
+        let valence = valence[v];
         let mut seen = 1u32;
-        let mut c = start;
-        while let Some(n) = self.swing(c) {
-            if n == start || seen > valence[v] {
+        // The corner after c in its triangle.
+        let mut after = {
+            let j = start % 3;
+            start - j + NEXT_IN_TRIANGLE[j as usize]
+        };
+        loop {
+            let Some(&o) = opposite.get(after as usize) else {
+                break;
+            };
+            if o == NONE {
+                break;
+            }
+            // The swung corner n = next(o), and the corner after it.
+            let jo = o % 3;
+            let base = o - jo;
+            let jn = NEXT_IN_TRIANGLE[jo as usize];
+            let n = base + jn;
+            if n == start || seen > valence {
                 break;
             }
             seen += 1;
-            c = n;
+            after = base + NEXT_IN_TRIANGLE[jn as usize];
         }
-        if seen != valence[v] {
+        if seen != valence {
             return Err(fail());
         }
         Ok(())
@@ -558,6 +577,9 @@ impl Iterator for VertexCorners<'_> {
         Some(c)
     }
 }
+
+/// Position in its triangle of the corner after the one at position `j`.
+const NEXT_IN_TRIANGLE: [u32; 3] = [1, 2, 0];
 
 #[inline]
 fn next_raw(c: usize) -> usize {
