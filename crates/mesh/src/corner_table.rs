@@ -385,10 +385,7 @@ impl CornerTable {
             let j = start % 3;
             start - j + NEXT_IN_TRIANGLE[j as usize]
         };
-        loop {
-            let Some(&o) = opposite.get(after as usize) else {
-                break;
-            };
+        while let Some(&o) = opposite.get(after as usize) {
             if o == NONE {
                 break;
             }
