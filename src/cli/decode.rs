@@ -37,8 +37,9 @@ pub struct DecodeArgs {
     /// filter for after sharpening to the vertices it left alone; with this flag, neither.
     #[arg(long)]
     no_surface_filter: bool,
-    /// Most bytes the decoder may allocate (subdiv streams' levels, `--bend`); a stream or a
-    /// level count that needs more is refused before the work starts.
+    /// Memory budget in bytes for what a stream or a level count asks for: the container's
+    /// payloads, a subdiv stream's levels and `--bend` are estimated and refused before they
+    /// run when they need more (the decoded counts have their own fixed limits).
     #[arg(long, value_name = "BYTES", default_value_t = super::DEFAULT_MAX_MEMORY)]
     max_memory: u64,
 }

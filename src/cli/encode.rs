@@ -127,6 +127,12 @@ pub struct EncodeArgs {
     /// --sharpen` leaves it out, as EdgeSharpener works on the unfiltered vertices.
     #[arg(long)]
     no_surface_filter: bool,
+    /// Swing: the most retiled triangles an edge length may ask for (estimated from the
+    /// original's area before any work; the retiler holds about 450 bytes per retiled
+    /// triangle, so the default, 2^24, is about 7.5 GB). Shorter lengths are refused, and
+    /// the rate searches stay above them.
+    #[arg(long, value_name = "N", default_value_t = whet_swing::RetileTuning::DEFAULT.max_triangles)]
+    max_retiled_triangles: usize,
     /// Swing: also write the retiled mesh the stream encodes (byte-identical to what
     /// `whet decode` writes in the same format).
     #[arg(long, value_name = "PATH")]
@@ -275,7 +281,10 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh) -> CliResult {
             .with_rate(rate)
             .with_quant_bits(quant_bits)
             .with_error_of(args.optimize_for.into())
-            .with_surface_filter(!args.no_surface_filter),
+            .with_surface_filter(!args.no_surface_filter)
+            .with_tuning(
+                whet_swing::RetileTuning::DEFAULT.with_max_triangles(args.max_retiled_triangles),
+            ),
     );
     let out = whet_swing::encode(mesh, &opts).map_err(|e| {
         let input = e.is_input_error();

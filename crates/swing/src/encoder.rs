@@ -561,6 +561,7 @@ impl SwingEncoder {
         if start.is_none() && guess < 0.5 * floor {
             return Err(crate::retiler::too_many_triangles(
                 guess * prep.diagonal,
+                prep.diagonal,
                 prep.area,
                 self.opts.tuning.max_triangles,
             ));

@@ -304,12 +304,13 @@ struct Retiler<'s, 'm> {
 
 /// The error for an edge length `l` at which a surface of area `area` needs more than
 /// `max` retiled triangles by the area law.
-pub(crate) fn too_many_triangles(l: f64, area: f64, max: usize) -> Error {
+pub(crate) fn too_many_triangles(l: f64, diagonal: f64, area: f64, max: usize) -> Error {
     let expected = 2.4 * area / (l * l);
     Error::Parameter(format!(
-        "an edge length of {l:e} would retile this mesh (area {area:e}) into about \
-         {expected:.3e} triangles, more than the limit of {max}: choose a longer edge length \
-         or a lower rate"
+        "an edge length of {:.3e} of the bounding-box diagonal ({l:.3e}) would retile this \
+         mesh (area {area:.3e}) into about {expected:.3e} triangles, more than the limit of \
+         {max} (--max-retiled-triangles): choose a longer edge length or a lower rate",
+        l / diagonal
     ))
 }
 
@@ -339,9 +340,10 @@ pub(crate) fn retile_fitted(
     let diagonal = mesh.bounding_box().diagonal();
     if l.is_nan() || diagonal.is_nan() || l < diagonal / (1u64 << 19) as f64 {
         return Err(Error::Parameter(format!(
-            "an edge length of {l:e} is under 2^-19 of the mesh's bounding-box diagonal \
-             ({diagonal:e}): finer than the retiler's grid indexes; choose a longer edge \
-             length or a lower rate"
+            "an edge length of {:.3e} of the bounding-box diagonal ({l:e}) is under 2^-19 \
+             of it: finer than the retiler's grid indexes; choose a longer edge length or a \
+             lower rate",
+            l / diagonal
         )));
     }
     // Originals with boundaries: retile the surface with its holes capped, then delete the
@@ -355,7 +357,12 @@ pub(crate) fn retile_fitted(
     let mesh_area = mesh.area();
     let expected = 2.4 * mesh_area / (l * l);
     if expected.is_nan() || expected > tune.max_triangles as f64 {
-        return Err(too_many_triangles(l, mesh_area, tune.max_triangles));
+        return Err(too_many_triangles(
+            l,
+            diagonal,
+            mesh_area,
+            tune.max_triangles,
+        ));
     }
     let mut surf = Surface::new(mesh, l);
     let bbox = mesh.bounding_box();
