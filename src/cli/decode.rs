@@ -50,9 +50,10 @@ pub fn run(args: &DecodeArgs) -> CliResult {
             anyhow::Error::new(e).context(format!("cannot read {}", args.input.display())),
         )
     })?;
+    let limits = whet_format::Limits::DEFAULT.with_max_alloc_bytes(args.max_memory);
     let opts = DecodeOptions::DEFAULT
         .with_surface_filter(!(args.no_surface_filter || args.sharpen))
-        .with_limits(whet_format::Limits::DEFAULT.with_max_alloc_bytes(args.max_memory));
+        .with_limits(limits);
     let mesh = whet::decode_with_levels(&bytes, &opts, args.levels).map_err(|e| {
         let input = e.is_input_error();
         let err = anyhow::Error::new(e).context(format!("cannot decode {}", args.input.display()));
@@ -68,7 +69,7 @@ pub fn run(args: &DecodeArgs) -> CliResult {
         if !args.no_surface_filter {
             // A swing stream's filter for after sharpening: the smooth parts the sharpener
             // left alone get the surface filter fitted for them (docs/swing.md section 2).
-            if let Ok(c) = whet_format::parse(&bytes, &whet_format::Limits::DEFAULT) {
+            if let Ok(c) = whet_format::parse(&bytes, &limits) {
                 whet_codec::SurfaceFilter::after_sharpening_of(&c.header)
                     .apply_after_sharpening(&mesh, &mut s.mesh);
             }

@@ -310,8 +310,8 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh) -> CliResult {
         let off = r.bytes as f64 / target - 1.0;
         if off.abs() > opts.tolerance {
             eprintln!(
-                "whet: the size search ended {:+.1} % from its target of {:.0} bytes: no \
-                 edge length it tried landed within {:.0} %; the closest stream was written",
+                "whet: the stream written is {:+.1} % from the target of {:.0} bytes: no \
+                 edge length the size search tried landed within {:.0} %",
                 100.0 * off,
                 target,
                 100.0 * opts.tolerance

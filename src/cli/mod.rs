@@ -148,10 +148,10 @@ pub fn check_memory(
     let bytes = triangles.saturating_mul(bytes_per_triangle);
     if bytes > max_memory {
         return Err(Failure::input(anyhow::anyhow!(
-            "{what} would make {triangles} triangles, about {:.1} GB at {bytes_per_triangle} \
-             bytes each, over --max-memory {max_memory} bytes: use fewer levels or raise \
+            "{what} would make {triangles} triangles, about {} at {bytes_per_triangle} bytes \
+             each, over --max-memory {max_memory} bytes: use fewer levels or raise \
              --max-memory",
-            bytes as f64 / 1e9
+            human_bytes(bytes)
         )));
     }
     Ok(())
@@ -171,6 +171,17 @@ pub fn manifold(mesh: whet::Mesh) -> whet::Mesh {
             m
         }
         _ => mesh,
+    }
+}
+
+/// `bytes` in the largest of B, kB, MB, GB that keeps a unit digit.
+fn human_bytes(bytes: u64) -> String {
+    let b = bytes as f64;
+    match bytes {
+        0..1_000 => format!("{bytes} B"),
+        1_000..1_000_000 => format!("{:.1} kB", b / 1e3),
+        1_000_000..1_000_000_000 => format!("{:.1} MB", b / 1e6),
+        _ => format!("{:.1} GB", b / 1e9),
     }
 }
 

@@ -178,7 +178,7 @@ pub fn run_bend(mesh: &Mesh, sharp: &[[u32; 2]], levels: u32, max_memory: u64) -
 }
 
 pub fn run_bend_cmd(args: &BendArgs) -> CliResult {
-    let mesh = super::manifold(read_mesh(&args.input, None)?);
+    let mesh = read_mesh(&args.input, None)?;
     if args.levels > 8 {
         return Err(Failure::input(anyhow::anyhow!(
             "--levels {} would multiply the triangles by 4^{}; at most 8",
@@ -186,6 +186,14 @@ pub fn run_bend_cmd(args: &BendArgs) -> CliResult {
             args.levels
         )));
     }
+    // Before the repair and the tagging pass: a refusal should cost nothing.
+    super::check_memory(
+        &format!("{} levels of Bender", args.levels),
+        super::split_triangles(mesh.triangles.len(), args.levels),
+        whet_bend::PEAK_BYTES_PER_OUTPUT_TRIANGLE,
+        args.max_memory,
+    )?;
+    let mesh = super::manifold(mesh);
     let sharp = match &args.tags {
         Some(t) => tag_edges(&SharpTags::read_path(t, &mesh).map_err(Failure::input)?),
         None => {

@@ -579,7 +579,7 @@ impl SwingEncoder {
                     stuck_at.push(f);
                     match shorter_after_stuck(f, floor) {
                         Some(next) => {
-                            f = next;
+                            f = outside_stuck(next, &stuck_at, floor);
                             continue;
                         }
                         None => break,
@@ -615,12 +615,15 @@ impl SwingEncoder {
                 break;
             }
             let next = outside_stuck(next.max(floor), &stuck_at, floor);
-            // A length tried already would give the same stream again.
-            if search
-                .iter()
-                .any(|&(tried, _)| (next / tried - 1.0).abs() < 1e-3)
-                || (next / f - 1.0).abs() < 1e-3
-            {
+            // The same length again gives the same stream (the clamps above can pin it).
+            // Once the retiler got stuck the sizes jump between nearby lengths, and the
+            // skipped ranges can send the search back to where it was: a length within a
+            // thousandth of one tried then ends it too.
+            let revisits = !stuck_at.is_empty()
+                && search
+                    .iter()
+                    .any(|&(tried, _)| (next / tried - 1.0).abs() < 1e-3);
+            if next == f || revisits {
                 break;
             }
             f = next;
@@ -689,6 +692,7 @@ impl SwingEncoder {
         let mut lo_ok = 0.0f64; // largest fraction known to meet the target
         let mut hi_bad = f64::INFINITY; // smallest fraction known to miss it
         let mut stuck: Option<Error> = None;
+        let mut stuck_at: Vec<f64> = Vec::new();
         for _ in 0..self.opts.max_iterations.max(1) {
             let mut out = match self.encode_near(prep, f) {
                 Ok(out) => out,
@@ -696,10 +700,11 @@ impl SwingEncoder {
                     // As in the size search: a shorter length resolves what stalled the
                     // front, and costs more bytes, never more error.
                     stuck = Some(e);
+                    stuck_at.push(f);
                     hi_bad = hi_bad.min(f);
                     match shorter_after_stuck(f, floor) {
                         Some(next) if next > lo_ok => {
-                            f = next;
+                            f = outside_stuck(next, &stuck_at, floor);
                             continue;
                         }
                         _ => break,
@@ -760,7 +765,13 @@ impl SwingEncoder {
                 limited = true;
                 break;
             }
-            f = next.max(floor);
+            // Lengths a stuck attempt's retries covered are skipped; when that leaves nothing
+            // between the longest good length and the shortest bad one, the search is over.
+            let next = outside_stuck(next.max(floor), &stuck_at, floor);
+            if !stuck_at.is_empty() && lo_ok > 0.0 && next <= lo_ok {
+                break;
+            }
+            f = next;
         }
         let mut out = match best_ok {
             Some(o) => o,
@@ -776,6 +787,10 @@ impl SwingEncoder {
                     )
                 } else {
                     String::new()
+                };
+                let limit = match &stuck {
+                    Some(e) => format!("{limit}; at some shorter lengths {e}"),
+                    None => limit,
                 };
                 return Err(Error::Unreachable(format!(
                     "no edge length reached an RMS error of {target} % of the diagonal \
