@@ -314,6 +314,13 @@ pub(crate) fn too_many_triangles(l: f64, diagonal: f64, area: f64, max: usize) -
     ))
 }
 
+/// Seeds a component may grow from before its retiling counts as stuck (docs/swing.md,
+/// "Bounded work").
+const SEED_ATTEMPTS: usize = 3;
+
+/// Least distance, in `L`, between the seeds of two attempts on one component.
+const SEED_SPREAD: f64 = 4.0;
+
 /// Retiles `mesh` with the edge length and grids of `params` (see the module docs).
 pub fn retile(
     mesh: &whet_mesh::Mesh,
@@ -422,7 +429,20 @@ pub(crate) fn retile_fitted(
         // Expected triangles: 2.4 · area / L² (algorithms.md 1.9).
         let budget = (tune.budget_factor * 2.4 * area[c] / (l * l)) as usize + 200;
         let mark = r.mark();
-        match r.component(first[c], budget) {
+        // A front that stalls depends on where it started: before giving up on the
+        // component, grow it again from the next seeds (in the seed's own order).
+        let mut result = r.component(first[c], budget, 0);
+        for attempt in 1..SEED_ATTEMPTS {
+            if !matches!(result, Err(Error::Stuck(_))) {
+                break;
+            }
+            r.rollback(mark);
+            match r.component(first[c], budget, attempt) {
+                Err(Error::Stuck(_)) => {}
+                other => result = other,
+            }
+        }
+        match result {
             Ok(()) => r.stats.components += 1,
             // A small component the front cannot cover (a strip narrower than L, a
             // splinter): a pillow loses it gracefully; a large one is an error (the encoder
@@ -843,10 +863,10 @@ impl Retiler<'_, '_> {
     }
 
     /// Seeds and retiles one component.
-    fn component(&mut self, first_tri: u32, budget: usize) -> Result<(), Error> {
+    fn component(&mut self, first_tri: u32, budget: usize, attempt: usize) -> Result<(), Error> {
         let start = self.tris.len();
         let forced_before = self.stats.forced;
-        let mut gate = self.seed(first_tri)?;
+        let mut gate = self.seed(first_tri, attempt)?;
         loop {
             // Fail fast when the front degenerates (a cascade of fallbacks feeds itself):
             // the encoder retries at a slightly different L.
@@ -940,7 +960,11 @@ impl Retiler<'_, '_> {
 
     /// Places the seed triangle `[x0, x1, x2]` of the current component on the surface and
     /// returns the first gate `x0 -> x2`.
-    fn seed(&mut self, first_tri: u32) -> Result<u32, Error> {
+    fn seed(&mut self, first_tri: u32, attempt: usize) -> Result<u32, Error> {
+        // Seed `attempt` is the first valid candidate at least SEED_SPREAD · L from the
+        // seeds of the attempts before it (a neighbour of a seed that stalled grows the same
+        // front).
+        let mut earlier: Vec<DVec3> = Vec::new();
         let mesh = self.surf.mesh;
         let l = self.l;
         let comp = self.comp;
@@ -995,6 +1019,15 @@ impl Retiler<'_, '_> {
                     d > lo * l && d < hi * l
                 });
                 if nrm.dot(n0).is_nan() || nrm.dot(n0) <= 0.0 || !edges_ok {
+                    continue;
+                }
+                if earlier.len() < attempt {
+                    if earlier.iter().all(|e| e.distance(x0) >= SEED_SPREAD * l) {
+                        earlier.push(x0);
+                    }
+                    continue;
+                }
+                if earlier.iter().any(|e| e.distance(x0) < SEED_SPREAD * l) {
                     continue;
                 }
                 let n1 = self.surf.normal_at(t1, x1);

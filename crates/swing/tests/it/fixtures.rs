@@ -114,3 +114,20 @@ fn forward_connectivity_costs_about_an_eighth_of_a_bit_per_triangle() {
     assert!(bpt < 0.155, "{bpt} bits per triangle");
     assert!(out.bytes.len() < 4500, "{} bytes", out.bytes.len());
 }
+
+/// At 9-10 % of the diagonal the front stalls on sharp_sphere's small sharp features when it
+/// starts from the flattest seed, at this length and at every retry length the encoder tries
+/// (0.8-1.015 times it): the encode used to fail with `Error::Stuck`. A component now grows
+/// again from up to two more seeds, each at least four lengths from the ones before, before it
+/// counts as stuck.
+#[test]
+fn a_stalled_front_grows_again_from_another_seed() {
+    let mesh = load("sharp_sphere.off");
+    for fraction in [0.09, 0.1] {
+        let out = round_trip(&mesh, fraction);
+        assert_swing(&out);
+        let report = out.retiled.topology_report();
+        assert_eq!(report.boundary_edges, 0, "{fraction}");
+        assert_eq!(report.components, 1, "{fraction}");
+    }
+}
