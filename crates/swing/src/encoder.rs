@@ -214,6 +214,10 @@ pub struct SwingOutput {
     /// The surface filter for after EdgeSharpener carried in the stream (optional header
     /// fields 17 and 19; `SurfaceFilter::apply_after_sharpening`).
     pub sharpened_filter: SurfaceFilter,
+    /// How far the original's surface strays from the retiling, in units of `L`: the
+    /// largest distance of a sample of the original's vertices, outside the components
+    /// coded as pillows, to the retiled mesh (see `MAX_COVERAGE_GAP`).
+    pub coverage_gap: f64,
 }
 
 impl SwingOutput {
@@ -482,7 +486,9 @@ impl SwingEncoder {
             sharpened_filter: retiled.sharpened_filter,
         };
         let enc: SwingEncoded = encode_retiled(&retiled.mesh, &params, &info)?;
+        let coverage_gap = coverage_gap(&prep.mesh, &retiled.pillowed_vertices, &enc.decoded, l);
         Ok(SwingOutput {
+            coverage_gap,
             bytes: enc.bytes,
             report: enc.report,
             retiled: enc.decoded,
@@ -517,7 +523,7 @@ impl SwingEncoder {
             }
             match self.encode_at(prep, fraction * k) {
                 Ok(out) => {
-                    let gap = coverage_gap(&prep.mesh, &out);
+                    let gap = out.coverage_gap;
                     if gap <= MAX_COVERAGE_GAP {
                         return Ok(out);
                     }
@@ -526,7 +532,12 @@ impl SwingEncoder {
                     }
                 }
                 Err(e @ (Error::Stuck(_) | Error::Internal(_))) => last = Some(e),
-                Err(e) => return Err(e),
+                // A retry that fails otherwise (a shorter retry past the size limit on a
+                // mesh whose capped holes add area) keeps the gapped retiling found before.
+                Err(e) => match gapped {
+                    Some((_, out)) => return Ok(out),
+                    None => return Err(e),
+                },
             }
         }
         if let Some((_, out)) = gapped {
@@ -832,19 +843,29 @@ const MAX_COVERAGE_GAP: f64 = 3.0;
 /// largest distance of a sample of the original's vertices to the retiled mesh. Cheap (a
 /// bounding-volume tree of the retiling and at most [`COVERAGE_SAMPLES`] queries) next to the
 /// retiling itself.
-fn coverage_gap(original: &Mesh, out: &SwingOutput) -> f64 {
-    if out.retiled.triangles.is_empty() || out.edge_length.is_nan() || out.edge_length <= 0.0 {
+fn coverage_gap(original: &Mesh, pillowed: &[bool], retiled: &Mesh, l: f64) -> f64 {
+    if retiled.triangles.is_empty() || l.is_nan() || l <= 0.0 {
         return 0.0;
     }
-    let bvh = whet_metro::Bvh::new(&out.retiled);
+    let bvh = whet_metro::Bvh::new(retiled);
     let stride = original.positions.len().div_ceil(COVERAGE_SAMPLES).max(1);
     let gap = original
         .positions
         .iter()
+        .enumerate()
         .step_by(stride)
-        .map(|&p| bvh.closest_point(p).distance)
+        .filter(|&(v, _)| !pillowed.get(v).copied().unwrap_or(false))
+        .map(|(_, &p)| {
+            // A NaN distance (no finite triangle) counts as uncovered.
+            let d = bvh.closest_point(p).distance;
+            if d.is_nan() {
+                f64::INFINITY
+            } else {
+                d
+            }
+        })
         .fold(0.0f64, f64::max);
-    gap / out.edge_length
+    gap / l
 }
 
 /// The next length a rate search tries after the retiler got stuck at fraction `f` (with

@@ -186,6 +186,10 @@ pub struct Retiled {
     pub mesh: RetiledMesh,
     /// What happened.
     pub stats: RetileStats,
+    /// Per vertex of the original: whether it belongs to a component coded as a pillow
+    /// (tiny, or a small one the front could not cover), which the retiling leaves out by
+    /// design (the encoder's coverage check skips these vertices).
+    pub pillowed_vertices: Vec<bool>,
     /// The surface filter fitted to the original ([`SurfaceFilter::NONE`] unless asked for).
     pub filter: SurfaceFilter,
     /// The filter for after EdgeSharpener (`SurfaceFilter::apply_after_sharpening`), fitted
@@ -418,12 +422,14 @@ pub(crate) fn retile_fitted(
         }
     }
     let total_area: f64 = area.iter().sum();
+    let mut pillowed = vec![false; comps];
     for c in 0..comps {
         r.comp = c as u32;
         let tiny = boxes[c].diagonal() < 1.5 * l || area[c] < 0.75 * l * l;
         if tiny {
             r.pillow(first[c])?;
             r.stats.tiny_components += 1;
+            pillowed[c] = true;
             continue;
         }
         // Expected triangles: 2.4 · area / L² (algorithms.md 1.9).
@@ -431,15 +437,16 @@ pub(crate) fn retile_fitted(
         let mark = r.mark();
         // A front that stalls depends on where it started: before giving up on the
         // component, grow it again from the next seeds (in the seed's own order).
+        // Only a success replaces the first attempt's Stuck: any other error of a later
+        // attempt leaves the component to the fallbacks below, as the first one's would.
         let mut result = r.component(first[c], budget, 0);
         for attempt in 1..SEED_ATTEMPTS {
             if !matches!(result, Err(Error::Stuck(_))) {
                 break;
             }
-            r.rollback(mark);
-            match r.component(first[c], budget, attempt) {
-                Err(Error::Stuck(_)) => {}
-                other => result = other,
+            r.rollback(&mark);
+            if r.component(first[c], budget, attempt).is_ok() {
+                result = Ok(());
             }
         }
         match result {
@@ -448,9 +455,10 @@ pub(crate) fn retile_fitted(
             // splinter): a pillow loses it gracefully; a large one is an error (the encoder
             // retries at another L).
             Err(Error::Stuck(_)) if area[c] <= 0.1 * total_area => {
-                r.rollback(mark);
+                r.rollback(&mark);
                 r.pillow(first[c])?;
                 r.stats.degraded_components += 1;
+                pillowed[c] = true;
             }
             Err(e) => return Err(e),
         }
@@ -483,6 +491,20 @@ pub(crate) fn retile_fitted(
     } else {
         (SurfaceFilter::NONE, SurfaceFilter::NONE)
     };
+    // Vertices of pillowed components (the original's vertices come first in a capped mesh,
+    // and its triangles first too).
+    let mut pillowed_vertices = vec![false; mesh.positions.len()];
+    if pillowed.iter().any(|&p| p) {
+        for (t, &c) in r.surf.component.iter().enumerate() {
+            if pillowed.get(c as usize).copied().unwrap_or(false) {
+                for &v in &mesh.triangles[t] {
+                    if let Some(x) = pillowed_vertices.get_mut(v as usize) {
+                        *x = true;
+                    }
+                }
+            }
+        }
+    }
     Ok(Retiled {
         mesh: RetiledMesh {
             positions: r.pos,
@@ -493,6 +515,7 @@ pub(crate) fn retile_fitted(
             deleted,
         },
         stats: r.stats,
+        pillowed_vertices,
         filter,
         sharpened_filter,
     })
@@ -772,18 +795,23 @@ impl Retiler<'_, '_> {
     // --- Components ---------------------------------------------------------------------
 
     /// The sizes to roll a failed component back to.
-    fn mark(&self) -> (usize, usize, usize, usize) {
+    fn mark(&self) -> (usize, usize, usize, usize, RetileStats) {
         (
             self.pos.len(),
             self.tris.len(),
             self.labels.len(),
             self.nodes.len(),
+            self.stats.clone(),
         )
     }
 
     /// Forgets everything built since `mark` (one component: it created all its vertices,
     /// triangles and loop nodes after the mark and touched nothing older).
-    fn rollback(&mut self, (nv, nt, nl, nn): (usize, usize, usize, usize)) {
+    fn rollback(&mut self, mark: &(usize, usize, usize, usize, RetileStats)) {
+        let (nv, nt, nl, nn, stats) = mark;
+        let (nv, nt, nl, nn) = (*nv, *nt, *nl, *nn);
+        // The counters of the attempt undone go with it.
+        self.stats = stats.clone();
         for t in nt..self.tris.len() {
             let [w, a, b] = self.tris[t];
             for (x, y) in [(w, a), (a, b), (b, w)] {
@@ -866,6 +894,8 @@ impl Retiler<'_, '_> {
     fn component(&mut self, first_tri: u32, budget: usize, attempt: usize) -> Result<(), Error> {
         let start = self.tris.len();
         let forced_before = self.stats.forced;
+        // A flag the previous component raised on its very last triangle is not this one's.
+        self.runaway = false;
         let mut gate = self.seed(first_tri, attempt)?;
         loop {
             // Fail fast when the front degenerates (a cascade of fallbacks feeds itself):
