@@ -84,11 +84,7 @@ fn bad_streams_exit_2() {
 fn non_manifold_input_is_cut_and_reported() {
     let dir = scratch_dir("cli-codec-nm");
     let p = dir.join("fin.off");
-    std::fs::write(
-        &p,
-        "OFF\n5 3 0\n0 0 0\n1 0 0\n0 1 0\n0 -1 0\n0 0 1\n3 0 1 2\n3 1 0 3\n3 0 1 4\n",
-    )
-    .unwrap();
+    std::fs::write(&p, crate::FIN_OFF).unwrap();
     let stream = dir.join("fin.whet");
     let o = whet(&["encode", s(&p), "-o", s(&stream), "--json"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));

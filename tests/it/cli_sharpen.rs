@@ -304,11 +304,7 @@ fn subdividing_commands_refuse_outputs_over_max_memory() {
 fn bend_and_subdivide_repair_non_manifold_input() {
     let dir = scratch_dir("cli-nonmanifold-refine");
     let fin = dir.join("fin.off");
-    std::fs::write(
-        &fin,
-        "OFF\n5 3 0\n0 0 0\n1 0 0\n0 1 0\n0 -1 0\n0 0 1\n3 0 1 2\n3 1 0 3\n3 0 1 4\n",
-    )
-    .unwrap();
+    std::fs::write(&fin, crate::FIN_OFF).unwrap();
     let out = dir.join("out.off");
     for cmd in ["bend", "subdivide"] {
         let o = whet(&[cmd, s(&fin), "-o", s(&out), "--levels", "1"]);

@@ -38,6 +38,10 @@ pub fn whet_json(args: &[&str]) -> serde_json::Value {
     })
 }
 
+/// A fin: three triangles on the edge (0, 1), the smallest non-manifold mesh.
+pub const FIN_OFF: &str =
+    "OFF\n5 3 0\n0 0 0\n1 0 0\n0 1 0\n0 -1 0\n0 0 1\n3 0 1 2\n3 1 0 3\n3 0 1 4\n";
+
 /// Path as &str (test paths are UTF-8).
 pub fn s(p: &Path) -> &str {
     p.to_str().expect("UTF-8 path")
