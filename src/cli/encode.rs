@@ -178,6 +178,16 @@ pub fn run(args: &EncodeArgs) -> CliResult {
     }
 }
 
+/// The context of an encoding error: "cannot encode <path>", or just the path when the
+/// library's own message already starts with "cannot encode" (its input errors do).
+fn encode_context(path: &std::path::Path, e: &impl std::fmt::Display) -> String {
+    if e.to_string().starts_with("cannot encode") {
+        path.display().to_string()
+    } else {
+        format!("cannot encode {}", path.display())
+    }
+}
+
 fn write_stream(args: &EncodeArgs, bytes: &[u8]) -> CliResult {
     std::fs::write(&args.output, bytes).map_err(|e| {
         Failure::other(
@@ -219,7 +229,8 @@ fn run_exact(args: &EncodeArgs, mesh: &whet::Mesh) -> CliResult {
         .with_quant_bits(quant_bits);
     let encoded = Encoder::new(opts).encode(mesh).map_err(|e| {
         let input = !matches!(e, whet_codec::Error::Parameter(_));
-        let err = anyhow::Error::new(e).context(format!("cannot encode {}", args.input.display()));
+        let context = encode_context(&args.input, &e);
+        let err = anyhow::Error::new(e).context(context);
         if input {
             Failure::input(err)
         } else {
@@ -288,7 +299,8 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh) -> CliResult {
     );
     let out = whet_swing::encode(mesh, &opts).map_err(|e| {
         let input = e.is_input_error();
-        let err = anyhow::Error::new(e).context(format!("cannot encode {}", args.input.display()));
+        let context = encode_context(&args.input, &e);
+        let err = anyhow::Error::new(e).context(context);
         if input {
             Failure::input(err)
         } else {

@@ -247,3 +247,17 @@ fn max_retiled_triangles_bounds_the_retiling() {
     let t = j["retiled_triangles"].as_u64().unwrap();
     assert!((3000..=5500).contains(&t), "{t} retiled triangles");
 }
+
+/// A mesh with nothing to encode exits 2 with the library's own "cannot encode this mesh"
+/// once, after the path (the CLI used to say "cannot encode <path>: cannot encode this mesh").
+#[test]
+fn an_empty_mesh_is_refused_naming_the_path_once() {
+    let dir = scratch_dir("cli-empty-mesh");
+    let empty = dir.join("points.off");
+    std::fs::write(&empty, "OFF\n3 0 0\n0 0 0\n1 0 0\n0 1 0\n").unwrap();
+    let o = whet(&["encode", s(&empty), "-o", s(&dir.join("x.whet"))]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(err.matches("cannot encode").count(), 1, "{err}");
+    assert!(err.contains("points.off") && err.contains("no triangles"), "{err}");
+}
