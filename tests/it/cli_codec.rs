@@ -259,5 +259,8 @@ fn an_empty_mesh_is_refused_naming_the_path_once() {
     assert_eq!(o.status.code(), Some(2));
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(err.matches("cannot encode").count(), 1, "{err}");
-    assert!(err.contains("points.off") && err.contains("no triangles"), "{err}");
+    assert!(
+        err.contains("points.off") && err.contains("no triangles"),
+        "{err}"
+    );
 }
