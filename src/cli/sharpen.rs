@@ -164,17 +164,27 @@ pub fn fallback_tags(mesh: &Mesh) -> CliResult<Vec<[u32; 2]>> {
         .collect())
 }
 
-/// Bender, `levels` times, after checking its estimated peak memory against `max_memory`.
-pub fn run_bend(mesh: &Mesh, sharp: &[[u32; 2]], levels: u32, max_memory: u64) -> CliResult<Mesh> {
+/// Refuses `levels` levels of Bender on `triangles` triangles past `max_memory`.
+fn check_bend_memory(triangles: usize, levels: u32, max_memory: u64) -> CliResult {
     super::check_memory(
         &format!("{levels} levels of Bender"),
-        super::split_triangles(mesh.triangles.len(), levels),
+        super::split_triangles(triangles, levels),
         whet_bend::PEAK_BYTES_PER_OUTPUT_TRIANGLE,
         max_memory,
-    )?;
+    )
+}
+
+/// Bender, `levels` times; errors are input errors.
+fn bend(mesh: &Mesh, sharp: &[[u32; 2]], levels: u32) -> CliResult<Mesh> {
     whet_bend::bend_levels(mesh, sharp, levels)
         .map(|b| b.mesh)
         .map_err(Failure::input)
+}
+
+/// Bender, `levels` times, after checking its estimated peak memory against `max_memory`.
+pub fn run_bend(mesh: &Mesh, sharp: &[[u32; 2]], levels: u32, max_memory: u64) -> CliResult<Mesh> {
+    check_bend_memory(mesh.triangles.len(), levels, max_memory)?;
+    bend(mesh, sharp, levels)
 }
 
 pub fn run_bend_cmd(args: &BendArgs) -> CliResult {
@@ -187,12 +197,7 @@ pub fn run_bend_cmd(args: &BendArgs) -> CliResult {
         )));
     }
     // Before the repair and the tagging pass: a refusal should cost nothing.
-    super::check_memory(
-        &format!("{} levels of Bender", args.levels),
-        super::split_triangles(mesh.triangles.len(), args.levels),
-        whet_bend::PEAK_BYTES_PER_OUTPUT_TRIANGLE,
-        args.max_memory,
-    )?;
+    check_bend_memory(mesh.triangles.len(), args.levels, args.max_memory)?;
     let mesh = super::manifold(mesh);
     let sharp = match &args.tags {
         Some(t) => tag_edges(&SharpTags::read_path(t, &mesh).map_err(Failure::input)?),
@@ -201,7 +206,8 @@ pub fn run_bend_cmd(args: &BendArgs) -> CliResult {
             fallback_tags(&mesh)?
         }
     };
-    let out = run_bend(&mesh, &sharp, args.levels, args.max_memory)?;
+    // Checked above, before the repair and the tagging pass.
+    let out = bend(&mesh, &sharp, args.levels)?;
     write_mesh(&args.output, &out, None, &whet::io::WriteOptions::DEFAULT)?;
     eprintln!(
         "{} -> {}: {} levels, {} sharp edges, {} triangles",
