@@ -100,6 +100,13 @@ impl CornerTable {
         }
         let nc = 3 * nt;
         let mut corner_vertex = Vec::with_capacity(nc);
+        // One pass over the triangles checks them, counts each vertex's corners and the edges
+        // bucketed at it (by lower vertex, see below), and notes each vertex's first corner
+        // (its fan's start unless it is on a boundary).
+        let edges = |tri: &[u32]| [(tri[1], tri[2]), (tri[2], tri[0]), (tri[0], tri[1])];
+        let mut offsets = vec![0u32; vertex_count + 1];
+        let mut valence = vec![0u32; vertex_count];
+        let mut vertex_corner = vec![NONE; vertex_count];
         for (t, tri) in triangles.iter().enumerate() {
             for &v in tri {
                 if v as usize >= vertex_count {
@@ -122,6 +129,16 @@ impl CornerTable {
                 });
             }
             corner_vertex.extend_from_slice(tri);
+            for (j, &v) in tri.iter().enumerate() {
+                valence[v as usize] += 1;
+                let slot = &mut vertex_corner[v as usize];
+                if *slot == NONE {
+                    *slot = (3 * t + j) as u32;
+                }
+            }
+            for (a, b) in edges(tri) {
+                offsets[a.min(b) as usize + 1] += 1;
+            }
         }
 
         // Pair the edges facing the corners. The edge facing c runs v(next c) -> v(prev c);
@@ -131,13 +148,6 @@ impl CornerTable {
         // one scatter in between: linear for bounded valence.
         // Triangle by triangle: corner 3t + j faces the edge from vertex j + 1 to j + 2
         // (mod 3) of triangle t, read without a modulo per corner.
-        let edges = |tri: &[u32]| [(tri[1], tri[2]), (tri[2], tri[0]), (tri[0], tri[1])];
-        let mut offsets = vec![0u32; vertex_count + 1];
-        for tri in corner_vertex.chunks_exact(3) {
-            for (a, b) in edges(tri) {
-                offsets[a.min(b) as usize + 1] += 1;
-            }
-        }
         for v in 0..vertex_count {
             offsets[v + 1] += offsets[v];
         }
@@ -160,6 +170,9 @@ impl CornerTable {
         drop(fill);
         let is_upward = |c: usize| upward[c / 64] >> (c % 64) & 1 == 1;
         let mut opposite = vec![NONE; nc];
+        // Corners that start an open fan, per vertex: the corner after each boundary corner
+        // (the edge behind it is the boundary). The fan walk then starts there.
+        let mut open_fans = vec![0u8; vertex_count];
         for v in 0..vertex_count {
             let s = &mut bucket[offsets[v] as usize..offsets[v + 1] as usize];
             if s.len() > 1 {
@@ -172,7 +185,16 @@ impl CornerTable {
                     j += 1;
                 }
                 match j - i {
-                    1 => {}
+                    1 => {
+                        let start = next_raw(s[i] as u32 as usize);
+                        let w = corner_vertex[start] as usize;
+                        open_fans[w] = open_fans[w].saturating_add(1);
+                        // The fan starts there. Of several starts (refused below) keep the
+                        // highest corner, as `from_parts`'s scan in corner order does.
+                        if open_fans[w] == 1 || start as u32 > vertex_corner[w] {
+                            vertex_corner[w] = start as u32;
+                        }
+                    }
                     2 => {
                         let (c1, c2) = (s[i] as u32 as usize, s[i + 1] as u32 as usize);
                         // Twins run in opposite directions: c1's edge starts where c2's ends.
@@ -200,7 +222,13 @@ impl CornerTable {
         }
         drop(bucket);
         drop(offsets);
-        CornerTable::from_parts(corner_vertex, opposite, vertex_count, walk_fans)
+        let table = CornerTable {
+            corner_vertex,
+            opposite,
+            vertex_corner,
+        };
+        table.check_vertex_fans(&valence, &open_fans, walk_fans)?;
+        Ok(table)
     }
 
     /// Builds the table from corner vertices and opposites that are already paired (a
@@ -332,17 +360,30 @@ impl CornerTable {
                 table.vertex_corner[v] = c as u32;
             }
         }
-        for v in 0..vertex_count {
+        table.check_vertex_fans(&valence, &open_fans, walk_fans)?;
+        Ok(table)
+    }
+
+    /// Refuses a vertex with two open fans and, with `walk_fans`, one whose fan from its
+    /// start corner misses some of its corners; vertices in order, so the error names the
+    /// lowest offender.
+    fn check_vertex_fans(
+        &self,
+        valence: &[u32],
+        open_fans: &[u8],
+        walk_fans: bool,
+    ) -> Result<(), MeshError> {
+        for v in 0..self.vertex_corner.len() {
             if walk_fans {
-                table.check_fan(v, &valence, &open_fans)?;
+                self.check_fan(v, valence, open_fans)?;
             } else if open_fans[v] > 1 {
                 return Err(MeshError::NonManifoldVertex {
                     vertex: v as u32,
-                    fans: table.count_fans(VertexId(v as u32)),
+                    fans: self.count_fans(VertexId(v as u32)),
                 });
             }
         }
-        Ok(table)
+        Ok(())
     }
 
     /// Per vertex: corners, and corners that start an open fan.
@@ -744,5 +785,84 @@ mod tests {
             CornerTable::new(&m),
             Err(MeshError::RepeatedVertex { vertex: 1, .. })
         ));
+    }
+
+    /// Triangles of an n x n grid of quads, each split along a chosen diagonal, with the
+    /// odd interior quads that `holes` picks left out, in the order given by `perm` (vertex indices relabelled
+    /// by `relabel`).
+    fn grid(
+        n: u32,
+        diagonals: &[bool],
+        holes: &[bool],
+        perm: &[usize],
+        relabel: &[u32],
+    ) -> Vec<[u32; 3]> {
+        let mut tris = Vec::new();
+        for y in 0..n {
+            for x in 0..n {
+                let q = (y * n + x) as usize;
+                // Holes only at odd interior quads: never two touching, never at the rim, so
+                // every vertex keeps a single fan.
+                let interior = x % 2 == 1 && y % 2 == 1 && x + 1 < n && y + 1 < n;
+                if interior && holes[q % holes.len()] {
+                    continue;
+                }
+                let v = |dx: u32, dy: u32| relabel[((y + dy) * (n + 1) + x + dx) as usize];
+                let (a, b, c, d) = (v(0, 0), v(1, 0), v(1, 1), v(0, 1));
+                if diagonals[q % diagonals.len()] {
+                    tris.push([a, b, c]);
+                    tris.push([a, c, d]);
+                } else {
+                    tris.push([a, b, d]);
+                    tris.push([b, c, d]);
+                }
+            }
+        }
+        perm.iter()
+            .filter(|&&i| i < tris.len())
+            .map(|&i| tris[i])
+            .collect()
+    }
+
+    proptest::proptest! {
+        /// The build's own fan bookkeeping (valences, open fans and start corners gathered
+        /// while pairing) gives the table `from_raw`'s separate pass gives from the same
+        /// opposites, and both refuse the same inputs.
+        #[test]
+        fn build_matches_the_separate_fan_pass(
+            n in 1u32..8,
+            diagonals in proptest::collection::vec(proptest::bool::ANY, 1..9),
+            holes in proptest::collection::vec(proptest::bool::weighted(0.25), 1..11),
+            seed in 0u64..u64::MAX,
+        ) {
+            let nv = ((n + 1) * (n + 1)) as usize;
+            // A deterministic shuffle of triangles and vertex labels from the seed.
+            let mut state = seed | 1;
+            let mut rand = |m: usize| {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                (state % m as u64) as usize
+            };
+            let mut perm: Vec<usize> = (0..2 * (n * n) as usize).collect();
+            for i in (1..perm.len()).rev() {
+                perm.swap(i, rand(i + 1));
+            }
+            let mut relabel: Vec<u32> = (0..nv as u32).collect();
+            for i in (1..nv).rev() {
+                relabel.swap(i, rand(i + 1));
+            }
+            let tris = grid(n, &diagonals, &holes, &perm, &relabel);
+            let built = CornerTable::from_triangles(&tris, nv);
+            proptest::prop_assert!(built.is_ok(), "{:?}", built);
+            let Ok(t) = built else { unreachable!() };
+            let raw = CornerTable::from_raw(
+                t.corner_vertices().to_vec(),
+                t.opposites().to_vec(),
+                nv,
+                true,
+            );
+            proptest::prop_assert_eq!(raw, Ok(t));
+        }
     }
 }

@@ -124,6 +124,9 @@ pub(crate) struct Scratch {
     pub new_vertices: Vec<NewVertex>,
     pub stack: Vec<u32>,
     pub touched: Vec<u32>,
+    /// Per input triangle: its index in `touched` (the last, if listed twice), `NONE` when
+    /// it was never touched.
+    pub touched_index: Vec<u32>,
     /// Extended detection: smooth region of each red triangle, and label planes per vertex.
     pub region: Vec<u32>,
     pub lp_start: Vec<u32>,
@@ -219,8 +222,8 @@ impl EdgeSharpener {
             positions: Vec::new(),
             max_edge: 0.0,
             limits: SnapLimits::new(0.0),
-            ref_normals: std::collections::HashMap::new(),
-            snap_cache: std::collections::HashMap::new(),
+            ref_normals: Vec::new(),
+            snap_cache: Vec::new(),
             surface_samples: false,
         };
         let (out, parents, tags) = run.run();
@@ -235,6 +238,10 @@ impl EdgeSharpener {
     }
 }
 
+/// The outcome of snapping a chamfer edge's new vertex: its position and planes, or why it
+/// stays at rest.
+pub(crate) type EdgeSnap = Result<(DVec3, Planes), UnmovedReason>;
+
 /// One run over one mesh.
 pub(crate) struct Run<'a> {
     pub mesh: &'a Mesh,
@@ -247,10 +254,12 @@ pub(crate) struct Run<'a> {
     /// Longest input edge.
     pub max_edge: f64,
     pub limits: SnapLimits,
-    /// Reference normals of the touched input triangles (see `reference_normal`).
-    pub ref_normals: std::collections::HashMap<u32, DVec3>,
-    /// Edge snaps computed while dropping idle splits, by the lower corner of their edge.
-    pub snap_cache: std::collections::HashMap<u32, Result<(DVec3, Planes), UnmovedReason>>,
+    /// Reference normals of the triangles touched when the subdivision was laid out, by
+    /// their index in `Scratch::touched` (see `reference_normal`).
+    pub ref_normals: Vec<DVec3>,
+    /// Edge snaps computed while dropping idle splits, by the lower corner of their edge, in
+    /// increasing corner order (the order both passes visit the edges in).
+    pub snap_cache: Vec<(u32, EdgeSnap)>,
     /// Extended method: the input is a regular tiling whose vertices are surface samples
     /// (`crate::extended::is_surface_sampling`).
     pub surface_samples: bool,
@@ -292,6 +301,7 @@ impl Run<'_> {
 
     /// Smooth edges, the filters, the extended classification, chamfer edges and corner
     /// triangles.
+    #[inline(never)] // one call per run; kept out of line so profiles show it
     fn detect(&mut self) {
         let nt = self.mesh.triangles.len();
         let nc = 3 * nt;
@@ -324,6 +334,7 @@ impl Run<'_> {
     }
 
     /// Smooth edges: face normals, the angle of every interior edge, the mean, brown flags.
+    #[inline(never)] // one call per run; kept out of line so profiles show it
     fn smooth_edges(&mut self) {
         let mesh = self.mesh;
         let nt = mesh.triangles.len();
@@ -383,6 +394,7 @@ impl Run<'_> {
     }
 
     /// Filters 1-4 and 3bis.
+    #[inline(never)] // one call per run; kept out of line so profiles show it
     fn filters(&mut self) {
         let mesh = self.mesh;
         let table = self.table;
@@ -411,21 +423,34 @@ impl Run<'_> {
                 s.tflags[t] |= T_RED;
             }
         }
-        // Filter 3: grow through brown edges (explicit stack), from every core triangle at once.
+        // Filter 3: grow through brown edges (explicit stack). The red set is the closure of
+        // the core triangles, so growing from each in turn gives what growing from all at once
+        // does, and the stack holds only the triangles the growth adds, not every red one.
         s.stack.clear();
-        s.stack
-            .extend((0..nt as u32).filter(|&t| s.tflags[t as usize] & T_RED != 0));
-        while let Some(t) = s.stack.pop() {
-            for c in 3 * t as usize..3 * t as usize + 3 {
-                if s.cflags[c] & C_BROWN == 0 {
-                    continue;
-                }
-                if let Some(o) = table.opposite(CornerId(c as u32)) {
-                    let u = o.index() / 3;
+        let opposite = table.opposites();
+        for t0 in 0..nt {
+            if s.tflags[t0] & T_RED == 0 {
+                continue;
+            }
+            let mut t = t0;
+            loop {
+                for c in 3 * t..3 * t + 3 {
+                    if s.cflags[c] & C_BROWN == 0 {
+                        continue;
+                    }
+                    let o = opposite[c];
+                    if o == NONE {
+                        continue; // brown edges are interior; never taken
+                    }
+                    let u = o as usize / 3;
                     if s.tflags[u] & T_RED == 0 {
                         s.tflags[u] |= T_RED;
                         s.stack.push(u as u32);
                     }
+                }
+                match s.stack.pop() {
+                    Some(u) => t = u as usize,
+                    None => break,
                 }
             }
         }
@@ -548,6 +573,7 @@ impl Run<'_> {
     /// [`IDLE_SPLIT`] of the edge length, changes no geometry; it is dropped so that already
     /// sharp creases keep their triangulation. So is the centre of a corner triangle that could
     /// not move, unless the triangle keeps three chamfer edges (which need a centre).
+    #[inline(never)] // one call per run; kept out of line so profiles show it
     fn drop_idle_splits(&mut self) {
         let nt = self.mesh.triangles.len();
         let mut blue = 0;
@@ -570,7 +596,7 @@ impl Run<'_> {
                 Err(_) => true,
             };
             if !idle {
-                self.snap_cache.insert(c as u32, snapped);
+                self.snap_cache.push((c as u32, snapped));
             }
             if idle {
                 self.s.cflags[c] &= !C_BLUE;
@@ -603,6 +629,7 @@ impl Run<'_> {
 
     /// Inserts one vertex per blue edge and green triangle, computes the planes at the ends of
     /// the chamfer edges and snaps.
+    #[inline(never)] // one call per run; kept out of line so profiles show it
     fn insert_vertices(&mut self) {
         let mesh = self.mesh;
         let nt = mesh.triangles.len();
@@ -611,6 +638,7 @@ impl Run<'_> {
         reset(&mut self.s.edge_vertex, nc, NONE);
         self.s.new_vertices.clear();
         self.s.touched.clear();
+        reset(&mut self.s.touched_index, nt, NONE);
         if self.opts.method == Method::Papers {
             // Which vertices need a plane: the ends of blue edges (corner-triangle vertices
             // are ends of blue edges too).
@@ -623,6 +651,7 @@ impl Run<'_> {
             }
             self.compute_planes();
         }
+        let mut next_cached = 0;
         for c in 0..nc {
             if self.s.cflags[c] & C_BLUE == 0 {
                 continue;
@@ -638,9 +667,17 @@ impl Run<'_> {
             let id = (nv + self.s.new_vertices.len()) as u32;
             self.s.edge_vertex[c] = id;
             self.s.edge_vertex[o.index()] = id;
-            let snapped = match self.snap_cache.remove(&(c as u32)) {
-                Some(s) => s,
-                None => self.edge_snap(a, b, rest),
+            // Both passes visit the blue edges by increasing corner: the cache is read in order.
+            while self
+                .snap_cache
+                .get(next_cached)
+                .is_some_and(|(k, _)| (*k as usize) < c)
+            {
+                next_cached += 1;
+            }
+            let snapped = match self.snap_cache.get(next_cached) {
+                Some((k, s)) if *k as usize == c => *s,
+                _ => self.edge_snap(a, b, rest),
             };
             let (pos, status, planes) = match snapped {
                 Ok((p, planes)) => (p, SNAPPED, planes),
@@ -686,6 +723,7 @@ impl Run<'_> {
                 || f & (T_TOUCHED | T_GREEN) != 0
             {
                 self.s.tflags[t] |= T_TOUCHED;
+                self.s.touched_index[t] = self.s.touched.len() as u32;
                 self.s.touched.push(t as u32);
             }
         }
@@ -694,6 +732,7 @@ impl Run<'_> {
 
     /// Angle-weighted normal of the red triangles around each vertex flagged `V_PLANE`
     /// (seed 000 section 3: weights are the triangles' angles at the vertex).
+    #[inline(never)] // one call per run; kept out of line so profiles show it
     fn compute_planes(&mut self) {
         let mesh = self.mesh;
         reset(&mut self.s.plane_of, mesh.positions.len(), NONE);
@@ -865,8 +904,11 @@ impl Run<'_> {
     /// around it is centred on the crease. Zero when that area cancels, in which case nothing is
     /// checked.
     pub(crate) fn reference_normal(&self, t: usize) -> DVec3 {
-        if let Some(n) = self.ref_normals.get(&(t as u32)) {
-            return *n;
+        // Triangles touched later (by the sliver pass) are computed again: the normal depends
+        // on the input alone.
+        let i = self.s.touched_index[t] as usize;
+        if i < self.ref_normals.len() && self.s.touched[i] as usize == t {
+            return self.ref_normals[i];
         }
         self.compute_reference_normal(t)
     }
@@ -882,12 +924,13 @@ impl Run<'_> {
     }
 
     /// Caches the reference normals of the touched triangles.
+    #[inline(never)] // one call per run; kept out of line so profiles show it
     fn cache_reference_normals(&mut self) {
         self.ref_normals.clear();
         for i in 0..self.s.touched.len() {
             let t = self.s.touched[i];
             let n = self.compute_reference_normal(t as usize);
-            self.ref_normals.insert(t, n);
+            self.ref_normals.push(n);
         }
     }
 
@@ -1040,6 +1083,7 @@ impl Run<'_> {
 
     /// Chooses diagonals and unsnaps vertices until no piece reverses its input triangle or
     /// has an edge with a snapped end longer than the longest input edge.
+    #[inline(never)] // one call per run; kept out of line so profiles show it
     fn settle_positions(&mut self) {
         let limit = self.max_edge * self.edge_limit_factor();
         let max2 = limit * limit;
@@ -1139,6 +1183,7 @@ impl Run<'_> {
     }
 
     /// Tagged vertices (3bis plus the surviving new vertices) and the edges between them.
+    #[inline(never)] // one call per run; kept out of line so profiles show it
     fn tags(&mut self, mesh: &Mesh) -> SharpTags {
         let nv = self.mesh.positions.len();
         let mut flags = vec![false; mesh.positions.len()];
@@ -1155,6 +1200,7 @@ impl Run<'_> {
         tags
     }
 
+    #[inline(never)] // one call per run; kept out of line so profiles show it
     fn extend_detection(&mut self) {
         crate::extended::classify(self);
     }
@@ -1164,6 +1210,7 @@ impl Run<'_> {
 /// edges (what filter 3's flood connects), numbered 0.. in order of their lowest triangle.
 /// Union-find in one pass over the triangles (neighbours are mostly close in index order,
 /// which keeps it cache friendly), then one pass to number the roots.
+#[inline(never)] // one call per run; kept out of line so profiles show it
 fn label_regions(s: &mut Scratch, table: &CornerTable, nt: usize) {
     let region = &mut s.region;
     region.clear();

@@ -104,6 +104,7 @@ pub(crate) const THIN_ANGLE_DEGREES: f64 = 20.0;
 /// turn by more than twice the smooth threshold as two surfaces, and refuses snaps across a
 /// strip that holds a vertex on neither plane ([`STRIP_TOLERANCE`]). Everything else, and
 /// marching-cubes input, is unchanged.
+#[inline(never)] // one call per run; kept out of line so profiles show it
 pub(crate) fn is_surface_sampling(mesh: &whet_mesh::Mesh) -> bool {
     let nt = mesh.triangles.len();
     if nt == 0 {
@@ -139,10 +140,13 @@ pub(crate) const MOVE_LIMIT: f64 = 0.5;
 /// Moves each labelled gray (chamfer) vertex that lies on two or more surfaces onto their
 /// intersection: the point of the crease line nearest to it, or the (least-squares) corner
 /// point. Only gray vertices move, never the vertices of smooth (red) triangles.
+#[inline(never)] // one call per run; kept out of line so profiles show it
 fn snap_chamfer_vertices(run: &mut Run) {
     let nv = run.mesh.positions.len();
     let mut moves: Vec<(u32, DVec3)> = Vec::new();
     let mut stay: Vec<u32> = Vec::new();
+    let mut kept: Vec<LabelPlane> = Vec::new();
+    let mut surfaces: Vec<Plane> = Vec::new();
     for v in 0..nv as u32 {
         if run.s.vflags[v as usize] & V_CHAMFER == 0 {
             continue;
@@ -151,13 +155,14 @@ fn snap_chamfer_vertices(run: &mut Run) {
             // Assume it stays; a successful move below removes it from the list.
             stay.push(v);
         }
-        let mut kept: Vec<LabelPlane> = Vec::new();
+        kept.clear();
         for lp in planes_of(run, v) {
             if kept.iter().all(|k| !same_surface(run, k, lp)) {
                 kept.push(*lp);
             }
         }
-        let surfaces: Vec<Plane> = kept.iter().map(|k| k.plane).collect();
+        surfaces.clear();
+        surfaces.extend(kept.iter().map(|k| k.plane));
         if surfaces.len() < 2 || !well_separated(run, &surfaces) {
             continue;
         }
@@ -226,6 +231,7 @@ pub(crate) const CORRIDOR_ON_PLANE: f64 = 0.1;
 /// whose vertices lie on the planes of neighbouring regions. Their triangles stop being red, so their
 /// vertices are classified like any chamfer vertex. This reaches what the papers' core test
 /// (filter 1) misses on coarse samplings.
+#[inline(never)] // one call per run; kept out of line so profiles show it
 fn demote_corridors(run: &mut Run) {
     let nv = run.mesh.positions.len();
     let nt = run.mesh.triangles.len();
@@ -363,6 +369,7 @@ fn neighbour_plane_distance(run: &Run, v: u32, r: u32) -> f64 {
 /// sums, and each bucket's median is a selection, not a sort. The median, not the mean: a CAD
 /// region often joins flat faces and the tangent blends between them, whose larger angles would
 /// pull a mean up; the median is the turn of most of the region.
+#[inline(never)] // one call per run; kept out of line so profiles show it
 pub(crate) fn region_turns(run: &mut Run) {
     let nregions = run
         .s
@@ -429,6 +436,7 @@ pub(crate) fn region_turns(run: &mut Run) {
 }
 
 /// Label planes of the red vertices that touch a non-red triangle or two regions.
+#[inline(never)] // one call per run; kept out of line so profiles show it
 fn border_planes(run: &mut Run) {
     let nv = run.mesh.positions.len();
     run.s.lp_start.clear();
@@ -502,6 +510,7 @@ pub(crate) fn planes_of<'a>(run: &'a Run, v: u32) -> &'a [LabelPlane] {
 }
 
 /// Gives each gray vertex the nearest label plane of a neighbour when it lies on it.
+#[inline(never)] // one call per run; kept out of line so profiles show it
 fn gray_vertices(run: &mut Run) {
     let nv = run.mesh.positions.len();
     let mut gray: Vec<u32> = (0..nv as u32)
@@ -555,9 +564,11 @@ fn gray_vertices(run: &mut Run) {
 }
 
 /// Gives labelled vertices that lie on a neighbour's other, non-parallel plane that label too.
+#[inline(never)] // one call per run; kept out of line so profiles show it
 fn crease_vertices(run: &mut Run) {
     let nv = run.mesh.positions.len();
     let mut extra: Vec<(u32, LabelPlane)> = Vec::new();
+    let mut found: Vec<LabelPlane> = Vec::new();
     for v in 0..nv as u32 {
         let own = planes_of(run, v);
         if own.is_empty() || run.table.is_boundary_vertex(VertexId(v)) {
@@ -566,7 +577,7 @@ fn crease_vertices(run: &mut Run) {
         let p = run.mesh.positions[v as usize];
         let mut len = 0.0;
         let mut k = 0usize;
-        let mut found: Vec<LabelPlane> = Vec::new();
+        found.clear();
         for c in run.table.vertex_corners(VertexId(v)) {
             let u = run.cv(next(c.index()));
             len += (run.mesh.positions[u as usize] - p).length();
@@ -590,7 +601,7 @@ fn crease_vertices(run: &mut Run) {
             RED_CREASE_TOLERANCE
         };
         let tol = factor * len / k as f64;
-        for lp in found {
+        for &lp in &found {
             if (p - lp.plane.point).dot(lp.plane.normal).abs() <= tol {
                 extra.push((v, lp));
             }
@@ -604,9 +615,8 @@ fn crease_vertices(run: &mut Run) {
     let mut lps = Vec::with_capacity(run.s.lps.len() + extra.len());
     let mut i = 0;
     for v in 0..nv {
-        let own: Vec<LabelPlane> = planes_of(run, v as u32).to_vec();
         let start = lps.len() as u32;
-        lps.extend_from_slice(&own);
+        lps.extend_from_slice(planes_of(run, v as u32));
         while i < extra.len() && extra[i].0 as usize == v {
             if lps.len() - (start as usize) < u8::MAX as usize {
                 lps.push(extra[i].1);
@@ -647,15 +657,27 @@ fn well_separated(run: &Run, planes: &[Plane]) -> bool {
 /// pyramid's base corners 0.7 and its apex triples 0.5).
 pub(crate) const MIN_CORNER_DET: f64 = 0.1;
 
-/// Number of distinct surfaces among `planes` (greedy, in order; see [`same_surface`]).
-fn surfaces(run: &Run, planes: &[LabelPlane]) -> usize {
-    let mut kept: Vec<&LabelPlane> = Vec::new();
+/// Whether `planes` hold three or more distinct surfaces (greedy, in order; see
+/// [`same_surface`]).
+fn at_least_three_surfaces(run: &Run, planes: &[LabelPlane]) -> bool {
+    // Counting stops at three, so the kept planes fit on the stack (this runs for every
+    // candidate corner triangle).
+    let mut kept: [Option<&LabelPlane>; 2] = [None; 2];
+    let mut n = 0;
     for lp in planes {
-        if kept.iter().all(|k| !same_surface(run, k, lp)) {
-            kept.push(lp);
+        if kept[..n]
+            .iter()
+            .flatten()
+            .all(|k| !same_surface(run, k, lp))
+        {
+            if n == 2 {
+                return true;
+            }
+            kept[n] = Some(lp);
+            n += 1;
         }
     }
-    kept.len()
+    false
 }
 
 /// Two label planes belong to the same surface when they come from the same smooth region
@@ -691,7 +713,7 @@ pub(crate) fn is_corner_triangle(run: &Run, tri: [u32; 3]) -> bool {
         return false;
     }
     // A vertex already on three surfaces is the corner (a corner vertex moved there).
-    if p.iter().any(|x| surfaces(run, x) >= 3) {
+    if p.iter().any(|x| at_least_three_surfaces(run, x)) {
         return false;
     }
     let mut common = false;
@@ -1065,6 +1087,7 @@ pub(crate) const CORNER_MOVE_LIMIT: f64 = 1.5;
 /// Corner vertices: for each corner triangle whose three planes meet in a point, the nearest
 /// chamfer vertex (of the triangle or around it) moves onto that point and takes the three
 /// planes as labels. Returns how many moved; the caller then recomputes the chamfer edges.
+#[inline(never)] // one call per run; kept out of line so profiles show it
 pub(crate) fn corner_vertices(run: &mut Run) -> usize {
     let nt = run.mesh.triangles.len();
     let mut placed: Vec<DVec3> = Vec::new();

@@ -35,7 +35,7 @@
 //! end no new triangle is thin or reversed.
 
 use std::cmp::Reverse;
-use std::collections::{BinaryHeap, HashMap};
+use std::collections::BinaryHeap;
 
 use glam::DVec3;
 use whet_mesh::{FaceId, Mesh, VertexId};
@@ -58,24 +58,33 @@ pub(crate) struct Output {
     min_angle_rad: f64,
 }
 
-/// Union-find with path halving that also lists each set's members (smaller lists merge into
-/// larger ones, so listing costs O(n log n) in total).
+/// Union-find with path halving that also lists each set's members: a linked list per set
+/// that starts at its root, the smaller list appended to the larger (so a member moves
+/// O(log n) times), in flat arrays rather than one vector per set.
 struct Groups {
     parent: Vec<u32>,
-    members: Vec<Vec<u32>>,
+    /// Next member in its set's list, `NONE` at the end.
+    next: Vec<u32>,
+    /// At a root: the last member of its list, and the set's size.
+    tail: Vec<u32>,
+    size: Vec<u32>,
 }
 
 impl Groups {
     fn new(n: usize) -> Groups {
         Groups {
             parent: (0..n as u32).collect(),
-            members: (0..n as u32).map(|i| vec![i]).collect(),
+            next: vec![NONE; n],
+            tail: (0..n as u32).collect(),
+            size: vec![1; n],
         }
     }
     fn push(&mut self) -> u32 {
         let i = self.parent.len() as u32;
         self.parent.push(i);
-        self.members.push(vec![i]);
+        self.next.push(NONE);
+        self.tail.push(i);
+        self.size.push(1);
         i
     }
     fn find(&mut self, mut x: u32) -> u32 {
@@ -91,18 +100,72 @@ impl Groups {
         if a == b {
             return;
         }
-        let (big, small) = if self.members[a as usize].len() >= self.members[b as usize].len() {
+        let (big, small) = if self.size[a as usize] >= self.size[b as usize] {
             (a, b)
         } else {
             (b, a)
         };
         self.parent[small as usize] = big;
-        let moved = std::mem::take(&mut self.members[small as usize]);
-        self.members[big as usize].extend(moved);
+        let end = self.tail[big as usize];
+        self.next[end as usize] = small;
+        self.tail[big as usize] = self.tail[small as usize];
+        self.size[big as usize] += self.size[small as usize];
     }
-    fn members_of(&mut self, x: u32) -> Vec<u32> {
-        let r = self.find(x);
-        self.members[r as usize].clone()
+    /// Appends the members of `x`'s set to `out`, in the order the unions listed them.
+    fn members_of(&mut self, x: u32, out: &mut Vec<u32>) {
+        let mut m = self.find(x);
+        while m != NONE {
+            out.push(m);
+            m = self.next[m as usize];
+        }
+    }
+}
+
+/// Per-vertex lists of slots, each in the order its slots were added, as linked lists in one
+/// arena (a sharpening makes thousands of short lists; one vector each cost more in the
+/// allocator than the sliver pass itself).
+struct SlotLists {
+    /// Per vertex: first and last node, `NONE` when empty.
+    head: Vec<u32>,
+    tail: Vec<u32>,
+    /// Per node: its slot and the next node.
+    slot: Vec<u32>,
+    next: Vec<u32>,
+}
+
+impl SlotLists {
+    fn new(vertex_count: usize) -> SlotLists {
+        SlotLists {
+            head: vec![NONE; vertex_count],
+            tail: vec![NONE; vertex_count],
+            slot: Vec::new(),
+            next: Vec::new(),
+        }
+    }
+    fn push(&mut self, v: u32, s: u32) {
+        let node = self.slot.len() as u32;
+        self.slot.push(s);
+        self.next.push(NONE);
+        let v = v as usize;
+        match self.tail[v] {
+            NONE => self.head[v] = node,
+            t => self.next[t as usize] = node,
+        }
+        self.tail[v] = node;
+    }
+    fn clear(&mut self, v: u32) {
+        self.head[v as usize] = NONE;
+        self.tail[v as usize] = NONE;
+    }
+    fn iter(&self, v: u32) -> impl Iterator<Item = u32> + '_ {
+        let mut node = self.head[v as usize];
+        std::iter::from_fn(move || {
+            (node != NONE).then(|| {
+                let s = self.slot[node as usize];
+                node = self.next[node as usize];
+                s
+            })
+        })
     }
 }
 
@@ -110,9 +173,7 @@ impl Groups {
 struct Local {
     /// New slots around each vertex that has one (filter: dead, restored, or no longer
     /// holding the vertex).
-    slots: HashMap<u32, Vec<u32>>,
-    /// Touched index of each touched input triangle.
-    touched_index: HashMap<u32, u32>,
+    slots: SlotLists,
     /// Touched triangles changed together by operations (restored together).
     groups: Groups,
     /// Per touched index: no operation changed its pieces yet.
@@ -258,37 +319,31 @@ impl Output {
     }
 
     fn build_local(&self, run: &Run) -> Local {
-        let mut slots: HashMap<u32, Vec<u32>> = HashMap::new();
+        let mut slots = SlotLists::new(run.positions.len());
         for s in 0..self.tris.len() {
             if self.is_new[s] {
                 for &v in &self.tris[s] {
-                    slots.entry(v).or_default().push(s as u32);
+                    slots.push(v, s as u32);
                 }
             }
         }
-        let touched_index: HashMap<u32, u32> = run
-            .s
-            .touched
-            .iter()
-            .enumerate()
-            .map(|(i, &t)| (t, i as u32))
-            .collect();
+        let touched_index = &run.s.touched_index;
         let n = run.s.touched.len();
         let mut groups = Groups::new(n);
         let mut pristine = vec![true; n];
         // A moved input vertex's triangles move together.
         let nv = run.mesh.positions.len();
-        for (v, list) in &slots {
-            let vi = *v as usize;
-            if vi >= nv || run.s.vflags[vi] & V_MOVED == 0 {
+        for v in 0..nv as u32 {
+            if run.s.vflags[v as usize] & V_MOVED == 0 {
                 continue;
             }
             let mut first = None;
             // Every new slot's parent is touched (pieces, or triangles around a moved vertex).
-            for i in list
-                .iter()
-                .filter_map(|&s| touched_index.get(&self.parent[s as usize]).copied())
-            {
+            for s in slots.iter(v) {
+                let i = touched_index[self.parent[s as usize] as usize];
+                if i == NONE {
+                    continue;
+                }
                 pristine[i as usize] = false;
                 match first {
                     None => first = Some(i),
@@ -299,7 +354,6 @@ impl Output {
         let new_count = self.is_new.iter().filter(|&&x| x).count();
         Local {
             slots,
-            touched_index,
             groups,
             pristine,
             flip_budget: 4 * new_count + 16,
@@ -310,10 +364,8 @@ impl Output {
     fn slots_at<'a>(&'a self, local: &'a Local, v: u32) -> impl Iterator<Item = usize> + 'a {
         local
             .slots
-            .get(&v)
-            .map_or(&[][..], |x| &x[..])
-            .iter()
-            .map(|&s| s as usize)
+            .iter(v)
+            .map(|s| s as usize)
             .filter(move |&s| self.alive[s] && self.is_new[s] && self.tris[s].contains(&v))
     }
 
@@ -543,12 +595,14 @@ impl Output {
         // together, if ever.
         let mut changed_parents: Vec<u32> = us
             .iter()
-            .filter_map(|&s| local.touched_index.get(&self.parent[s]).copied())
+            .map(|&s| run.s.touched_index[self.parent[s] as usize])
+            .filter(|&i| i != NONE)
             .collect();
         if w >= nv {
             changed_parents.extend(
                 self.slots_at(local, w)
-                    .filter_map(|s| local.touched_index.get(&self.parent[s]).copied()),
+                    .map(|s| run.s.touched_index[self.parent[s] as usize])
+                    .filter(|&i| i != NONE),
             );
         }
         if let Some(&first) = changed_parents.first() {
@@ -581,12 +635,10 @@ impl Output {
                 moved.push(s as u32);
             }
         }
-        local.slots.remove(&u);
-        local
-            .slots
-            .entry(w)
-            .or_default()
-            .extend(moved.iter().copied());
+        local.slots.clear(u);
+        for &s in &moved {
+            local.slots.push(w, s);
+        }
         let mut changed: Vec<u32> = self.slots_at(local, w).map(|s| s as u32).collect();
         changed.sort_unstable();
         changed.dedup();
@@ -603,12 +655,12 @@ impl Output {
         let i = run.s.touched.len() as u32;
         run.s.touched.push(t);
         self.ranges.push((s as u32, 1));
-        local.touched_index.insert(t, i);
+        run.s.touched_index[t as usize] = i;
         local.groups.push();
         local.pristine.push(false);
         self.is_new[s] = true;
         for &v in &self.tris[s] {
-            local.slots.entry(v).or_default().push(s as u32);
+            local.slots.push(v, s as u32);
         }
     }
 
@@ -631,13 +683,14 @@ impl Output {
             .unwrap_or(c); // flip_quality found d: the slot across holds a third vertex
         self.tris[s] = [c, a, d];
         self.tris[s2] = [c, d, b];
-        local.slots.entry(d).or_default().push(s as u32);
-        local.slots.entry(c).or_default().push(s2 as u32);
+        local.slots.push(d, s as u32);
+        local.slots.push(c, s2 as u32);
         // Both parents are touched: s is new, s2 was touched above.
-        if let (Some(&i1), Some(&i2)) = (
-            local.touched_index.get(&self.parent[s]),
-            local.touched_index.get(&self.parent[s2]),
-        ) {
+        let (i1, i2) = (
+            run.s.touched_index[self.parent[s] as usize],
+            run.s.touched_index[self.parent[s2] as usize],
+        );
+        if i1 != NONE && i2 != NONE {
             local.groups.union(i1, i2);
             local.pristine[i1 as usize] = false;
             local.pristine[i2 as usize] = false;
@@ -651,16 +704,20 @@ impl Output {
     fn restore(&mut self, run: &mut Run, local: &mut Local, s: usize) -> Vec<u32> {
         let mut changed: Vec<u32> = Vec::new();
         let mut work: Vec<u32> = vec![self.parent[s]];
+        let mut members: Vec<u32> = Vec::new();
         while let Some(t) = work.pop() {
             let t = t as usize;
             if run.s.tflags[t] & T_TOUCHED == 0 {
                 continue; // restored already, or never touched
             }
-            let Some(&i) = local.touched_index.get(&(t as u32)) else {
+            let i = run.s.touched_index[t];
+            if i == NONE {
                 continue;
-            };
+            }
             // Its group goes back with it.
-            for j in local.groups.members_of(i) {
+            members.clear();
+            local.groups.members_of(i, &mut members);
+            for &j in &members {
                 let u = run.s.touched[j as usize];
                 if u as usize != t && run.s.tflags[u as usize] & T_TOUCHED != 0 {
                     work.push(u);
@@ -682,9 +739,10 @@ impl Output {
                 if run.s.tflags[t2] & T_TOUCHED == 0 {
                     continue;
                 }
-                let Some(&i2) = local.touched_index.get(&(t2 as u32)) else {
+                let i2 = run.s.touched_index[t2];
+                if i2 == NONE {
                     continue;
-                };
+                }
                 if local.pristine[i2 as usize] {
                     changed.extend(self.recut(run, local, t2, i2));
                 } else {
@@ -728,7 +786,7 @@ impl Output {
                 self.alive[slot] = true;
                 self.is_new[slot] = true;
                 for &v in &pieces[k] {
-                    local.slots.entry(v).or_default().push(slot as u32);
+                    local.slots.push(v, slot as u32);
                 }
                 changed.push(slot as u32);
             } else {
@@ -792,5 +850,47 @@ impl Output {
         r.output_vertices = positions.len();
         r.output_triangles = tris.len();
         (Mesh::new(positions, tris), parents)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn groups_list_members_in_union_order() {
+        let mut g = Groups::new(5);
+        g.union(0, 1); // {0, 1}
+        g.union(3, 4); // {3, 4}
+        g.union(2, 0); // the smaller {2} joins {0, 1}
+        let pushed = g.push();
+        assert_eq!(pushed, 5);
+        g.union(4, 1); // equal sizes would keep the first; {3, 4} is smaller here
+        let mut m = Vec::new();
+        g.members_of(3, &mut m);
+        assert_eq!(m, vec![0, 1, 2, 3, 4]);
+        m.clear();
+        g.members_of(5, &mut m);
+        assert_eq!(m, vec![5]);
+        // Path halving leaves the sets as they were.
+        for x in 0..5 {
+            assert_eq!(g.find(x), g.find(0));
+        }
+    }
+
+    #[test]
+    fn slot_lists_keep_insertion_order_and_clear_per_vertex() {
+        let mut l = SlotLists::new(4);
+        for (v, s) in [(1, 10), (2, 20), (1, 11), (3, 30), (1, 12), (2, 21)] {
+            l.push(v, s);
+        }
+        assert_eq!(l.iter(1).collect::<Vec<_>>(), vec![10, 11, 12]);
+        assert_eq!(l.iter(2).collect::<Vec<_>>(), vec![20, 21]);
+        assert_eq!(l.iter(0).count(), 0);
+        l.clear(1);
+        assert_eq!(l.iter(1).count(), 0);
+        l.push(1, 13);
+        assert_eq!(l.iter(1).collect::<Vec<_>>(), vec![13]);
+        assert_eq!(l.iter(3).collect::<Vec<_>>(), vec![30]);
     }
 }

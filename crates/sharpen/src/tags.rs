@@ -49,17 +49,22 @@ impl SharpTags {
             .filter(|&v| tagged[v])
             .map(VertexId::from_index)
             .collect();
-        let mut edges: Vec<[VertexId; 2]> = Vec::new();
+        // Packed as one word (lower end high), so the sort compares words; the same order as
+        // the pairs.
+        let mut packed: Vec<u64> = Vec::new();
         for tri in &mesh.triangles {
-            for k in 0..3 {
-                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            for (a, b) in [(tri[0], tri[1]), (tri[1], tri[2]), (tri[2], tri[0])] {
                 if a != b && is(a) && is(b) {
-                    edges.push([VertexId(a.min(b)), VertexId(a.max(b))]);
+                    packed.push(u64::from(a.min(b)) << 32 | u64::from(a.max(b)));
                 }
             }
         }
-        edges.sort_unstable();
-        edges.dedup();
+        packed.sort_unstable();
+        packed.dedup();
+        let edges = packed
+            .iter()
+            .map(|&e| [VertexId((e >> 32) as u32), VertexId(e as u32)])
+            .collect();
         SharpTags { vertices, edges }
     }
 
