@@ -343,22 +343,25 @@ fn neighbour_plane_distance(run: &Run, v: u32, r: u32) -> f64 {
     let mut len = 0.0;
     let mut k = 0usize;
     let mut best = f64::INFINITY;
+    let mut nearest_in_fan = |x: u32| {
+        for cc in run.table.vertex_corners(VertexId(x)) {
+            let t = cc.index() / 3;
+            let rt = run.s.region[t];
+            if rt == NONE || rt == r {
+                continue;
+            }
+            let n = run.s.normals[t];
+            let q = run.mesh.positions[run.mesh.triangles[t][0] as usize];
+            best = best.min((p - q).dot(n).abs());
+        }
+    };
+    // The vertex's own fan once, then each neighbour's (a minimum: the order is free).
+    nearest_in_fan(v);
     for c in run.table.vertex_corners(VertexId(v)) {
         let u = run.cv(next(c.index()));
         len += (run.mesh.positions[u as usize] - p).length();
         k += 1;
-        for x in [v, u] {
-            for cc in run.table.vertex_corners(VertexId(x)) {
-                let t = cc.index() / 3;
-                let rt = run.s.region[t];
-                if rt == NONE || rt == r {
-                    continue;
-                }
-                let n = run.s.normals[t];
-                let q = run.mesh.positions[run.mesh.triangles[t][0] as usize];
-                best = best.min((p - q).dot(n).abs());
-            }
-        }
+        nearest_in_fan(u);
     }
     best / (len / k.max(1) as f64)
 }
