@@ -1208,59 +1208,48 @@ impl Run<'_> {
 
 /// Labels the smooth regions: the connected components of red triangles through smooth
 /// edges (what filter 3's flood connects), numbered 0.. in order of their lowest triangle.
-/// Union-find in one pass over the triangles (neighbours are mostly close in index order,
-/// which keeps it cache friendly), then one pass to number the roots.
+/// A flood from each unlabelled red triangle in index order: the first triangle a region
+/// meets is its lowest, so regions are numbered as that order requires, and each red
+/// triangle is visited once.
 #[inline(never)] // one call per run; kept out of line so profiles show it
 fn label_regions(s: &mut Scratch, table: &CornerTable, nt: usize) {
     let region = &mut s.region;
     region.clear();
-    region.extend(0..nt as u32);
-    fn find(p: &mut [u32], mut x: u32) -> u32 {
-        while p[x as usize] != x {
-            let g = p[p[x as usize] as usize];
-            p[x as usize] = g;
-            x = g;
-        }
-        x
-    }
-    for t in 0..nt {
-        if s.tflags[t] & T_RED == 0 {
+    region.resize(nt, NONE);
+    let opposite = table.opposites();
+    let mut stack = std::mem::take(&mut s.stack);
+    stack.clear();
+    let mut next_label = 0u32;
+    for t0 in 0..nt {
+        if s.tflags[t0] & T_RED == 0 || region[t0] != NONE {
             continue;
         }
-        for c in 3 * t..3 * t + 3 {
-            if s.cflags[c] & C_BROWN == 0 {
-                continue;
-            }
-            if let Some(o) = table.opposite(CornerId(c as u32)) {
-                let u = o.index() / 3;
-                if u < t && s.tflags[u] & T_RED != 0 {
-                    let (a, b) = (find(region, t as u32), find(region, u as u32));
-                    if a != b {
-                        // The smaller root wins: roots are then the lowest triangle of each set.
-                        let (lo, hi) = if a < b { (a, b) } else { (b, a) };
-                        region[hi as usize] = lo;
-                    }
+        let label = next_label;
+        next_label += 1;
+        region[t0] = label;
+        let mut t = t0;
+        loop {
+            for c in 3 * t..3 * t + 3 {
+                if s.cflags[c] & C_BROWN == 0 {
+                    continue;
+                }
+                let o = opposite[c];
+                if o == NONE {
+                    continue; // brown edges are interior; never taken
+                }
+                let u = o as usize / 3;
+                if region[u] == NONE && s.tflags[u] & T_RED != 0 {
+                    region[u] = label;
+                    stack.push(u as u32);
                 }
             }
+            match stack.pop() {
+                Some(u) => t = u as usize,
+                None => break,
+            }
         }
     }
-    // Number the roots in order; every non-root points to a smaller index, so one forward
-    // pass resolves them.
-    let mut next_label = 0u32;
-    for t in 0..nt {
-        if s.tflags[t] & T_RED == 0 {
-            region[t] = NONE;
-            continue;
-        }
-        let p = region[t] as usize;
-        if p == t {
-            region[t] = next_label;
-            next_label += 1;
-        } else {
-            // p < t: already renumbered (roots are labels now, non-roots their root's label).
-            region[t] = region[p];
-        }
-    }
+    s.stack = stack;
 }
 
 /// Angle between two unit vectors. Most edges of a sampled surface are nearly flat, so the
