@@ -24,6 +24,7 @@
 //! limitation), blends within a few samples of radius, and self-intersections a snapped vertex
 //! may create with a distant part of the mesh.
 
+use std::cell::Cell;
 use std::time::Instant;
 
 use glam::DVec3;
@@ -255,8 +256,9 @@ pub(crate) struct Run<'a> {
     pub max_edge: f64,
     pub limits: SnapLimits,
     /// Reference normals of the triangles touched when the subdivision was laid out, by
-    /// their index in `Scratch::touched` (see `reference_normal`).
-    pub ref_normals: Vec<DVec3>,
+    /// their index in `Scratch::touched`, computed when first asked for (see
+    /// `reference_normal`: a fallback that most meshes never reach).
+    pub ref_normals: Vec<Cell<Option<DVec3>>>,
     /// Edge snaps computed while dropping idle splits, by the lower corner of their edge, in
     /// increasing corner order (the order both passes visit the edges in).
     pub snap_cache: Vec<(u32, EdgeSnap)>,
@@ -290,7 +292,7 @@ impl Run<'_> {
     fn run(&mut self) -> (Mesh, Vec<FaceId>, SharpTags) {
         self.detect();
         self.insert_vertices();
-        self.cache_reference_normals();
+        self.reset_reference_normals();
         self.settle_positions();
         let mut out = crate::slivers::Output::assemble(self);
         out.remove_slivers(self);
@@ -908,7 +910,12 @@ impl Run<'_> {
         // on the input alone.
         let i = self.s.touched_index[t] as usize;
         if i < self.ref_normals.len() && self.s.touched[i] as usize == t {
-            return self.ref_normals[i];
+            let cached = &self.ref_normals[i];
+            return cached.get().unwrap_or_else(|| {
+                let n = self.compute_reference_normal(t);
+                cached.set(Some(n));
+                n
+            });
         }
         self.compute_reference_normal(t)
     }
@@ -923,15 +930,11 @@ impl Run<'_> {
         n.normalize_or_zero()
     }
 
-    /// Caches the reference normals of the touched triangles.
-    #[inline(never)] // one call per run; kept out of line so profiles show it
-    fn cache_reference_normals(&mut self) {
+    /// Empties the cache of the touched triangles' reference normals (filled on demand).
+    fn reset_reference_normals(&mut self) {
         self.ref_normals.clear();
-        for i in 0..self.s.touched.len() {
-            let t = self.s.touched[i];
-            let n = self.compute_reference_normal(t as usize);
-            self.ref_normals.push(n);
-        }
+        self.ref_normals
+            .resize(self.s.touched.len(), Cell::new(None));
     }
 
     /// The triangles of the subdivision of input triangle `t`, with the current diagonal
@@ -1335,6 +1338,50 @@ pub(crate) fn fast_angle(a: DVec3, b: DVec3) -> f64 {
 mod tests {
     use super::*;
     use whet_mesh::angle_between;
+
+    #[test]
+    fn reference_normals_are_computed_once_on_demand() {
+        use whet_synth::{marching_cubes, Shape, ShapeKind, ShapeParams};
+        let shape = Shape::new(ShapeKind::Cube, &ShapeParams::default()).unwrap();
+        let mesh = marching_cubes(&shape, 12).unwrap();
+        let table = CornerTable::new(&mesh).unwrap();
+        let opts = SharpenOptions::DEFAULT;
+        let mut scratch = Scratch::default();
+        let mut run = Run {
+            mesh: &mesh,
+            table: &table,
+            opts: &opts,
+            s: &mut scratch,
+            report: SharpenReport::default(),
+            positions: Vec::new(),
+            max_edge: 0.0,
+            limits: SnapLimits::new(0.0),
+            ref_normals: Vec::new(),
+            snap_cache: Vec::new(),
+            surface_samples: false,
+        };
+        run.detect();
+        run.insert_vertices();
+        run.reset_reference_normals();
+        let touched = run.s.touched.clone();
+        assert!(!touched.is_empty());
+        for (i, &t) in touched.iter().enumerate() {
+            let t = t as usize;
+            assert_eq!(run.ref_normals[i].get(), None);
+            let n = run.reference_normal(t);
+            assert_eq!(n, run.compute_reference_normal(t));
+            assert_eq!(run.ref_normals[i].get(), Some(n));
+            assert_eq!(run.reference_normal(t), n);
+        }
+        // An untouched triangle is computed, not cached.
+        let untouched = (0..mesh.triangles.len())
+            .find(|&t| run.s.touched_index[t] == NONE)
+            .unwrap();
+        assert_eq!(
+            run.reference_normal(untouched),
+            run.compute_reference_normal(untouched)
+        );
+    }
 
     #[test]
     fn fast_angle_is_accurate_to_2e_5() {
