@@ -330,6 +330,19 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh) -> CliResult {
             );
         }
     }
+    // The retiling bridges features thinner than L; far past that, part of the surface is
+    // missing from the decoded mesh, which the user should hear about rather than find.
+    let gap_pct = 100.0 * out.coverage_gap * out.edge_length_fraction;
+    if out.coverage_gap > whet_swing::MAX_COVERAGE_GAP {
+        eprintln!(
+            "whet: the retiling leaves part of the surface uncovered: an original vertex lies \
+             {:.1} edge lengths ({gap_pct:.2} % of the diagonal) from it, where parts thinner \
+             than the edge length ({:.2} % of the diagonal) were wrapped wrongly; a higher rate \
+             (--bpv, --target-bytes) or a shorter --edge-length covers them",
+            out.coverage_gap,
+            100.0 * out.edge_length_fraction
+        );
+    }
     if let whet_codec::SwingGeometry::Explicit(reason) = &out.geometry {
         eprintln!("whet: swing geometry coded as explicit positions: {reason}");
     }
@@ -361,6 +374,8 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh) -> CliResult {
                 _ => "explicit",
             },
             "rms_error_pct": out.rms_pct,
+            "coverage_gap": out.coverage_gap,
+            "coverage_gap_pct": gap_pct,
             "surface_filter": {
                 "normal": out.surface_filter.factors().0,
                 "smoothed": out.surface_filter.factors().1,

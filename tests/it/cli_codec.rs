@@ -202,6 +202,55 @@ fn a_missed_size_target_is_written_with_a_warning() {
     assert!(!String::from_utf8_lossy(&o.stderr).contains("size search"));
 }
 
+/// A retiling that leaves part of the surface uncovered (the screwdriver's shaft, thinner than
+/// L at 3.7 % of the diagonal: every retry length wraps it wrongly, 3.2 L away at best,
+/// measured 2026-12-02) is written with a warning, and `--json` reports the gap in L and in %
+/// of the diagonal; a sphere's retiling reports a gap under an edge length and no warning.
+#[test]
+fn an_uncovered_surface_is_reported() {
+    let dir = scratch_dir("cli-coverage");
+    let src = shared_fixture("screwdriver.off");
+    let stream = dir.join("sd.whet");
+    let args = [
+        "encode",
+        s(&src),
+        "-o",
+        s(&stream),
+        "--edge-length",
+        "0.0368",
+        "--json",
+    ];
+    let o = whet(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("leaves part of the surface uncovered"),
+        "{err}"
+    );
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let gap = j["coverage_gap"].as_f64().unwrap();
+    let l = j["edge_length"].as_f64().unwrap();
+    assert!(gap > 3.0, "{gap}");
+    let pct = j["coverage_gap_pct"].as_f64().unwrap();
+    assert!((pct - 100.0 * gap * l).abs() < 1e-9, "{pct} {gap} {l}");
+    let sphere = dir.join("sphere.off");
+    let o = whet(&["synth", "sphere", "-o", s(&sphere), "--resolution", "24"]);
+    assert!(o.status.success());
+    let o = whet(&[
+        "encode",
+        s(&sphere),
+        "-o",
+        s(&stream),
+        "--bpv",
+        "4",
+        "--json",
+    ]);
+    assert!(o.status.success());
+    assert!(!String::from_utf8_lossy(&o.stderr).contains("uncovered"));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(j["coverage_gap"].as_f64().unwrap() < 1.0, "{j}");
+}
+
 /// `--max-retiled-triangles` bounds the retiling: a length past it is refused before any
 /// work with a message in the units the user gave (a fraction of the diagonal) and the flag's
 /// name; a size search under the bound stays above the shortest length it allows.

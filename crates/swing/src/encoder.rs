@@ -837,7 +837,7 @@ const COVERAGE_SAMPLES: usize = 20_000;
 /// original at the coarsest rates) but never leaves more of the surface uncovered; measured on
 /// every fixture at 0.3-8 bpv, all under 2.5 L but screwdriver at 1 and 2 bpv, whose thin
 /// shaft the front wrapped wrongly (7.3 and 4.7 L, RMS 4.5 and 0.9 % of the diagonal).
-const MAX_COVERAGE_GAP: f64 = 3.0;
+pub const MAX_COVERAGE_GAP: f64 = 3.0;
 
 /// How far the original's surface strays from the retiling `out`, in units of its `L`: the
 /// largest distance of a sample of the original's vertices to the retiled mesh. Cheap (a

@@ -27,6 +27,7 @@ mod surface;
 
 pub use encoder::{
     encode, valence6_fraction, AngleTrial, ErrorOf, Rate, SwingEncoder, SwingOptions, SwingOutput,
+    MAX_COVERAGE_GAP,
 };
 pub use filter_fit::{fit_displacements, fit_surface_filter};
 pub use retiler::{retile, RetileStats, RetileTuning, Retiled};
