@@ -45,13 +45,77 @@ impl Quantizer {
     #[inline]
     pub fn quantize(&self, p: DVec3) -> [i32; 3] {
         let q = (p - self.min) / self.step;
-        let m = self.max_level() as f64;
-        [q.x, q.y, q.z].map(|c| c.round().clamp(0.0, m) as i32)
+        let m = self.max_level();
+        [q.x, q.y, q.z].map(|c| grid_coordinate(c, m))
     }
 
     /// Position of grid point `q`.
     #[inline]
     pub fn dequantize(&self, q: [i32; 3]) -> DVec3 {
         self.min + DVec3::new(q[0] as f64, q[1] as f64, q[2] as f64) * self.step
+    }
+}
+
+/// `c` rounded half away from zero and clamped into `[0, m]` (`m` < 2^31), as
+/// `c.round().clamp(0.0, m as f64) as i32` gives, NaN included (0), without the call to the
+/// software `round` that baseline x86-64 makes (a few percent of an exact encode).
+#[inline]
+fn grid_coordinate(c: f64, m: i32) -> i32 {
+    if c.is_nan() || c <= 0.0 {
+        return 0;
+    }
+    if c >= f64::from(m) {
+        return m;
+    }
+    // 0 < c < m < 2^31: the truncation is exact, and so is the fraction (c and its integer
+    // part are within a factor of two of each other, or the part is 0).
+    let t = c as i32;
+    let fraction = c - f64::from(t);
+    t + i32::from(fraction >= 0.5)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn grid_coordinate_matches_round_then_clamp() {
+        let m = (1 << 20) - 1;
+        let reference = |c: f64| c.round().clamp(0.0, f64::from(m)) as i32;
+        let mut cases = vec![
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            -0.0,
+            0.0,
+            -0.5,
+            -0.49999999999999994,
+            0.49999999999999994,
+            0.5,
+            1.5,
+            2.5,
+            f64::from(m) - 0.5,
+            f64::from(m) - 0.50000000001,
+            f64::from(m),
+            f64::from(m) + 0.4,
+            1e300,
+            -1e300,
+            f64::MIN_POSITIVE,
+        ];
+        // Halves, their neighbours and a spread of ordinary values.
+        let mut state = 0x2545_F491_4F6C_DD1Du64;
+        for _ in 0..20_000 {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let x = (state >> 11) as f64 / (1u64 << 53) as f64 * 1.1 * f64::from(m) - 1000.0;
+            let half = x.floor() + 0.5;
+            // Both neighbours of the half (never 0), whatever its sign.
+            let (a, b) = (half.to_bits() + 1, half.to_bits() - 1);
+            cases.extend([x, half, f64::from_bits(a), f64::from_bits(b)]);
+        }
+        for c in cases {
+            assert_eq!(grid_coordinate(c, m), reference(c), "{c:e}");
+        }
     }
 }
