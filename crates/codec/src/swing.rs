@@ -246,7 +246,7 @@ impl AngleTable {
 
     /// The swing index nearest to angle `theta` (radians, wrapped into the index range).
     pub fn quantize(&self, theta: f64) -> i32 {
-        let q = (theta / self.step()).round();
+        let q = crate::quantize::round_half_away(theta / self.step());
         if !q.is_finite() {
             return 0;
         }
@@ -598,7 +598,7 @@ fn atan_unit(z: f64) -> f64 {
 /// on decoded data only (the walk), with the arithmetic spelled out.
 pub fn predict_swing(frame: &SwingFrame, normal: DVec3, table: &AngleTable) -> i32 {
     // |θ| ≤ π/2: the index is within the range for every table (at least 3 bits).
-    (predicted_angle(frame, normal) * table.inverse_step()).round() as i32
+    crate::quantize::round_half_away(predicted_angle(frame, normal) * table.inverse_step()) as i32
 }
 
 /// How much farther than the fan normals say the surface is predicted to bend on
@@ -613,7 +613,9 @@ pub const PREDICTION_SCALE: f64 = 1.75;
 /// (`swing_ctx`; 6 angle bits, L = 0.85 % of the diagonal): 1.5, 1.75 and 2 all save 2-5 %
 /// of the index bits over 1, 1.75 the most on average.
 pub fn predict_swing_scaled(frame: &SwingFrame, normal: DVec3, table: &AngleTable) -> i32 {
-    let q = (predicted_angle(frame, normal) * PREDICTION_SCALE * table.inverse_step()).round();
+    let q = crate::quantize::round_half_away(
+        predicted_angle(frame, normal) * PREDICTION_SCALE * table.inverse_step(),
+    );
     // |θ| · 1.75 ≤ 2.75 rad: within the i32 range; the clamp keeps it in the index range.
     (q as i32).clamp(table.min_index(), table.max_index())
 }
