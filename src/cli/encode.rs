@@ -333,7 +333,10 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh) -> CliResult {
     // The retiling bridges features thinner than L; far past that, part of the surface is
     // missing from the decoded mesh, which the user should hear about rather than find.
     let gap_pct = 100.0 * out.coverage_gap * out.edge_length_fraction;
-    if out.coverage_gap > whet_swing::MAX_COVERAGE_GAP {
+    if !out.coverage_gap.is_finite() {
+        // A distance that could not be computed (JSON: null).
+        eprintln!("whet: the retiling's coverage of the surface could not be measured");
+    } else if out.coverage_gap > whet_swing::MAX_COVERAGE_GAP {
         eprintln!(
             "whet: the retiling leaves part of the surface uncovered: an original vertex lies \
              {:.1} edge lengths ({gap_pct:.2} % of the diagonal) from it, where parts thinner \
@@ -374,8 +377,8 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh) -> CliResult {
                 _ => "explicit",
             },
             "rms_error_pct": out.rms_pct,
-            "coverage_gap": out.coverage_gap,
-            "coverage_gap_pct": gap_pct,
+            "coverage_gap": if gap_pct.is_finite() { json!(out.coverage_gap) } else { json!(null) },
+            "coverage_gap_pct": if gap_pct.is_finite() { json!(gap_pct) } else { json!(null) },
             "surface_filter": {
                 "normal": out.surface_filter.factors().0,
                 "smoothed": out.surface_filter.factors().1,

@@ -856,6 +856,9 @@ mod tests {
             let built = CornerTable::from_triangles(&tris, nv);
             proptest::prop_assert!(built.is_ok(), "{:?}", built);
             let Ok(t) = built else { unreachable!() };
+            // Without the closed-fan walk the table is the same.
+            let deferred = CornerTable::from_triangles_deferring_fans(&tris, nv);
+            proptest::prop_assert_eq!(deferred.as_ref(), Ok(&t));
             let raw = CornerTable::from_raw(
                 t.corner_vertices().to_vec(),
                 t.opposites().to_vec(),

@@ -427,7 +427,8 @@ impl Run<'_> {
         }
         // Filter 3: grow through brown edges (explicit stack). The red set is the closure of
         // the core triangles, so growing from each in turn gives what growing from all at once
-        // does, and the stack holds only the triangles the growth adds, not every red one.
+        // does, and the stack holds only the triangles the growth adds, not every red one (a
+        // grown triangle is looked at again when the scan reaches it, and adds nothing).
         s.stack.clear();
         let opposite = table.opposites();
         for t0 in 0..nt {
@@ -906,8 +907,8 @@ impl Run<'_> {
     /// around it is centred on the crease. Zero when that area cancels, in which case nothing is
     /// checked.
     pub(crate) fn reference_normal(&self, t: usize) -> DVec3 {
-        // Triangles touched later (by the sliver pass) are computed again: the normal depends
-        // on the input alone.
+        // Triangles touched later (by the sliver pass, or touched again after a restore) are
+        // computed again, uncached: the normal depends on the input alone.
         let i = self.s.touched_index[t] as usize;
         if i < self.ref_normals.len() && self.s.touched[i] as usize == t {
             let cached = &self.ref_normals[i];

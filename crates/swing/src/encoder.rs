@@ -831,8 +831,9 @@ impl SwingEncoder {
 /// Most original vertices [`coverage_gap`] measures (evenly strided over the vertex list).
 const COVERAGE_SAMPLES: usize = 20_000;
 
-/// A retiling whose [`coverage_gap`] is larger than this many `L` is retried at the next
-/// length of [`SwingEncoder::encode_near`] (and kept only if every length gaps more). A
+/// A retiling whose coverage gap ([`SwingOutput::coverage_gap`]) is larger than this many `L`
+/// is retried at the next length of the encoder's retries (and kept only if every length
+/// gaps more); `whet encode` warns past it. A
 /// retiling bridges features narrower than `L` (the armadillo's fingers: 1-1.8 L from the
 /// original at the coarsest rates) but never leaves more of the surface uncovered; measured on
 /// every fixture at 0.3-8 bpv, all under 2.5 L but screwdriver at 1 and 2 bpv, whose thin
