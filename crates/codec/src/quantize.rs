@@ -62,7 +62,7 @@ impl Quantizer {
 #[inline]
 pub(crate) fn round_half_away(x: f64) -> f64 {
     // From 2^52 on every f64 is an integer (and NaN and the infinities round to themselves).
-    if !(x.abs() < 4_503_599_627_370_496.0) {
+    if x.is_nan() || x.abs() >= 4_503_599_627_370_496.0 {
         return x;
     }
     // |x| < 2^52: the truncation through i64 is exact, and so is the fraction.
