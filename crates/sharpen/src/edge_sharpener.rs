@@ -349,26 +349,35 @@ impl Run<'_> {
         let mut count = 0usize;
         let mut max_edge2 = 0.0f64;
         // Triangle by triangle, in corner order: the vertices after and before corner j of
-        // a triangle are at (j + 1) % 3 and (j + 2) % 3, with no division per corner.
-        for (t, tri) in mesh.triangles.iter().enumerate() {
+        // a triangle are at (j + 1) % 3 and (j + 2) % 3, with no division per corner. The
+        // corner arrays are walked in step with the triangles (no index checks per corner).
+        let opposite = self.table.opposites();
+        let normals = &s.normals[..];
+        for (t, ((tri, o3), a3)) in mesh
+            .triangles
+            .iter()
+            .zip(opposite.chunks_exact(3))
+            .zip(s.angles.chunks_exact_mut(3))
+            .enumerate()
+        {
             for (j, (after, before)) in AFTER_BEFORE.into_iter().enumerate() {
-                let c = 3 * t + j;
-                let o = self.table.opposite(CornerId(c as u32));
-                if let Some(o) = o {
-                    if o.index() < c {
-                        continue;
-                    }
+                let o = o3[j];
+                // Each interior edge once, from its lower corner.
+                if o != NONE && (o as usize) < 3 * t + j {
+                    continue;
                 }
                 let a = mesh.positions[tri[after] as usize];
                 let b = mesh.positions[tri[before] as usize];
                 max_edge2 = max_edge2.max(a.distance_squared(b));
-                let Some(o) = o else { continue };
-                let (n1, n2) = (s.normals[c / 3], s.normals[o.index() / 3]);
+                if o == NONE {
+                    continue;
+                }
+                let (n1, n2) = (normals[t], normals[o as usize / 3]);
                 if n1 == DVec3::ZERO || n2 == DVec3::ZERO {
                     continue;
                 }
                 let angle = normal_angle(n1, n2);
-                s.angles[c] = angle as f32;
+                a3[j] = angle as f32;
                 sum += angle;
                 count += 1;
             }
@@ -381,15 +390,12 @@ impl Run<'_> {
         self.limits = SnapLimits::new(threshold);
         let thr = threshold as f32;
         let mut smooth = 0;
-        for c in 0..nc {
-            let a = s.angles[c];
-            if a >= 0.0 && a < thr {
-                // Only the lower corner of an interior edge holds its angle.
-                if let Some(o) = self.table.opposite(CornerId(c as u32)) {
-                    s.cflags[c] |= C_BROWN;
-                    s.cflags[o.index()] |= C_BROWN;
-                    smooth += 1;
-                }
+        for (c, (&a, &o)) in s.angles.iter().zip(opposite).enumerate() {
+            // Only the lower corner of an interior edge holds its angle (-1 elsewhere).
+            if a >= 0.0 && a < thr && o != NONE {
+                s.cflags[c] |= C_BROWN;
+                s.cflags[o as usize] |= C_BROWN;
+                smooth += 1;
             }
         }
         self.report.smooth_edges = smooth;
