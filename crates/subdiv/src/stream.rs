@@ -295,12 +295,15 @@ pub fn decode_subdiv(
     )
 }
 
-/// What subdividing costs per output triangle, at its peak, at least: the levels'
-/// connectivity and positions and the output mesh (measured: 210 bytes per triangle at
-/// peak for `whet decode --levels 6` of the armadillo's stream, 4.1M triangles, with the
-/// output file's writer). Checked against [`whet_codec::Limits::max_alloc_bytes`] before
-/// subdividing: a stream of a few kilobytes can ask for any level count up to the limit.
-pub const SUBDIVISION_BYTES_PER_TRIANGLE: u64 = 160;
+/// What subdividing costs per output triangle at its peak, with the output file's writer:
+/// the levels' connectivity and positions and the output mesh (measured: 210 bytes per
+/// triangle for `whet decode --levels 6` of the armadillo's stream, 4.1M triangles; 216 for
+/// `whet subdivide bunny.off --levels 5`, 7.1M triangles, 1.50 GB maximum resident size).
+/// Checked against [`whet_codec::Limits::max_alloc_bytes`] before subdividing (a stream of
+/// a few kilobytes can ask for any level count up to the limit) and against `whet subdivide
+/// --max-memory`; it was 160, the allocations alone, which let a run pass a budget it then
+/// exceeded by a third.
+pub const SUBDIVISION_BYTES_PER_TRIANGLE: u64 = 220;
 
 /// Zero-flag contexts: nonzero edges already coded around this edge, 0, 1, 2+.
 const CONTEXTS: usize = 3;
