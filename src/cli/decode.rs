@@ -38,8 +38,9 @@ pub struct DecodeArgs {
     #[arg(long)]
     no_surface_filter: bool,
     /// Memory budget in bytes for what a stream or a level count asks for: the container's
-    /// payloads, a subdiv stream's levels and `--bend` are estimated and refused before they
-    /// run when they need more (the decoded counts have their own fixed limits).
+    /// payloads, the decoded mesh (from the header's counts), a subdiv stream's levels,
+    /// `--sharpen` and `--bend` are estimated and refused before they run when they need
+    /// more.
     #[arg(long, value_name = "BYTES", default_value_t = super::DEFAULT_MAX_MEMORY)]
     max_memory: u64,
 }
@@ -56,7 +57,19 @@ pub fn run(args: &DecodeArgs) -> CliResult {
         .with_limits(limits);
     let mesh = whet::decode_with_levels(&bytes, &opts, args.levels).map_err(|e| {
         let input = e.is_input_error();
-        let err = anyhow::Error::new(e).context(format!("cannot decode {}", args.input.display()));
+        // The byte limits are --max-memory here: say so where the library says "Limits".
+        let hint = if matches!(
+            &e,
+            whet::Error::Codec(whet_codec::Error::Format(
+                whet_format::Error::LimitExceeded { what, .. }
+            )) if what.contains("bytes")
+        ) {
+            " (--max-memory sets the byte limit)"
+        } else {
+            ""
+        };
+        let err =
+            anyhow::Error::new(e).context(format!("cannot decode {}{hint}", args.input.display()));
         if input {
             Failure::input(err)
         } else {
@@ -64,6 +77,18 @@ pub fn run(args: &DecodeArgs) -> CliResult {
         }
     })?;
     let mesh = if args.sharpen {
+        let peak =
+            (mesh.triangles.len() as u64).saturating_mul(whet_sharpen::PEAK_BYTES_PER_TRIANGLE);
+        if peak > args.max_memory {
+            return Err(Failure::input(anyhow::anyhow!(
+                "sharpening {} triangles would take about {} at {} bytes each, over \
+                 --max-memory {} bytes: raise --max-memory or decode without --sharpen",
+                mesh.triangles.len(),
+                super::human_bytes(peak),
+                whet_sharpen::PEAK_BYTES_PER_TRIANGLE,
+                args.max_memory
+            )));
+        }
         let opts = super::sharpen::sharpen_options(&args.method, args.smooth_factor)?;
         let mut s = super::sharpen::run_sharpen(&mesh, &opts)?;
         if !args.no_surface_filter {

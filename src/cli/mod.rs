@@ -175,7 +175,7 @@ pub fn manifold(mesh: whet::Mesh) -> whet::Mesh {
 }
 
 /// `bytes` in the largest of B, kB, MB, GB that keeps a unit digit.
-fn human_bytes(bytes: u64) -> String {
+pub fn human_bytes(bytes: u64) -> String {
     let b = bytes as f64;
     match bytes {
         0..1_000 => format!("{bytes} B"),

@@ -251,6 +251,65 @@ fn an_uncovered_surface_is_reported() {
     assert!(j["coverage_gap"].as_f64().unwrap() < 1.0, "{j}");
 }
 
+/// `whet decode --max-memory` bounds the decoded mesh (estimated from the header's counts)
+/// and `--sharpen` (from the decoded triangles) before either runs: exit code 2 and the flag
+/// named; the default budget decodes and sharpens.
+#[test]
+fn decode_holds_the_mesh_and_sharpening_to_max_memory() {
+    let dir = scratch_dir("cli-decode-memory");
+    let sphere = dir.join("sphere.off");
+    let o = whet(&["synth", "sphere", "-o", s(&sphere), "--resolution", "24"]);
+    assert!(o.status.success());
+    let stream = dir.join("sphere.whet");
+    let j = whet_json(&[
+        "encode",
+        s(&sphere),
+        "-o",
+        s(&stream),
+        "--mode",
+        "exact",
+        "--json",
+    ]);
+    let (t, v) = (
+        j["triangles"].as_u64().unwrap(),
+        j["vertices"].as_u64().unwrap(),
+    );
+    let decoded_estimate =
+        t * whet_codec::DECODE_BYTES_PER_TRIANGLE + v * whet_codec::DECODE_BYTES_PER_VERTEX;
+    let out = dir.join("out.off");
+    let budget = |bytes: u64, sharpen: bool| {
+        let b = bytes.to_string();
+        let mut args = vec!["decode", s(&stream), "-o", s(&out), "--max-memory", &b];
+        if sharpen {
+            args.push("--sharpen");
+        }
+        whet(&args)
+    };
+    let refused = budget(decoded_estimate - 1, false);
+    assert_eq!(refused.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        err.contains("decoding allocates") && err.contains("--max-memory"),
+        "{err}"
+    );
+    assert!(budget(decoded_estimate, false).status.success());
+    // Enough to decode, not to sharpen.
+    let sharpen_estimate = t * whet_sharpen::PEAK_BYTES_PER_TRIANGLE;
+    let refused = budget(sharpen_estimate - 1, true);
+    assert_eq!(refused.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        err.contains("sharpening") && err.contains("--max-memory"),
+        "{err}"
+    );
+    let ok = whet(&["decode", s(&stream), "-o", s(&out), "--sharpen"]);
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+}
+
 /// `--max-retiled-triangles` bounds the retiling: a length past it is refused before any
 /// work with a message in the units the user gave (a fraction of the diagonal) and the flag's
 /// name; a size search under the bound stays above the shortest length it allows.

@@ -37,6 +37,7 @@ pub mod swing;
 
 pub use decoder::{
     decode, decode_container, peek_header, DecodeOptions, Decoder, StreamingDecoder,
+    DECODE_BYTES_PER_TRIANGLE, DECODE_BYTES_PER_VERTEX,
 };
 pub use encoder::{
     encode, prepare_mesh, EncodeOptions, EncodeReport, Encoded, Encoder, PreparedMesh,

@@ -79,3 +79,33 @@ fn random_bytes_never_panic() {
         }
     }
 }
+
+/// The decoded mesh's memory is estimated from the header's counts and held against
+/// `max_alloc_bytes` before decoding: a budget under the estimate refuses the stream, with
+/// the estimate named; the estimate itself passes.
+#[test]
+fn decoding_is_refused_past_the_byte_limit() {
+    let bytes = sample_stream();
+    let info = whet_codec::peek_header(&bytes).unwrap();
+    let estimate = info.triangle_count * whet_codec::DECODE_BYTES_PER_TRIANGLE
+        + info.vertex_count * whet_codec::DECODE_BYTES_PER_VERTEX;
+    let with = |max: u64| {
+        whet_codec::decode(
+            &bytes,
+            &DecodeOptions::DEFAULT
+                .with_limits(whet_codec::Limits::DEFAULT.with_max_alloc_bytes(max)),
+        )
+    };
+    assert!(with(estimate).is_ok());
+    match with(estimate - 1) {
+        Err(whet_codec::Error::Format(whet_format::Error::LimitExceeded {
+            what,
+            limit,
+            value,
+        })) => {
+            assert!(what.contains("decoding"), "{what}");
+            assert_eq!((limit, value), (estimate - 1, estimate));
+        }
+        other => panic!("{other:?}"),
+    }
+}
