@@ -321,15 +321,10 @@ impl Run<'_> {
         }
         self.chamfer_edges();
         if self.opts.method == Method::Extended {
-            if crate::extended::corner_vertices(self) > 0 {
-                // Corner vertices changed labels: find the chamfer edges again.
-                for f in self.s.cflags.iter_mut() {
-                    *f &= !C_BLUE;
-                }
-                for f in self.s.tflags.iter_mut() {
-                    *f &= !T_GREEN;
-                }
-                self.chamfer_edges();
+            let moved = crate::extended::corner_vertices(self);
+            if !moved.is_empty() {
+                // Corner vertices changed labels: find the chamfer edges again around them.
+                self.update_chamfer_edges(moved);
             }
             self.drop_idle_splits();
         }
@@ -561,6 +556,71 @@ impl Run<'_> {
             }
         }
         self.report.corner_triangles = green;
+    }
+
+    /// [`Run::chamfer_edges`] again after the label planes of the vertices `moved` changed,
+    /// only where that can change its answer: an edge's blue flag depends on its two ends'
+    /// planes (and on its input triangles and red flags, which did not change), a triangle's
+    /// green flag on its vertices' planes and its edges' blue flags; every such edge and
+    /// triangle holds a moved vertex. The same flags as running it over the whole mesh.
+    fn update_chamfer_edges(&mut self, mut moved: Vec<u32>) {
+        moved.sort_unstable();
+        moved.dedup();
+        let is_moved = |v: u32| moved.binary_search(&v).is_ok();
+        let mut around: Vec<usize> = Vec::new();
+        for &v in &moved {
+            around.extend(
+                self.table
+                    .vertex_corners(VertexId(v))
+                    .map(|c| c.index() / 3),
+            );
+        }
+        around.sort_unstable();
+        around.dedup();
+        for &t in &around {
+            for c in 3 * t..3 * t + 3 {
+                let Some(o) = self.table.opposite(CornerId(c as u32)) else {
+                    continue;
+                };
+                let (a, b) = (self.cv(next(c)), self.cv(prev(c)));
+                if !is_moved(a) && !is_moved(b) {
+                    continue;
+                }
+                // The rule of `chamfer_edges`, symmetric in the edge's two corners.
+                self.s.cflags[c] &= !C_BLUE;
+                self.s.cflags[o.index()] &= !C_BLUE;
+                if self.s.cflags[c] & C_RED != 0 {
+                    continue;
+                }
+                if crate::extended::is_chamfer_edge(self, a, b)
+                    && !self.split_blocked(c)
+                    && !self.split_blocked(o.index())
+                {
+                    self.s.cflags[c] |= C_BLUE;
+                    self.s.cflags[o.index()] |= C_BLUE;
+                }
+            }
+        }
+        for &t in &around {
+            let f = &self.s.cflags[3 * t..3 * t + 3];
+            let corner = f.iter().all(|&x| x & C_BLUE != 0)
+                || (self.s.tflags[t] & T_RED == 0
+                    && crate::extended::is_corner_triangle(self, self.mesh.triangles[t]));
+            if corner {
+                self.s.tflags[t] |= T_GREEN;
+            } else {
+                self.s.tflags[t] &= !T_GREEN;
+            }
+        }
+        let nt = self.mesh.triangles.len();
+        self.report.chamfer_edges = (0..3 * nt)
+            .filter(|&c| {
+                self.s.cflags[c] & C_BLUE != 0
+                    && self.table.opposites()[c] != NONE
+                    && (self.table.opposites()[c] as usize) > c
+            })
+            .count();
+        self.report.corner_triangles = self.s.tflags.iter().filter(|&&f| f & T_GREEN != 0).count();
     }
 
     /// True when the edge opposite corner `c` is a long edge of an input sliver (a triangle
@@ -1345,6 +1405,80 @@ pub(crate) fn fast_angle(a: DVec3, b: DVec3) -> f64 {
 mod tests {
     use super::*;
     use whet_mesh::angle_between;
+
+    /// A run's state over `mesh`, with its own scratch.
+    fn with_run<R>(mesh: &Mesh, opts: &SharpenOptions, f: impl FnOnce(&mut Run) -> R) -> R {
+        let table = CornerTable::new(mesh).unwrap();
+        let mut scratch = Scratch::default();
+        let mut run = Run {
+            mesh,
+            table: &table,
+            opts,
+            s: &mut scratch,
+            report: SharpenReport::default(),
+            positions: Vec::new(),
+            max_edge: 0.0,
+            limits: SnapLimits::new(0.0),
+            ref_normals: Vec::new(),
+            snap_cache: Vec::new(),
+            surface_samples: false,
+        };
+        f(&mut run)
+    }
+
+    /// After corner vertices move, updating the chamfer edges and corner triangles around
+    /// them gives the flags and counts that recomputing them over the whole mesh gives.
+    #[test]
+    fn the_chamfer_update_around_corner_vertices_matches_a_full_pass() {
+        use glam::DQuat;
+        use whet_synth::{marching_cubes, Shape, ShapeKind, ShapeParams};
+        let rotation = DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.5);
+        let mut moved_somewhere = false;
+        for (kind, res) in [
+            (ShapeKind::Cube, 16),
+            (ShapeKind::Fandisk, 40),
+            (ShapeKind::Pyramid, 24),
+        ] {
+            let shape = Shape::new(kind, &ShapeParams::default().with_rotation(rotation)).unwrap();
+            let mesh = marching_cubes(&shape, res).unwrap();
+            let opts = SharpenOptions::DEFAULT;
+            with_run(&mesh, &opts, |run| {
+                let nt = run.mesh.triangles.len();
+                run.s.cflags = vec![0; 3 * nt];
+                run.s.vflags = vec![0; run.mesh.positions.len()];
+                run.s.tflags = vec![0; nt];
+                run.positions = run.mesh.positions.clone();
+                run.smooth_edges();
+                run.filters();
+                run.extend_detection();
+                run.chamfer_edges();
+                let moved = crate::extended::corner_vertices(run);
+                moved_somewhere |= !moved.is_empty();
+                let (cflags, tflags) = (run.s.cflags.clone(), run.s.tflags.clone());
+                run.update_chamfer_edges(moved);
+                let updated = (
+                    run.s.cflags.clone(),
+                    run.s.tflags.clone(),
+                    run.report.chamfer_edges,
+                    run.report.corner_triangles,
+                );
+                run.s.cflags = cflags.iter().map(|f| f & !C_BLUE).collect();
+                run.s.tflags = tflags.iter().map(|f| f & !T_GREEN).collect();
+                run.chamfer_edges();
+                let full = (
+                    run.s.cflags.clone(),
+                    run.s.tflags.clone(),
+                    run.report.chamfer_edges,
+                    run.report.corner_triangles,
+                );
+                assert!(updated == full, "{kind:?} at {res}");
+            });
+        }
+        assert!(
+            moved_somewhere,
+            "no corner vertex moved: the test tests nothing"
+        );
+    }
 
     #[test]
     fn reference_normals_are_computed_once_on_demand() {

@@ -1089,12 +1089,13 @@ pub(crate) const CORNER_MOVE_LIMIT: f64 = 1.5;
 
 /// Corner vertices: for each corner triangle whose three planes meet in a point, the nearest
 /// chamfer vertex (of the triangle or around it) moves onto that point and takes the three
-/// planes as labels. Returns how many moved; the caller then recomputes the chamfer edges.
+/// planes as labels. Returns the vertices that moved; the caller then recomputes the
+/// chamfer edges and corner triangles around them.
 #[inline(never)] // one call per run; kept out of line so profiles show it
-pub(crate) fn corner_vertices(run: &mut Run) -> usize {
+pub(crate) fn corner_vertices(run: &mut Run) -> Vec<u32> {
     let nt = run.mesh.triangles.len();
     let mut placed: Vec<DVec3> = Vec::new();
-    let mut moved = 0;
+    let mut moved = Vec::new();
     for t in 0..nt {
         if run.s.tflags[t] & crate::edge_sharpener::T_GREEN == 0 {
             continue;
@@ -1182,7 +1183,7 @@ pub(crate) fn corner_vertices(run: &mut Run) -> usize {
             });
         }
         placed.push(w);
-        moved += 1;
+        moved.push(v);
     }
     moved
 }
