@@ -58,12 +58,7 @@ pub fn run(args: &DecodeArgs) -> CliResult {
     let mesh = whet::decode_with_levels(&bytes, &opts, args.levels).map_err(|e| {
         let input = e.is_input_error();
         // The byte limits are --max-memory here: say so where the library says "Limits".
-        let hint = if matches!(
-            &e,
-            whet::Error::Codec(whet_codec::Error::Format(
-                whet_format::Error::LimitExceeded { what, .. }
-            )) if what.contains("bytes")
-        ) {
+        let hint = if over_max_memory(&e) {
             " (--max-memory sets the byte limit)"
         } else {
             ""
@@ -122,4 +117,71 @@ pub fn run(args: &DecodeArgs) -> CliResult {
         args.output_format,
         &whet::io::WriteOptions::DEFAULT,
     )
+}
+
+/// True when `e` refused the stream for the allocation budget that `--max-memory` sets
+/// (`Limits::max_alloc_bytes`), not for a count or section-length limit, which it does not.
+fn over_max_memory(e: &whet::Error) -> bool {
+    fn codec(e: &whet_codec::Error) -> bool {
+        matches!(
+            e,
+            whet_codec::Error::Format(whet_format::Error::LimitExceeded { what, .. })
+                if *what == "allocation (bytes)" || *what == "bytes decoding allocates (estimated)"
+        )
+    }
+    match e {
+        whet::Error::Codec(c) => codec(c),
+        whet::Error::Subdiv(whet_subdiv::Error::Codec(c)) => codec(c),
+        whet::Error::Subdiv(whet_subdiv::Error::LimitExceeded { what, .. }) => {
+            what.starts_with("bytes the subdivision allocates")
+        }
+        _ => false,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::over_max_memory;
+
+    fn limit(what: &'static str) -> whet_format::Error {
+        whet_format::Error::LimitExceeded {
+            what,
+            limit: 1,
+            value: 2,
+        }
+    }
+
+    #[test]
+    fn only_byte_budget_refusals_point_at_max_memory() {
+        let codec = |w| whet::Error::Codec(whet_codec::Error::Format(limit(w)));
+        let control = |w| {
+            whet::Error::Subdiv(whet_subdiv::Error::Codec(whet_codec::Error::Format(limit(
+                w,
+            ))))
+        };
+        assert!(over_max_memory(&codec("allocation (bytes)")));
+        assert!(over_max_memory(&codec(
+            "bytes decoding allocates (estimated)"
+        )));
+        assert!(over_max_memory(&control(
+            "bytes decoding allocates (estimated)"
+        )));
+        assert!(over_max_memory(&whet::Error::Subdiv(
+            whet_subdiv::Error::LimitExceeded {
+                what: "bytes the subdivision allocates (estimated)",
+                limit: 1,
+                value: 2,
+            }
+        )));
+        // Limits --max-memory does not set.
+        assert!(!over_max_memory(&codec("section length (bytes)")));
+        assert!(!over_max_memory(&codec("triangle count")));
+        assert!(!over_max_memory(&whet::Error::Subdiv(
+            whet_subdiv::Error::LimitExceeded {
+                what: "decoded triangles",
+                limit: 1,
+                value: 2,
+            }
+        )));
+    }
 }

@@ -334,8 +334,12 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh) -> CliResult {
     // missing from the decoded mesh, which the user should hear about rather than find.
     let gap_pct = 100.0 * out.coverage_gap * out.edge_length_fraction;
     if !out.coverage_gap.is_finite() {
-        // A distance that could not be computed (JSON: null).
-        eprintln!("whet: the retiling's coverage of the surface could not be measured");
+        // A distance that could not be computed, which the encoder counts as uncovered
+        // (JSON: null).
+        eprintln!(
+            "whet: part of the surface may be left uncovered: the distance from the original \
+             to the retiling could not be measured"
+        );
     } else if out.coverage_gap > whet_swing::MAX_COVERAGE_GAP {
         eprintln!(
             "whet: the retiling leaves part of the surface uncovered: an original vertex lies \

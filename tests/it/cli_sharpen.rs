@@ -253,7 +253,7 @@ fn subdividing_commands_refuse_outputs_over_max_memory() {
     )
     .unwrap();
     let out = dir.join("out.off");
-    // 12 * 4^3 = 768 triangles: 123 kB for the subdivision estimate, 35 kB for Bender's.
+    // 12 * 4^3 = 768 triangles: 169 kB for the subdivision estimate, 35 kB for Bender's.
     for (cmd, levels_flag) in [("subdivide", "--levels"), ("bend", "--levels")] {
         let ok = whet(&[cmd, s(&cube), "-o", s(&out), levels_flag, "3"]);
         assert!(

@@ -73,20 +73,25 @@ pub fn decode_container(container: &Container, opts: &DecodeOptions) -> Result<M
         .map_err(Error::Format)?;
     // What decoding will hold at its peak, from the declared counts, before any of it: a
     // stream of a few kilobytes can declare (and, with a skewed label model, code) hundreds
-    // of millions of triangles.
-    let peak = h
-        .triangle_count
-        .saturating_mul(DECODE_BYTES_PER_TRIANGLE)
-        .saturating_add(h.vertex_count.saturating_mul(DECODE_BYTES_PER_VERTEX));
-    if peak > opts.limits.max_alloc_bytes {
-        return Err(Error::Format(whet_format::Error::LimitExceeded {
-            what: "bytes decoding allocates (estimated)",
-            limit: opts.limits.max_alloc_bytes,
-            value: peak,
-        }));
-    }
+    // of millions of triangles. (The swing decoder also holds its walk's own triangle count
+    // to the limit: it may exceed the header's.)
+    let check_peak = || {
+        let peak = h
+            .triangle_count
+            .saturating_mul(DECODE_BYTES_PER_TRIANGLE)
+            .saturating_add(h.vertex_count.saturating_mul(DECODE_BYTES_PER_VERTEX));
+        if peak > opts.limits.max_alloc_bytes {
+            return Err(Error::Format(whet_format::Error::LimitExceeded {
+                what: "bytes decoding allocates (estimated)",
+                limit: opts.limits.max_alloc_bytes,
+                value: peak,
+            }));
+        }
+        Ok(())
+    };
     let mesh = match h.mode {
         Mode::Exact => {
+            check_peak()?;
             let bits = h
                 .get_u64(tag::QUANT_BITS)
                 .ok_or(Error::MissingField("quant_bits"))?;
@@ -114,7 +119,10 @@ pub fn decode_container(container: &Container, opts: &DecodeOptions) -> Result<M
                 .with_max_triangles(h.triangle_count.saturating_mul(2).saturating_add(64));
             decode_exact(conn, geom, &quantizer, &limits)?
         }
-        Mode::Swing => crate::swing::decode_swing(container, opts)?,
+        Mode::Swing => {
+            check_peak()?;
+            crate::swing::decode_swing(container, opts)?
+        }
         other => {
             return Err(Error::Parameter(format!(
                 "mode {other} is not available in this build"

@@ -1548,8 +1548,14 @@ pub(crate) fn decode_swing(
         );
     }
     // The connectivity may hold more triangles than the output (dummy fans of the explicit
-    // kind, triangles deleted over holes): bounded by the caller's face limit.
-    let conn_limits = ConnectivityLimits::DEFAULT.with_max_triangles(limits.max_faces);
+    // kind, triangles deleted over holes): bounded by the caller's face limit and by what
+    // its byte limit allows at the decoders' peak per triangle (the header's counts, which
+    // `decode_container` held to it, do not bound this).
+    let conn_limits = ConnectivityLimits::DEFAULT.with_max_triangles(
+        limits
+            .max_faces
+            .min(limits.max_alloc_bytes / crate::DECODE_BYTES_PER_TRIANGLE),
+    );
     let (conn, used) = whet_edgebreaker::decode_connectivity(conn_bytes, &conn_limits)?;
     if used != conn_bytes.len() {
         return Err(Error::Corrupt(
@@ -1663,13 +1669,22 @@ fn decode_forward(
         ));
     }
     // The walk may hold more triangles than the output (those deleted over holes): bounded
-    // by the caller's face limit.
+    // by the caller's face limit, and by its byte limit at the decoders' peak per triangle.
     let max = opts.limits.max_faces;
     if n > max {
         return Err(whet_format::Error::LimitExceeded {
             what: "swing triangle count",
             limit: max,
             value: n,
+        }
+        .into());
+    }
+    let peak = n.saturating_mul(crate::DECODE_BYTES_PER_TRIANGLE);
+    if peak > opts.limits.max_alloc_bytes {
+        return Err(whet_format::Error::LimitExceeded {
+            what: "bytes decoding allocates (estimated)",
+            limit: opts.limits.max_alloc_bytes,
+            value: peak,
         }
         .into());
     }

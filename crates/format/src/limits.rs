@@ -16,7 +16,9 @@ pub struct Limits {
     /// Most triangles a header may declare.
     pub max_faces: u64,
     /// Most bytes a reader keeps (the header plus kept section payloads); the codec checks its
-    /// own buffers against it too.
+    /// own buffers against it too: the decoded mesh, estimated from the header's counts
+    /// before decoding (`whet_codec::DECODE_BYTES_PER_TRIANGLE`; at the default 4 GiB about
+    /// 50M triangles, fewer than `max_faces` admits), and a subdiv stream's levels.
     pub max_alloc_bytes: u64,
     /// Longest section payload (and header body) a reader accepts.
     pub max_section_bytes: u64,

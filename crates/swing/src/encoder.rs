@@ -216,7 +216,8 @@ pub struct SwingOutput {
     pub sharpened_filter: SurfaceFilter,
     /// How far the original's surface strays from the retiling, in units of `L`: the
     /// largest distance of a sample of the original's vertices, outside the components
-    /// coded as pillows, to the retiled mesh (see `MAX_COVERAGE_GAP`).
+    /// coded as pillows, to the retiled mesh (see `MAX_COVERAGE_GAP`); infinite when a
+    /// distance could not be computed (counted as uncovered), 0 for an empty retiling.
     pub coverage_gap: f64,
 }
 
@@ -832,8 +833,9 @@ impl SwingEncoder {
 const COVERAGE_SAMPLES: usize = 20_000;
 
 /// A retiling whose coverage gap ([`SwingOutput::coverage_gap`]) is larger than this many `L`
-/// is retried at the next length of the encoder's retries (and kept only if every length
-/// gaps more); `whet encode` warns past it. A
+/// is retried at the next length of the encoder's retries; when no retry does better (every
+/// length gaps more, a later one fails, or the remaining lengths are out of range) the
+/// smallest gap is kept. `whet encode` warns past it. A
 /// retiling bridges features narrower than `L` (the armadillo's fingers: 1-1.8 L from the
 /// original at the coarsest rates) but never leaves more of the surface uncovered; measured on
 /// every fixture at 0.3-8 bpv, all under 2.5 L but screwdriver at 1 and 2 bpv, whose thin

@@ -158,3 +158,36 @@ fn any_surface_filter_in_range_decodes_to_finite_positions_and_others_are_refuse
         assert!(err.to_string().contains("surface filter"), "{err}");
     }
 }
+
+/// A swing stream's walk may hold more triangles than its header declares (triangles deleted
+/// over holes), so the decoder holds the walk's own count to the byte limit too: a header
+/// shrunk to one triangle passes the estimate from the counts, and the walk is refused
+/// before it runs (it used to decode in full and fail only on the count mismatch).
+#[test]
+fn a_walk_longer_than_the_header_says_is_held_to_the_byte_limit() {
+    let mesh = whet_testkit::meshes::icosphere(3);
+    let out = crate::round_trip(&mesh, 0.1);
+    let n = out.retiled.triangles.len() as u64;
+    let mut c = whet_format::parse(&out.bytes, &whet_format::Limits::DEFAULT).unwrap();
+    c.header.triangle_count = 1;
+    c.header.vertex_count = 3;
+    // Room for the declared counts, not for the walk.
+    let budget = n * whet_codec::DECODE_BYTES_PER_TRIANGLE - 1;
+    let opts = whet_codec::DecodeOptions::DEFAULT
+        .with_limits(whet_format::Limits::DEFAULT.with_max_alloc_bytes(budget));
+    match whet_codec::decode_container(&c, &opts) {
+        Err(whet_codec::Error::Format(whet_format::Error::LimitExceeded {
+            what, value, ..
+        })) => {
+            assert!(what.contains("decoding allocates"), "{what}");
+            assert!(value > budget);
+        }
+        other => panic!("{other:?}"),
+    }
+    // With room for the walk it decodes, and the count mismatch is what is reported.
+    let roomy = whet_codec::DecodeOptions::DEFAULT;
+    assert!(matches!(
+        whet_codec::decode_container(&c, &roomy),
+        Err(whet_codec::Error::Corrupt(_))
+    ));
+}
