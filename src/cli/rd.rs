@@ -30,7 +30,7 @@ impl Codec for ExactCodec {
             .map_err(|e| e.to_string())
     }
     fn decode(&self, bytes: &[u8]) -> Result<Mesh, String> {
-        whet_codec::decode(bytes, &whet_codec::DecodeOptions::DEFAULT).map_err(|e| e.to_string())
+        whet_codec::decode(bytes, &own_streams()).map_err(|e| e.to_string())
     }
 }
 
@@ -64,12 +64,12 @@ impl Codec for SwingCodec {
             .map_err(|e| e.to_string())
     }
     fn decode(&self, bytes: &[u8]) -> Result<Mesh, String> {
-        whet::decode(bytes, &whet_codec::DecodeOptions::DEFAULT).map_err(|e| e.to_string())
+        whet::decode(bytes, &own_streams()).map_err(|e| e.to_string())
     }
     fn decode_for_stages(&self, bytes: &[u8]) -> Option<Result<Mesh, String>> {
         // As `whet decode --sharpen`: EdgeSharpener starts from the unfiltered vertices. A
         // stream without a filter decodes to them already: no second decode.
-        let header = whet_format::parse(bytes, &whet_format::Limits::DEFAULT)
+        let header = whet_format::parse(bytes, &whet_format::Limits::UNLIMITED)
             .ok()?
             .header;
         let tags = [
@@ -79,7 +79,7 @@ impl Codec for SwingCodec {
         if tags.iter().all(|&t| header.get_i64(t).is_none()) {
             return None;
         }
-        let opts = whet_codec::DecodeOptions::DEFAULT.with_surface_filter(false);
+        let opts = own_streams().with_surface_filter(false);
         Some(whet::decode(bytes, &opts).map_err(|e| e.to_string()))
     }
 }
@@ -169,7 +169,7 @@ impl Codec for SubdivCodec {
             .map_err(|e| e.to_string())
     }
     fn decode(&self, bytes: &[u8]) -> Result<Mesh, String> {
-        whet::decode(bytes, &whet_codec::DecodeOptions::DEFAULT).map_err(|e| e.to_string())
+        whet::decode(bytes, &own_streams()).map_err(|e| e.to_string())
     }
 }
 
@@ -190,7 +190,7 @@ fn sharpened(mesh: &Mesh) -> Result<whet_sharpen::Sharpened, String> {
 /// sharpening (swing streams that carry one) on the vertices the sharpener left alone.
 fn sharpened_from_stream(mesh: &Mesh, bytes: &[u8]) -> Result<whet_sharpen::Sharpened, String> {
     let mut s = sharpened(mesh)?;
-    if let Ok(c) = whet_format::parse(bytes, &whet_format::Limits::DEFAULT) {
+    if let Ok(c) = whet_format::parse(bytes, &whet_format::Limits::UNLIMITED) {
         whet_codec::SurfaceFilter::after_sharpening_of(&c.header)
             .apply_after_sharpening(mesh, &mut s.mesh);
     }
@@ -367,4 +367,11 @@ pub fn run(args: &RdArgs) -> CliResult {
         plan.out.display()
     );
     Ok(())
+}
+
+/// Decode options for the streams the harness itself just encoded: trusted, so without the
+/// byte and count limits that guard `whet decode` against hostile ones (a benchmark mesh
+/// past the default budget's 50M decoded triangles still measures).
+fn own_streams() -> whet_codec::DecodeOptions {
+    whet_codec::DecodeOptions::DEFAULT.with_limits(whet_format::Limits::UNLIMITED)
 }
