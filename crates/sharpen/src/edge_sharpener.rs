@@ -128,6 +128,10 @@ pub(crate) struct Scratch {
     /// Per input triangle: its index in `touched` (the last, if listed twice), `NONE` when
     /// it was never touched.
     pub touched_index: Vec<u32>,
+    /// Per touched index: the pieces (bit k for piece k) that settling last found neither
+    /// thin nor reversed, with the positions it left; the sliver pass's first scan skips
+    /// their orientation test.
+    pub settled_ok: Vec<u8>,
     /// Extended detection: smooth region of each red triangle, and label planes per vertex.
     pub region: Vec<u32>,
     pub lp_start: Vec<u32>,
@@ -1160,22 +1164,30 @@ impl Run<'_> {
         let mut stack = std::mem::take(&mut self.s.stack);
         stack.clear();
         stack.extend_from_slice(&self.s.touched);
+        reset(&mut self.s.settled_ok, self.s.touched.len(), 0);
         while let Some(t) = stack.pop() {
             let t = t as usize;
             self.choose_diagonal(t);
             let (pieces, n) = self.pieces(t);
             let mut victim: Option<(u32, UnmovedReason)> = None;
-            'pieces: for piece in &pieces[..n] {
+            // A triangle's last look is after every change to its pieces: an unsnap pushes
+            // every touched triangle of the vertex again (`triangles_of`), and the orientation
+            // test reads only the pieces' own vertices.
+            let mut ok = 0u8;
+            'pieces: for (index, piece) in pieces[..n].iter().enumerate() {
                 let p = piece.map(|v| self.positions[v as usize]);
                 // A thin piece's normal means little; the sliver pass removes it (and checks
                 // the orientation of what replaces it).
-                if min_angle(&p) >= SETTLE_MIN_ANGLE.to_radians() && self.is_reversed(piece, t, &p)
-                {
-                    victim = self
-                        .worst_snapped(piece.iter().copied())
-                        .map(|v| (v, UnmovedReason::Flipped));
-                    if victim.is_some() {
-                        break 'pieces;
+                if min_angle(&p) >= SETTLE_MIN_ANGLE.to_radians() {
+                    if self.is_reversed(piece, t, &p) {
+                        victim = self
+                            .worst_snapped(piece.iter().copied())
+                            .map(|v| (v, UnmovedReason::Flipped));
+                        if victim.is_some() {
+                            break 'pieces;
+                        }
+                    } else {
+                        ok |= 1 << index;
                     }
                 }
                 for k in 0..3 {
@@ -1190,6 +1202,8 @@ impl Run<'_> {
                     }
                 }
             }
+            let i = self.s.touched_index[t] as usize;
+            self.s.settled_ok[i] = ok;
             if let Some((v, reason)) = victim {
                 self.unsnap(v, reason);
                 for u in self.triangles_of(v) {

@@ -262,6 +262,33 @@ impl Output {
             .then_some(a)
     }
 
+    /// [`Output::badness`] before any operation, using what settling found: a piece it last
+    /// saw neither thin nor reversed needs only the thin test (same answer, since nothing
+    /// moved since).
+    fn initial_badness(&self, run: &Run, s: usize) -> Option<f64> {
+        let i = run.s.touched_index[self.parent[s] as usize];
+        let known_ok = i != NONE && {
+            let (start, n) = self.ranges[i as usize];
+            let k = s.wrapping_sub(start as usize);
+            k < n as usize
+                && run
+                    .s
+                    .settled_ok
+                    .get(i as usize)
+                    .is_some_and(|m| m >> k & 1 == 1)
+        };
+        if !known_ok {
+            return self.badness(run, s);
+        }
+        if same_triangle(self.tris[s], run.mesh.triangles[self.parent[s] as usize])
+            && self.tris[s].iter().all(|&v| !run.is_snapped(v))
+        {
+            return None;
+        }
+        let a = min_angle(&self.points(run, s));
+        (a < self.min_angle_rad).then_some(a)
+    }
+
     fn push_bad(&self, run: &Run, heap: &mut BinaryHeap<Reverse<(u64, u32)>>, s: usize) {
         if self.alive[s] && self.is_new[s] {
             if let Some(a) = self.badness(run, s) {
@@ -274,8 +301,17 @@ impl Output {
     pub(crate) fn remove_slivers(&mut self, run: &mut Run) {
         let mut heap: BinaryHeap<Reverse<(u64, u32)>> = BinaryHeap::new();
         for s in 0..self.tris.len() {
-            if self.is_new[s] {
-                self.push_bad(run, &mut heap, s);
+            if self.alive[s] && self.is_new[s] {
+                let bad = self.initial_badness(run, s);
+                // Test builds check the shortcut against the full test on every sharpening.
+                debug_assert_eq!(
+                    bad.map(f64::to_bits),
+                    self.badness(run, s).map(f64::to_bits),
+                    "slot {s}"
+                );
+                if let Some(a) = bad {
+                    heap.push(Reverse((a.to_bits(), s as u32)));
+                }
             }
         }
         if heap.is_empty() {
