@@ -229,6 +229,7 @@ impl EdgeSharpener {
             limits: SnapLimits::new(0.0),
             ref_normals: Vec::new(),
             snap_cache: Vec::new(),
+            corner_cache: Vec::new(),
             surface_samples: false,
         };
         let (out, parents, tags) = run.run();
@@ -266,6 +267,9 @@ pub(crate) struct Run<'a> {
     /// Edge snaps computed while dropping idle splits, by the lower corner of their edge, in
     /// increasing corner order (the order both passes visit the edges in).
     pub snap_cache: Vec<(u32, EdgeSnap)>,
+    /// Corner snaps computed while dropping idle splits, by triangle, in increasing order,
+    /// with the anchor they were computed for.
+    pub corner_cache: Vec<(u32, DVec3, EdgeSnap)>,
     /// Extended method: the input is a regular tiling whose vertices are surface samples
     /// (`crate::extended::is_surface_sampling`).
     pub surface_samples: bool,
@@ -691,7 +695,15 @@ impl Run<'_> {
                 .map(|&v| self.positions[v as usize])
                 .sum::<DVec3>()
                 / 3.0;
-            if three || self.corner_snap(tri, anchor).is_ok() {
+            let snapped = if three {
+                None
+            } else {
+                let snapped = self.corner_snap(tri, anchor);
+                let ok = snapped.is_ok();
+                self.corner_cache.push((t as u32, anchor, snapped));
+                Some(ok)
+            };
+            if snapped != Some(false) {
                 green += 1;
             } else {
                 self.s.tflags[t] &= !T_GREEN;
@@ -764,6 +776,7 @@ impl Run<'_> {
             });
             self.positions.push(pos);
         }
+        let mut next_corner = 0;
         reset(&mut self.s.center, 0, NONE);
         if self.report.corner_triangles > 0 {
             reset(&mut self.s.center, nt, NONE);
@@ -778,7 +791,27 @@ impl Run<'_> {
                     / 3.0;
                 let id = (nv + self.s.new_vertices.len()) as u32;
                 self.s.center[t] = id;
-                let (pos, status, planes) = match self.corner_snap(tri, rest) {
+                // Dropping idle splits snapped most of them already, in triangle order
+                // (nothing the snap reads has moved since; the anchor is compared bit for
+                // bit, as it was summed in another order).
+                while self
+                    .corner_cache
+                    .get(next_corner)
+                    .is_some_and(|(k, _, _)| (*k as usize) < t)
+                {
+                    next_corner += 1;
+                }
+                let snapped = match self.corner_cache.get(next_corner) {
+                    Some((k, anchor, s))
+                        if *k as usize == t
+                            && anchor.to_array().map(f64::to_bits)
+                                == rest.to_array().map(f64::to_bits) =>
+                    {
+                        *s
+                    }
+                    _ => self.corner_snap(tri, rest),
+                };
+                let (pos, status, planes) = match snapped {
                     Ok((p, planes)) => (p, SNAPPED, planes),
                     Err(r) => (rest, 1 + r.index() as u8, Planes::default()),
                 };
@@ -1435,6 +1468,7 @@ mod tests {
             limits: SnapLimits::new(0.0),
             ref_normals: Vec::new(),
             snap_cache: Vec::new(),
+            corner_cache: Vec::new(),
             surface_samples: false,
         };
         f(&mut run)
@@ -1513,6 +1547,7 @@ mod tests {
             limits: SnapLimits::new(0.0),
             ref_normals: Vec::new(),
             snap_cache: Vec::new(),
+            corner_cache: Vec::new(),
             surface_samples: false,
         };
         run.detect();
