@@ -793,7 +793,7 @@ impl Run<'_> {
                 self.s.center[t] = id;
                 // Dropping idle splits snapped most of them already, in triangle order
                 // (nothing the snap reads has moved since; the anchor is compared bit for
-                // bit, as it was summed in another order).
+                // bit: summed from zero there, a zero sum may differ in sign).
                 while self
                     .corner_cache
                     .get(next_corner)

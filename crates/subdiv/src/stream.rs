@@ -173,7 +173,11 @@ pub fn encode_control(
             .with_repair(false),
     )?;
     // The decoder numbers vertices in traversal order; express the sharpness on that mesh.
-    let decoded = whet_codec::decode(&encoded.bytes, &DecodeOptions::DEFAULT)?;
+    // Its own stream: trusted, so without the hostile-input limits.
+    let decoded = whet_codec::decode(
+        &encoded.bytes,
+        &DecodeOptions::DEFAULT.with_limits(whet_codec::Limits::UNLIMITED),
+    )?;
     let order = &encoded.report.vertex_order;
     let edges = decoded.undirected_edges();
     let mut values = Vec::with_capacity(edges.len());

@@ -677,7 +677,10 @@ impl SwingEncoder {
                 let input = if out.surface_filter.is_none() {
                     &out.retiled
                 } else {
-                    let opts = whet_codec::DecodeOptions::DEFAULT.with_surface_filter(false);
+                    // Its own stream: trusted, so without the hostile-input limits.
+                    let opts = whet_codec::DecodeOptions::DEFAULT
+                        .with_surface_filter(false)
+                        .with_limits(whet_codec::Limits::UNLIMITED);
                     unfiltered = whet_codec::decode(&out.bytes, &opts)?;
                     &unfiltered
                 };
