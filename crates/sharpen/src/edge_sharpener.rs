@@ -410,7 +410,6 @@ impl Run<'_> {
         let mesh = self.mesh;
         let table = self.table;
         let nt = mesh.triangles.len();
-        let nc = 3 * nt;
         let s = &mut *self.s;
         // Filter 1: red (core) vertices, all of whose edges are brown.
         for (t, tri) in mesh.triangles.iter().enumerate() {
@@ -469,17 +468,25 @@ impl Run<'_> {
         if self.opts.method == Method::Extended {
             label_regions(s, table, nt);
         }
-        // Filter 3bis: tag the ends of non-brown edges between two red triangles ...
-        for c in 0..nc {
-            if s.cflags[c] & C_BROWN != 0 || s.tflags[c / 3] & T_RED == 0 {
+        // Filter 3bis: tag the ends of non-brown edges between two red triangles ... (red
+        // triangle by red triangle, the corner arrays walked in step)
+        for (t, (tri, (o3, cf3))) in mesh
+            .triangles
+            .iter()
+            .zip(opposite.chunks_exact(3).zip(s.cflags.chunks_exact(3)))
+            .enumerate()
+        {
+            if s.tflags[t] & T_RED == 0 {
                 continue;
             }
-            if let Some(o) = table.opposite(CornerId(c as u32)) {
-                if s.tflags[o.index() / 3] & T_RED != 0 {
-                    let tri_a = table.corner_vertices()[next(c)];
-                    let tri_b = table.corner_vertices()[prev(c)];
-                    s.vflags[tri_a as usize] |= V_TAG;
-                    s.vflags[tri_b as usize] |= V_TAG;
+            for (j, (after, before)) in AFTER_BEFORE.into_iter().enumerate() {
+                let o = o3[j];
+                if cf3[j] & C_BROWN != 0 || o == NONE {
+                    continue;
+                }
+                if s.tflags[o as usize / 3] & T_RED != 0 {
+                    s.vflags[tri[after] as usize] |= V_TAG;
+                    s.vflags[tri[before] as usize] |= V_TAG;
                 }
             }
         }
@@ -489,23 +496,27 @@ impl Run<'_> {
         // red-region border edge (opposite corner c of a red triangle) starts a run at next(c).
         let mut runs = vec![0u8; mesh.positions.len()];
         // Filter 4: edges and vertices of red triangles.
-        for (t, tri) in mesh.triangles.iter().enumerate() {
+        for (t, (tri, o3)) in mesh
+            .triangles
+            .iter()
+            .zip(opposite.chunks_exact(3))
+            .enumerate()
+        {
             if s.tflags[t] & T_RED == 0 {
                 continue;
             }
-            for k in 0..3 {
-                let c = 3 * t + k;
-                s.cflags[c] |= C_RED;
+            for (k, (after, _)) in AFTER_BEFORE.into_iter().enumerate() {
+                s.cflags[3 * t + k] |= C_RED;
                 s.vflags[tri[k] as usize] |= V_RED;
-                let border = match table.opposite(CornerId(c as u32)) {
-                    Some(o) => {
-                        s.cflags[o.index()] |= C_RED;
-                        s.tflags[o.index() / 3] & T_RED == 0
-                    }
-                    None => true,
+                let o = o3[k];
+                let border = if o == NONE {
+                    true
+                } else {
+                    s.cflags[o as usize] |= C_RED;
+                    s.tflags[o as usize / 3] & T_RED == 0
                 };
                 if border {
-                    let v = tri[(k + 1) % 3] as usize;
+                    let v = tri[after] as usize;
                     runs[v] = runs[v].saturating_add(1);
                 }
             }
