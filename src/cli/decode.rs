@@ -52,6 +52,15 @@ pub fn run(args: &DecodeArgs) -> CliResult {
         )
     })?;
     let limits = whet_format::Limits::DEFAULT.with_max_alloc_bytes(args.max_memory);
+    if args.sharpen {
+        // An exact or swing stream states its triangle count: refuse sharpening it before
+        // decoding when that alone passes the budget (checked again on the decoded mesh).
+        if let Ok(h) = whet_codec::peek_header(&bytes) {
+            if matches!(h.mode, whet_format::Mode::Exact | whet_format::Mode::Swing) {
+                check_sharpen_memory(h.triangle_count, args.max_memory)?;
+            }
+        }
+    }
     let opts = DecodeOptions::DEFAULT
         .with_surface_filter(!(args.no_surface_filter || args.sharpen))
         .with_limits(limits);
@@ -72,18 +81,7 @@ pub fn run(args: &DecodeArgs) -> CliResult {
         }
     })?;
     let mesh = if args.sharpen {
-        let peak =
-            (mesh.triangles.len() as u64).saturating_mul(whet_sharpen::PEAK_BYTES_PER_TRIANGLE);
-        if peak > args.max_memory {
-            return Err(Failure::input(anyhow::anyhow!(
-                "sharpening {} triangles would take about {} at {} bytes each, over \
-                 --max-memory {} bytes: raise --max-memory or decode without --sharpen",
-                mesh.triangles.len(),
-                super::human_bytes(peak),
-                whet_sharpen::PEAK_BYTES_PER_TRIANGLE,
-                args.max_memory
-            )));
-        }
+        check_sharpen_memory(mesh.triangles.len() as u64, args.max_memory)?;
         let opts = super::sharpen::sharpen_options(&args.method, args.smooth_factor)?;
         let mut s = super::sharpen::run_sharpen(&mesh, &opts)?;
         if !args.no_surface_filter {
@@ -117,6 +115,21 @@ pub fn run(args: &DecodeArgs) -> CliResult {
         args.output_format,
         &whet::io::WriteOptions::DEFAULT,
     )
+}
+
+/// Refuses (exit code 2) sharpening `triangles` triangles past `max_memory` bytes at the
+/// sharpener's measured peak per triangle.
+fn check_sharpen_memory(triangles: u64, max_memory: u64) -> CliResult {
+    let peak = triangles.saturating_mul(whet_sharpen::PEAK_BYTES_PER_TRIANGLE);
+    if peak > max_memory {
+        return Err(Failure::input(anyhow::anyhow!(
+            "sharpening {triangles} triangles would take about {} at {} bytes each, over \
+             --max-memory {max_memory} bytes: raise --max-memory or decode without --sharpen",
+            super::human_bytes(peak),
+            whet_sharpen::PEAK_BYTES_PER_TRIANGLE,
+        )));
+    }
+    Ok(())
 }
 
 /// True when `e` refused the stream for the allocation budget that `--max-memory` sets
