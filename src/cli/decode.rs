@@ -139,14 +139,14 @@ fn over_max_memory(e: &whet::Error) -> bool {
         matches!(
             e,
             whet_codec::Error::Format(whet_format::Error::LimitExceeded { what, .. })
-                if *what == "allocation (bytes)" || *what == "bytes decoding allocates (estimated)"
+                if *what == whet_format::ALLOCATION_LIMIT || *what == whet_codec::DECODE_PEAK_LIMIT
         )
     }
     match e {
         whet::Error::Codec(c) => codec(c),
         whet::Error::Subdiv(whet_subdiv::Error::Codec(c)) => codec(c),
         whet::Error::Subdiv(whet_subdiv::Error::LimitExceeded { what, .. }) => {
-            what.starts_with("bytes the subdivision allocates")
+            *what == whet_subdiv::SUBDIVISION_PEAK_LIMIT
         }
         _ => false,
     }

@@ -53,6 +53,9 @@ impl Default for DecodeOptions {
 pub const DECODE_BYTES_PER_TRIANGLE: u64 = 60;
 /// See [`DECODE_BYTES_PER_TRIANGLE`].
 pub const DECODE_BYTES_PER_VERTEX: u64 = 48;
+/// The `what` of the [`whet_format::Error::LimitExceeded`] a decoder returns when that
+/// estimate passes [`Limits::max_alloc_bytes`].
+pub const DECODE_PEAK_LIMIT: &str = "bytes decoding allocates (estimated)";
 
 /// Decodes a whole `.whet` stream held in memory.
 pub fn decode(bytes: &[u8], opts: &DecodeOptions) -> Result<Mesh, Error> {
@@ -82,7 +85,7 @@ pub fn decode_container(container: &Container, opts: &DecodeOptions) -> Result<M
             .saturating_add(h.vertex_count.saturating_mul(DECODE_BYTES_PER_VERTEX));
         if peak > opts.limits.max_alloc_bytes {
             return Err(Error::Format(whet_format::Error::LimitExceeded {
-                what: "bytes decoding allocates (estimated)",
+                what: DECODE_PEAK_LIMIT,
                 limit: opts.limits.max_alloc_bytes,
                 value: peak,
             }));

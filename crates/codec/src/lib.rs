@@ -37,7 +37,7 @@ pub mod swing;
 
 pub use decoder::{
     decode, decode_container, peek_header, DecodeOptions, Decoder, StreamingDecoder,
-    DECODE_BYTES_PER_TRIANGLE, DECODE_BYTES_PER_VERTEX,
+    DECODE_BYTES_PER_TRIANGLE, DECODE_BYTES_PER_VERTEX, DECODE_PEAK_LIMIT,
 };
 pub use encoder::{
     encode, prepare_mesh, EncodeOptions, EncodeReport, Encoded, Encoder, PreparedMesh,

@@ -101,6 +101,25 @@ fn grid_coordinate(c: f64, m: i32) -> i32 {
 mod tests {
     use super::*;
 
+    /// 20 000 values spread over `[low, low + width)` (xorshift from `seed`), each with the
+    /// half-integer nearest it away from zero and that half's two neighbouring doubles: the
+    /// cases where rounding differs.
+    fn spread_with_halves(seed: u64, low: f64, width: f64) -> Vec<f64> {
+        let mut state = seed;
+        let mut out = Vec::with_capacity(80_000);
+        for _ in 0..20_000 {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let x = low + (state >> 11) as f64 / (1u64 << 53) as f64 * width;
+            let half = x.trunc() + 0.5 * x.signum();
+            // Both neighbours of the half (never 0), whatever its sign.
+            let (a, b) = (half.to_bits() + 1, half.to_bits() - 1);
+            out.extend([x, half, f64::from_bits(a), f64::from_bits(b)]);
+        }
+        out
+    }
+
     #[test]
     fn round_half_away_matches_round_bit_for_bit() {
         let mut cases = vec![
@@ -124,16 +143,7 @@ mod tests {
             f64::MIN_POSITIVE,
             -f64::MIN_POSITIVE,
         ];
-        let mut state = 0x9E37_79B9_7F4A_7C15u64;
-        for _ in 0..20_000 {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            let x = ((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 200.0;
-            let half = x.trunc() + 0.5 * x.signum();
-            let (a, b) = (half.to_bits() + 1, half.to_bits() - 1);
-            cases.extend([x, half, f64::from_bits(a), f64::from_bits(b)]);
-        }
+        cases.extend(spread_with_halves(0x9E37_79B9_7F4A_7C15, -100.0, 200.0));
         for x in cases {
             let (got, want) = (round_half_away(x), x.round());
             assert!(
@@ -168,17 +178,11 @@ mod tests {
             f64::MIN_POSITIVE,
         ];
         // Halves, their neighbours and a spread of ordinary values.
-        let mut state = 0x2545_F491_4F6C_DD1Du64;
-        for _ in 0..20_000 {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            let x = (state >> 11) as f64 / (1u64 << 53) as f64 * 1.1 * f64::from(m) - 1000.0;
-            let half = x.floor() + 0.5;
-            // Both neighbours of the half (never 0), whatever its sign.
-            let (a, b) = (half.to_bits() + 1, half.to_bits() - 1);
-            cases.extend([x, half, f64::from_bits(a), f64::from_bits(b)]);
-        }
+        cases.extend(spread_with_halves(
+            0x2545_F491_4F6C_DD1D,
+            -1000.0,
+            1.1 * f64::from(m),
+        ));
         for c in cases {
             assert_eq!(grid_coordinate(c, m), reference(c), "{c:e}");
         }

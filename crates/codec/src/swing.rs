@@ -1682,7 +1682,7 @@ fn decode_forward(
     let peak = n.saturating_mul(crate::DECODE_BYTES_PER_TRIANGLE);
     if peak > opts.limits.max_alloc_bytes {
         return Err(whet_format::Error::LimitExceeded {
-            what: "bytes decoding allocates (estimated)",
+            what: crate::DECODE_PEAK_LIMIT,
             limit: opts.limits.max_alloc_bytes,
             value: peak,
         }

@@ -46,7 +46,7 @@ pub use header::{
     peek_header, tag, Header, HeaderField, HeaderInfo, HeaderValue, Mode, ValueType, Version,
     BBOX_LEN, MAGIC, MAX_HEADER_LEN,
 };
-pub use limits::Limits;
+pub use limits::{Limits, ALLOCATION_LIMIT};
 pub use varint::{
     read_varint, read_varint_i64, varint_len, write_varint, write_varint_i64, zigzag_decode,
     zigzag_encode, MAX_VARINT_LEN,

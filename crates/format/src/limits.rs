@@ -73,7 +73,7 @@ impl Limits {
 
     /// Checks that `bytes` more bytes may be allocated (for a running total, pass the total).
     pub fn check_alloc(&self, bytes: u64) -> Result<(), Error> {
-        check("allocation (bytes)", self.max_alloc_bytes, bytes)
+        check(ALLOCATION_LIMIT, self.max_alloc_bytes, bytes)
     }
 
     /// Checks a declared section (or header body) length.
@@ -81,6 +81,10 @@ impl Limits {
         check("section length (bytes)", self.max_section_bytes, len)
     }
 }
+
+/// The `what` of a [`Error::LimitExceeded`] from [`Limits::check_alloc`] (the bytes a reader
+/// keeps).
+pub const ALLOCATION_LIMIT: &str = "allocation (bytes)";
 
 fn check(what: &'static str, limit: u64, value: u64) -> Result<(), Error> {
     if value > limit {

@@ -437,34 +437,23 @@ impl Run<'_> {
         // the core triangles, so growing from each in turn gives what growing from all at once
         // does, and the stack holds only the triangles the growth adds, not every red one (a
         // grown triangle is looked at again when the scan reaches it, and adds nothing).
-        s.stack.clear();
         let opposite = table.opposites();
+        let mut stack = std::mem::take(&mut s.stack);
+        stack.clear();
         for t0 in 0..nt {
             if s.tflags[t0] & T_RED == 0 {
                 continue;
             }
-            let mut t = t0;
-            loop {
-                for c in 3 * t..3 * t + 3 {
-                    if s.cflags[c] & C_BROWN == 0 {
-                        continue;
-                    }
-                    let o = opposite[c];
-                    if o == NONE {
-                        continue; // brown edges are interior; never taken
-                    }
-                    let u = o as usize / 3;
-                    if s.tflags[u] & T_RED == 0 {
-                        s.tflags[u] |= T_RED;
-                        s.stack.push(u as u32);
-                    }
+            let tflags = &mut s.tflags;
+            grow_through_brown(t0, &s.cflags, opposite, &mut stack, |u| {
+                let grows = tflags[u] & T_RED == 0;
+                if grows {
+                    tflags[u] |= T_RED;
                 }
-                match s.stack.pop() {
-                    Some(u) => t = u as usize,
-                    None => break,
-                }
-            }
+                grows
+            });
         }
+        s.stack = stack;
         if self.opts.method == Method::Extended {
             label_regions(s, table, nt);
         }
@@ -1355,29 +1344,49 @@ fn label_regions(s: &mut Scratch, table: &CornerTable, nt: usize) {
         let label = next_label;
         next_label += 1;
         region[t0] = label;
-        let mut t = t0;
-        loop {
-            for c in 3 * t..3 * t + 3 {
-                if s.cflags[c] & C_BROWN == 0 {
-                    continue;
-                }
-                let o = opposite[c];
-                if o == NONE {
-                    continue; // brown edges are interior; never taken
-                }
-                let u = o as usize / 3;
-                if region[u] == NONE && s.tflags[u] & T_RED != 0 {
-                    region[u] = label;
-                    stack.push(u as u32);
-                }
+        let tflags = &s.tflags;
+        grow_through_brown(t0, &s.cflags, opposite, &mut stack, |u| {
+            let joins = region[u] == NONE && tflags[u] & T_RED != 0;
+            if joins {
+                region[u] = label;
             }
-            match stack.pop() {
-                Some(u) => t = u as usize,
-                None => break,
-            }
-        }
+            joins
+        });
     }
     s.stack = stack;
+}
+
+/// Grows from triangle `t0` across its brown (smooth) edges, depth first on `stack` (empty on
+/// return): `joins(u)` is asked once per brown edge of every triangle grown from, and a
+/// neighbour `u` it accepts (and marks) is grown from in turn. Filter 3 and the region labels
+/// both flood this way.
+fn grow_through_brown(
+    t0: usize,
+    cflags: &[u8],
+    opposite: &[u32],
+    stack: &mut Vec<u32>,
+    mut joins: impl FnMut(usize) -> bool,
+) {
+    let mut t = t0;
+    loop {
+        for c in 3 * t..3 * t + 3 {
+            if cflags[c] & C_BROWN == 0 {
+                continue;
+            }
+            let o = opposite[c];
+            if o == NONE {
+                continue; // brown edges are interior; never taken
+            }
+            let u = o as usize / 3;
+            if joins(u) {
+                stack.push(u as u32);
+            }
+        }
+        match stack.pop() {
+            Some(u) => t = u as usize,
+            None => break,
+        }
+    }
 }
 
 /// Angle between two unit vectors. Most edges of a sampled surface are nearly flat, so the

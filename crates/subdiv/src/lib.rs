@@ -47,7 +47,7 @@ pub use sharpness::EdgeSharpness;
 pub use stream::{
     decode_control, decode_subdiv, encode_control, encode_subdiv, DecodedControl,
     SubdivEncodeOptions, SubdivPayloads, SubdivReport, SHARPNESS_FORMAT,
-    SUBDIVISION_BYTES_PER_TRIANGLE,
+    SUBDIVISION_BYTES_PER_TRIANGLE, SUBDIVISION_PEAK_LIMIT,
 };
 pub use surface::{subdivide, subdivided_counts, SubdivOptions, MAX_LEVELS, MAX_OUTPUT_TRIANGLES};
 

@@ -281,7 +281,7 @@ pub fn decode_subdiv(
         ("decoded vertices", opts.limits.max_vertices, v),
         ("decoded triangles", opts.limits.max_faces, t),
         (
-            "bytes the subdivision allocates (estimated)",
+            SUBDIVISION_PEAK_LIMIT,
             opts.limits.max_alloc_bytes,
             t.saturating_mul(SUBDIVISION_BYTES_PER_TRIANGLE),
         ),
@@ -308,6 +308,10 @@ pub fn decode_subdiv(
 /// --max-memory`; it was 160, the allocations alone, which let a run pass a budget it then
 /// exceeded by a third.
 pub const SUBDIVISION_BYTES_PER_TRIANGLE: u64 = 220;
+
+/// The `what` of the [`Error::LimitExceeded`] returned when that estimate passes the byte
+/// limit.
+pub const SUBDIVISION_PEAK_LIMIT: &str = "bytes the subdivision allocates (estimated)";
 
 /// Zero-flag contexts: nonzero edges already coded around this edge, 0, 1, 2+.
 const CONTEXTS: usize = 3;
