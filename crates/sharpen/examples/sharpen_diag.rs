@@ -13,6 +13,14 @@
 //! `support::cached_stand_in`, or `<fixture> <bpv> <angle bits|auto> <method>` and uses the
 //! swing-decoded fixture of `swing_inputs::swing_input` (auto: optimised for sharpening).
 //! Any mesh file (a path with a `/`) takes `<input> <reference> - <method>`.
+//!
+//! It also counts the near-coincident input vertex pairs (marching cubes' clusters, closer
+//! than 5 % of the mean edge) around the three worst places, lists every boundary edge the
+//! output gained, and with `DIAG_LOCAL=1` lists the input and output triangles around the worst
+//! place (the angle of each to its nearest reference face, the distance of its vertices to the
+//! reference, into how many pieces it was cut) and the vertices there in the frame of the two
+//! nearest reference faces; `DIAG_V=<vertex>` prints that input vertex's input and output
+//! positions.
 
 mod support;
 mod swing_inputs;
@@ -79,6 +87,15 @@ fn main() {
         "sharpen",
     );
     println!("{}", out.report.to_json());
+    if let Some(v) = std::env::var("DIAG_V")
+        .ok()
+        .and_then(|x| x.parse::<usize>().ok())
+    {
+        println!(
+            "vertex {v}: input {:.5} output {:.5}",
+            input.positions[v], out.mesh.positions[v]
+        );
+    }
     let c = support::check(&reference, &input, &out);
     println!(
         "manifold {}, new boundary edges {}, new triangles {}, reversed {} (input {}), \
@@ -90,6 +107,26 @@ fn main() {
         c.input_reversed,
         c.min_new_angle
     );
+    if c.new_boundary_edges != 0 {
+        let mut count: std::collections::HashMap<(u32, u32), Vec<usize>> = Default::default();
+        for (t, tri) in out.mesh.triangles.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                count.entry((a.min(b), a.max(b))).or_default().push(t);
+            }
+        }
+        for ((a, b), ts) in &count {
+            if ts.len() == 1 {
+                let t = ts[0];
+                println!(
+                    "boundary edge {a}-{b} of output t{t} {:?} from input t{} {:?}",
+                    out.mesh.triangles[t],
+                    out.parents[t],
+                    input.triangles[out.parents[t].index()]
+                );
+            }
+        }
+    }
     let opts = MetroOptions::DEFAULT.with_samples(300_000);
     let before = or_die(metro(&reference, &input, &opts), "metro");
     let after = or_die(metro(&reference, &out.mesh, &opts), "metro");
@@ -166,6 +203,145 @@ fn main() {
         shown.push(p);
         if shown.len() >= 8 {
             break;
+        }
+    }
+    // Near-coincident input vertex pairs (marching cubes' clusters) around the worst places.
+    let h = input.mean_edge_length();
+    for p in shown.iter().take(3) {
+        let near: Vec<glam::DVec3> = input
+            .positions
+            .iter()
+            .copied()
+            .filter(|q| q.distance(*p) < 2.0 * h)
+            .collect();
+        let mut pairs = 0;
+        for i in 0..near.len() {
+            for j in i + 1..near.len() {
+                if near[i].distance(near[j]) < 0.05 * h {
+                    pairs += 1;
+                }
+            }
+        }
+        println!("  cluster pairs within 2 edges of {p:.3}: {pairs}");
+    }
+    if let Some(p) = shown.first() {
+        local_dump(&reference, &input, &out, *p);
+    }
+}
+
+/// Input and output triangles around `p`: the angle of each normal to the nearest reference
+/// triangle's, the distance of its vertices to the reference, and whether it was cut.
+fn local_dump(
+    reference: &whet_mesh::Mesh,
+    input: &whet_mesh::Mesh,
+    out: &whet_sharpen::Sharpened,
+    p: glam::DVec3,
+) {
+    if std::env::var_os("DIAG_LOCAL").is_none() {
+        return;
+    }
+    let to_ref = Bvh::new(reference);
+    let diag = reference.diagonal();
+    let radius = 2.5 * input.mean_edge_length();
+    let describe = |m: &whet_mesh::Mesh, t: usize| {
+        let tri = m.triangles[t];
+        let c = (m.positions[tri[0] as usize]
+            + m.positions[tri[1] as usize]
+            + m.positions[tri[2] as usize])
+            / 3.0;
+        let hit = to_ref.closest_point(c);
+        let rn = reference.face_normal(hit.triangle as usize);
+        let ang = m.face_normal(t).angle_between(rn).to_degrees();
+        let d: Vec<String> = tri
+            .iter()
+            .map(|&v| {
+                format!(
+                    "{}:{:.3}",
+                    v,
+                    to_ref.closest_point(m.positions[v as usize]).distance / diag * 100.0
+                )
+            })
+            .collect();
+        (c, ang, d)
+    };
+    let mut children = vec![0usize; input.triangles.len()];
+    for f in &out.parents {
+        children[f.index()] += 1;
+    }
+    println!(
+        "input triangles within 2.5 edges of {p:.3} (angle to reference normal, vertex:dist%):"
+    );
+    for t in 0..input.triangles.len() {
+        let (c, ang, d) = describe(input, t);
+        if c.distance(p) < radius {
+            println!(
+                "  t{t} {ang:6.1} deg  {}  pieces {}",
+                d.join(" "),
+                children[t]
+            );
+        }
+    }
+    // The local frame: the two reference face normals nearest p, the crease direction.
+    let near = |q: glam::DVec3| reference.face_normal(to_ref.closest_point(q).triangle as usize);
+    let n0 = near(p);
+    let mut n1 = n0;
+    for t in 0..input.triangles.len() {
+        let tri = input.triangles[t];
+        for &v in &tri {
+            let q = input.positions[v as usize];
+            if q.distance(p) < radius {
+                let n = near(q);
+                if n.angle_between(n0) > n1.angle_between(n0) {
+                    n1 = n;
+                }
+            }
+        }
+    }
+    let e = n0.cross(n1).normalize_or_zero();
+    let h = input.mean_edge_length();
+    println!("frame: normals {n0:.3} {n1:.3} ({:.1} deg), edge {h:.4}; vertex: along, above plane 0, above plane 1 (edges)", n0.angle_between(n1).to_degrees());
+    let apex = to_ref.closest_point(p).point;
+    let mut seen = std::collections::BTreeSet::new();
+    for tri in &input.triangles {
+        for &v in tri {
+            let q = input.positions[v as usize];
+            if q.distance(p) < radius && seen.insert(v) {
+                let d = q - apex;
+                println!(
+                    "  v{v}: {:6.2} {:6.2} {:6.2}",
+                    d.dot(e) / h,
+                    d.dot(n0) / h,
+                    d.dot(n1) / h
+                );
+            }
+        }
+    }
+    for (i, q) in out
+        .mesh
+        .positions
+        .iter()
+        .enumerate()
+        .skip(input.positions.len())
+    {
+        if q.distance(p) < radius {
+            let d = *q - apex;
+            println!(
+                "  new v{i}: {:6.2} {:6.2} {:6.2}",
+                d.dot(e) / h,
+                d.dot(n0) / h,
+                d.dot(n1) / h
+            );
+        }
+    }
+    println!("output triangles there:");
+    for t in 0..out.mesh.triangles.len() {
+        let (c, ang, d) = describe(&out.mesh, t);
+        if c.distance(p) < radius {
+            println!(
+                "  t{t} (from {}) {ang:6.1} deg  {}",
+                out.parents[t],
+                d.join(" ")
+            );
         }
     }
 }

@@ -1216,6 +1216,21 @@ impl Run<'_> {
                         victim = self
                             .worst_snapped(piece.iter().copied())
                             .map(|v| (v, UnmovedReason::Flipped));
+                        // A moved input vertex (a corner or crease vertex) is not given up
+                        // for a piece that also holds a split vertex left at rest: the sliver
+                        // pass can undo that split instead (collapsing it into an end of its
+                        // edge), which keeps the corner; if it cannot, it unsnaps the vertex
+                        // there. On marching cubes a corner vertex sits up to two edges from
+                        // the cut corner's rim, and the split of a rim edge whose snap failed
+                        // folded against it (synth pyramid 64 r1, fandisk 64 r0).
+                        let nv = self.mesh.positions.len();
+                        if victim.is_some_and(|(v, _)| (v as usize) < nv)
+                            && piece
+                                .iter()
+                                .any(|&u| u as usize >= nv && !self.is_snapped(u))
+                        {
+                            victim = None;
+                        }
                         if victim.is_some() {
                             break 'pieces;
                         }

@@ -801,6 +801,44 @@ pub(crate) const SUPPORT: f64 = 1.5;
 /// blend wider than a few samples, which the smooth test may still call a chamfer, is left
 /// alone.
 fn supported(run: &Run, p: DVec3, around: &[u32]) -> bool {
+    supported_within(run, p, around, 1.0)
+}
+
+/// How many times deeper than a right-angled one a grid sampler cuts the corner where the
+/// planes `planes` meet: 1 for right angles and flatter, `sin(45) / sin(a / 2)` for a wedge of
+/// interior angle `a` between two of them (at most [`MAX_ACUTE_REACH`]). Marching cubes cuts
+/// a tip where its cross-section first holds a grid point, and a wedge's cross-section narrows
+/// with its angle: the synth pyramid's base corners (interior angles of 58 degrees) were cut
+/// 1.6-1.8 mean edge lengths deep and their three-plane points refused by the support test
+/// (docs/results.md). Corner points of marching-cubes input only: on surface samplings
+/// every sample is on the surface and acute wedges are left alone anyway
+/// ([`MAX_SURFACE_TURN_DEGREES`]), and widening the edge snaps' support too changed no row
+/// of the synth or stand-in tables.
+fn acute_reach(run: &Run, planes: &[&Plane]) -> f64 {
+    if run.surface_samples {
+        return 1.0;
+    }
+    let mut narrowest = 1.0f64;
+    for i in 0..planes.len() {
+        for j in i + 1..planes.len() {
+            let turn = planes[i]
+                .normal
+                .dot(planes[j].normal)
+                .clamp(-1.0, 1.0)
+                .acos();
+            let interior = std::f64::consts::PI - turn;
+            narrowest = narrowest.min((0.5 * interior).sin());
+        }
+    }
+    (std::f64::consts::FRAC_1_SQRT_2 / narrowest).clamp(1.0, MAX_ACUTE_REACH)
+}
+
+/// Cap of [`acute_reach`]: a wedge of about 27 degrees; sharper tips are cut so deep that the
+/// corner point is no longer tied to the chamfer around it.
+pub(crate) const MAX_ACUTE_REACH: f64 = 3.0;
+
+/// [`supported`] with the limit multiplied by `reach`.
+fn supported_within(run: &Run, p: DVec3, around: &[u32], reach: f64) -> bool {
     let mut len = 0.0;
     let mut k = 0usize;
     for &v in around {
@@ -813,7 +851,7 @@ fn supported(run: &Run, p: DVec3, around: &[u32]) -> bool {
     if k == 0 {
         return false;
     }
-    let limit = SUPPORT * len / k as f64;
+    let limit = SUPPORT * reach * len / k as f64;
     around.iter().any(|&v| {
         run.table.vertex_corners(VertexId(v)).any(|c| {
             let [a, b, q] = run.mesh.triangle_positions(c.index() / 3);
@@ -1031,7 +1069,12 @@ pub(crate) fn corner_snap(
                             2.0 * scale,
                         ) || (run.surface_samples
                             && !distinct_crease(run, &[(tri[0], x), (tri[1], y), (tri[2], z)]))
-                            || !supported(run, q, &tri)
+                            || !supported_within(
+                                run,
+                                q,
+                                &tri,
+                                acute_reach(run, &[&x.plane, &y.plane, &z.plane]),
+                            )
                         {
                             reason = UnmovedReason::Curved;
                             continue;

@@ -142,7 +142,14 @@ impl SlotLists {
             next: Vec::new(),
         }
     }
+    /// Lists slot `s` at `v`, once: a slot can come back to a vertex (a re-cut triangle, a
+    /// flip, a collapse into a vertex the slot held before), and a slot listed twice would be
+    /// seen twice by a collapse, which kills a triangle holding both of its ends: the second
+    /// visit found the first one's result and opened a hole.
     fn push(&mut self, v: u32, s: u32) {
+        if self.iter(v).any(|x| x == s) {
+            return;
+        }
         let node = self.slot.len() as u32;
         self.slot.push(s);
         self.next.push(NONE);
@@ -928,5 +935,19 @@ mod tests {
         l.push(1, 13);
         assert_eq!(l.iter(1).collect::<Vec<_>>(), vec![13]);
         assert_eq!(l.iter(3).collect::<Vec<_>>(), vec![30]);
+    }
+
+    #[test]
+    fn slot_lists_hold_a_slot_once_per_vertex() {
+        // A re-cut or flipped slot is pushed again at vertices that list it already.
+        let mut l = SlotLists::new(3);
+        for (v, s) in [(1, 10), (1, 11), (1, 10), (2, 10), (1, 11), (2, 10)] {
+            l.push(v, s);
+        }
+        assert_eq!(l.iter(1).collect::<Vec<_>>(), vec![10, 11]);
+        assert_eq!(l.iter(2).collect::<Vec<_>>(), vec![10]);
+        l.clear(1);
+        l.push(1, 10);
+        assert_eq!(l.iter(1).collect::<Vec<_>>(), vec![10]);
     }
 }
