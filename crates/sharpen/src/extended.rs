@@ -1132,8 +1132,9 @@ pub(crate) const CORNER_MOVE_LIMIT: f64 = 1.5;
 
 /// Corner vertices: for each corner triangle whose three planes meet in a point, the nearest
 /// chamfer vertex (of the triangle or around it) moves onto that point and takes the three
-/// planes as labels. Returns the vertices that moved; the caller then recomputes the
-/// chamfer edges and corner triangles around them.
+/// planes as labels; then, on marching cubes, [`unlabelled_corner_vertices`]. Returns the
+/// vertices that moved; the caller then recomputes the chamfer edges and corner triangles
+/// around them.
 #[inline(never)] // one call per run; kept out of line so profiles show it
 pub(crate) fn corner_vertices(run: &mut Run) -> Vec<u32> {
     let nt = run.mesh.triangles.len();
@@ -1228,7 +1229,135 @@ pub(crate) fn corner_vertices(run: &mut Run) -> Vec<u32> {
         placed.push(w);
         moved.push(v);
     }
+    if !run.surface_samples {
+        unlabelled_corner_vertices(run, &mut placed, &mut moved);
+    }
     moved
+}
+
+/// A vertex inside a cut corner lies within this fraction of its mean edge length of one of
+/// the three planes at least: marching cubes places it by interpolating the distance along a
+/// grid edge, and near a convex corner the distance is the largest of the three plane
+/// distances, so the vertex is off the nearest plane by a fraction of a cell only. A vertex
+/// far from all three (synth fandisk at 32: 0.8 of its edges from each) sits where the planes
+/// extrapolated from coarsely sampled curved faces disagree, and moving it there made the
+/// max 1.7x worse.
+pub(crate) const CORNER_SURFACE_GAP: f64 = 0.5;
+
+/// Corner vertices that no corner triangle finds (marching cubes): a gray vertex with no label
+/// plane (it lies on none of its neighbours' planes: it is inside the cut-off corner) whose
+/// neighbours carry three or more surfaces moves onto the three-plane point of the best
+/// triple and takes their labels, under the rules of [`corner_vertices`]. The corner
+/// triangles of the papers need a label at each of their vertices, so a corner whose cut
+/// left such a vertex in its middle had none (synth fandisk at 96-128).
+fn unlabelled_corner_vertices(run: &mut Run, placed: &mut Vec<DVec3>, moved: &mut Vec<u32>) {
+    let nv = run.mesh.positions.len();
+    let mut kept: Vec<(u32, LabelPlane)> = Vec::new();
+    for v in 0..nv as u32 {
+        let f = run.s.vflags[v as usize];
+        if f & V_USED == 0
+            || f & (V_RED | V_MOVED) != 0
+            || run.s.lp_len[v as usize] != 0
+            || run.table.is_boundary_vertex(VertexId(v))
+        {
+            continue;
+        }
+        kept.clear();
+        let p = run.mesh.positions[v as usize];
+        let mut len = 0.0;
+        let mut k = 0usize;
+        for c in run.table.vertex_corners(VertexId(v)) {
+            let u = run.cv(next(c.index()));
+            len += (run.mesh.positions[u as usize] - p).length();
+            k += 1;
+            for lp in planes_of(run, u) {
+                if kept.iter().all(|(_, o)| !same_surface(run, o, lp)) {
+                    kept.push((u, *lp));
+                }
+            }
+        }
+        if kept.len() < 3 || k == 0 {
+            continue;
+        }
+        let mean = len / k as f64;
+        // The triple whose point is nearest.
+        let mut best: Option<(f64, DVec3, [usize; 3])> = None;
+        for i in 0..kept.len() {
+            for j in i + 1..kept.len() {
+                for l in j + 1..kept.len() {
+                    let (x, y, z) = (&kept[i].1, &kept[j].1, &kept[l].1);
+                    if !well_separated(run, &[x.plane, y.plane, z.plane]) {
+                        continue;
+                    }
+                    let Ok(q) = snap::corner_point(&x.plane, &y.plane, &z.plane, p, &run.limits)
+                    else {
+                        continue;
+                    };
+                    let gap = [x, y, z]
+                        .iter()
+                        .map(|pl| (p - pl.plane.point).dot(pl.plane.normal).abs())
+                        .fold(f64::INFINITY, f64::min);
+                    if gap > CORNER_SURFACE_GAP * mean {
+                        continue;
+                    }
+                    let d = q.distance(p);
+                    let reach = acute_reach(run, &[&x.plane, &y.plane, &z.plane]);
+                    if d > CORNER_MOVE_LIMIT * reach * mean
+                        || !consistent(
+                            run,
+                            q,
+                            &[
+                                (kept[i].0, x.label),
+                                (kept[j].0, y.label),
+                                (kept[l].0, z.label),
+                            ],
+                            2.0 * d.max(mean),
+                        )
+                        || !supported_within(run, q, &[v], reach)
+                    {
+                        continue;
+                    }
+                    if better(best.map(|b| b.0), d) {
+                        best = Some((d, q, [i, j, l]));
+                    }
+                }
+            }
+        }
+        let Some((_, w, triple)) = best else { continue };
+        if placed.iter().any(|q| q.distance(w) < 0.5 * mean) {
+            continue;
+        }
+        let thin = run.opts.min_angle_degrees.to_radians();
+        let fan_ok = run.table.vertex_corners(VertexId(v)).all(|cc| {
+            let u = cc.index() / 3;
+            let q =
+                run.mesh.triangles[u].map(|x| if x == v { w } else { run.positions[x as usize] });
+            let area = (q[1] - q[0]).cross(q[2] - q[0]);
+            area.dot(run.mesh.face_cross(u)) > 0.0 && crate::edge_sharpener::min_angle(&q) >= thin
+        });
+        if !fan_ok {
+            continue;
+        }
+        run.positions[v as usize] = w;
+        run.s.vflags[v as usize] |= V_MOVED | V_CHAMFER;
+        for cc in run.table.vertex_corners(VertexId(v)) {
+            run.s.tflags[cc.index() / 3] |= T_TOUCHED;
+        }
+        run.s.lp_start[v as usize] = run.s.lps.len() as u32;
+        run.s.lp_len[v as usize] = 3;
+        for i in triple {
+            let lp = kept[i].1;
+            run.s.lps.push(LabelPlane {
+                label: lp.label,
+                plane: Plane {
+                    point: w,
+                    normal: lp.plane.normal,
+                },
+            });
+        }
+        placed.push(w);
+        moved.push(v);
+    }
 }
 
 /// True when distance `d` beats the best so far (none yet counts as beaten).
