@@ -33,13 +33,13 @@ const SMOOTH: [(&str, [f64; 4]); 5] = [
 
 /// The CAD rows of `sharpen_figures -- swing` (rocker_arm, without a crease, is a smooth row).
 const CAD: [(&str, [f64; 3]); 7] = [
-    ("fandisk.off", [2.1, 3.8, 6.4]),
-    ("cad_box_hole.off", [1.5, 2.7, 4.5]),
-    ("cad_bracket.off", [1.6, 2.9, 4.9]),
-    ("cad_cyl_fillet.off", [1.2, 2.2, 3.8]),
-    ("block.off", [2.1, 3.8, 6.4]),
-    ("partLp.off", [2.2, 4.1, 7.0]),
-    ("joint.off", [1.4, 2.5, 4.3]),
+    ("fandisk.off", [1.6, 2.6, 4.4]),
+    ("cad_box_hole.off", [1.1, 1.9, 3.1]),
+    ("cad_bracket.off", [1.2, 2.0, 3.5]),
+    ("cad_cyl_fillet.off", [0.9, 1.6, 2.8]),
+    ("block.off", [1.7, 2.8, 4.6]),
+    ("partLp.off", [2.0, 3.3, 5.2]),
+    ("joint.off", [1.0, 1.8, 3.3]),
 ];
 
 fn samples() -> Option<usize> {
