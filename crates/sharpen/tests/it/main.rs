@@ -23,4 +23,5 @@ mod normal_filter;
 mod outputs;
 mod ridge;
 mod robustness;
+mod rotations;
 mod swing;
