@@ -974,6 +974,10 @@ impl Run<'_> {
         self.reference_normal(parent)
     }
 
+    /// A piece whose normal is within acos(0.9) (26 degrees) of the opposite of a plane it lies
+    /// on is folded onto it.
+    const FOLD_COS: f64 = 0.9;
+
     /// True when the triangle `tri` at positions `p`, cut from input triangle `parent`, is
     /// reversed (see [`Run::expected_normal`]). A triangle whose vertices are the parent's
     /// corners and its new vertices at rest lies in the parent's plane: reversed only if it
@@ -985,7 +989,34 @@ impl Run<'_> {
                 && self.s.normals[parent] != DVec3::ZERO;
         }
         let n = self.expected_normal(tri, parent);
-        n != DVec3::ZERO && area.dot(n) <= 0.0
+        if n != DVec3::ZERO && area.dot(n) <= 0.0 {
+            return true;
+        }
+        // A piece lying on any plane of its vertices and facing against it is folded onto
+        // that face, whichever plane its input vertices chose: next to an acute crease a
+        // chamfer vertex labelled with one face can carry a piece folded onto the other (synth
+        // pyramids turned by under 2 degrees: 87 such pieces in 300 samplings, 8 with this
+        // test). Only nearly antiparallel pieces count: judging every piece by every plane
+        // of its vertices unsnapped good chamfer pieces (cube 48 r0 max gain 1.89x -> 1.17x).
+        let unit = area.normalize_or_zero();
+        let longest2 = (0..3)
+            .map(|k| p[k].distance_squared(p[(k + 1) % 3]))
+            .fold(0.0f64, f64::max);
+        let tol = 0.2 * longest2.sqrt();
+        let mut folded = false;
+        for &v in tri {
+            self.for_each_plane(v, |pl| {
+                if pl.normal == DVec3::ZERO || unit.dot(pl.normal) > -Self::FOLD_COS {
+                    return;
+                }
+                let d = p
+                    .iter()
+                    .map(|q| (*q - pl.point).dot(pl.normal).abs())
+                    .fold(0.0f64, f64::max);
+                folded |= d <= tol;
+            });
+        }
+        folded
     }
 
     /// True when every vertex of `tri` is a corner of input triangle `t` (unmoved) or a new
