@@ -979,9 +979,10 @@ impl Run<'_> {
     const FOLD_COS: f64 = 0.9;
 
     /// True when the triangle `tri` at positions `p`, cut from input triangle `parent`, is
-    /// reversed (see [`Run::expected_normal`]). A triangle whose vertices are the parent's
-    /// corners and its new vertices at rest lies in the parent's plane: reversed only if it
-    /// points against the parent.
+    /// reversed (see [`Run::expected_normal`]), or folded onto any plane of its vertices (it
+    /// lies on it and faces within 26 degrees of its opposite). A triangle whose vertices are
+    /// the parent's corners and its new vertices at rest lies in the parent's plane: reversed
+    /// only if it points against the parent.
     pub(crate) fn is_reversed(&self, tri: &[u32; 3], parent: usize, p: &[DVec3; 3]) -> bool {
         let area = (p[1] - p[0]).cross(p[2] - p[0]);
         if self.at_rest_in(tri, parent) {
@@ -998,8 +999,8 @@ impl Run<'_> {
         // pyramids turned by under 2 degrees: 87 such pieces in 300 samplings, 8 with this
         // test). Only nearly antiparallel pieces count: judging every piece by every plane
         // of its vertices unsnapped good chamfer pieces (cube 48 r0 max gain 1.89x -> 1.17x).
-        // The normal test first, without a square root; the distances only for the rare
-        // plane that passes it.
+        // The normal test first (one square root per piece); the distances only for the
+        // rare plane that passes it.
         let limit = -Self::FOLD_COS * area.length();
         let mut folded = false;
         for &v in tri {
@@ -1221,7 +1222,9 @@ impl Run<'_> {
     }
 
     /// Chooses diagonals and unsnaps vertices until no piece reverses its input triangle or
-    /// has an edge with a snapped end longer than the longest input edge.
+    /// has an edge with a snapped end longer than the longest input edge, except a reversed
+    /// piece that holds a moved input vertex and a new vertex at rest, which is left to the
+    /// sliver pass (below).
     #[inline(never)] // one call per run; kept out of line so profiles show it
     fn settle_positions(&mut self) {
         let limit = self.max_edge * self.edge_limit_factor();
@@ -1249,10 +1252,10 @@ impl Run<'_> {
                             .worst_snapped(piece.iter().copied())
                             .map(|v| (v, UnmovedReason::Flipped));
                         // A moved input vertex (a corner or crease vertex) is not given up
-                        // for a piece that also holds a split vertex left at rest: the sliver
-                        // pass can undo that split instead (collapsing it into an end of its
-                        // edge), which keeps the corner; if it cannot, it unsnaps the vertex
-                        // there. On marching cubes a corner vertex sits up to two edges from
+                        // for a piece that also holds a new vertex left at rest (a split, or
+                        // a centre): the sliver pass can undo that split instead (collapsing
+                        // it into an end of its edge), which keeps the corner; if it cannot,
+                        // it unsnaps the vertex there. On marching cubes a corner vertex sits up to two edges from
                         // the cut corner's rim, and the split of a rim edge whose snap failed
                         // folded against it (synth pyramid 64 r1, fandisk 64 r0).
                         let nv = self.mesh.positions.len();

@@ -810,7 +810,8 @@ fn supported(run: &Run, p: DVec3, around: &[u32]) -> bool {
 /// a tip where its cross-section first holds a grid point, and a wedge's cross-section narrows
 /// with its angle: the synth pyramid's base corners (interior angles of 58 degrees) were cut
 /// 1.6-1.8 mean edge lengths deep and their three-plane points refused by the support test
-/// (docs/results.md). Corner points of marching-cubes input only: on surface samplings
+/// (docs/results.md). It widens the support test of corner points and the move limit of
+/// [`unlabelled_corner_vertices`]. Marching-cubes input only: on surface samplings
 /// every sample is on the surface and acute wedges are left alone anyway
 /// ([`MAX_SURFACE_TURN_DEGREES`]), and widening the edge snaps' support too changed no row
 /// of the synth or stand-in tables.
@@ -1247,12 +1248,17 @@ pub(crate) const CORNER_SURFACE_GAP: f64 = 0.5;
 /// Corner vertices that no corner triangle finds (marching cubes): a gray vertex with no label
 /// plane (it lies on none of its neighbours' planes: it is inside the cut-off corner) whose
 /// neighbours carry three or more surfaces moves onto the three-plane point of the best
-/// triple and takes their labels, under the rules of [`corner_vertices`]. The corner
-/// triangles of the papers need a label at each of their vertices, so a corner whose cut
-/// left such a vertex in its middle had none (synth fandisk at 96-128).
+/// triple and takes their labels, under the rules of [`corner_vertices`] (the move limit
+/// widened by [`acute_reach`] like the support test). The corner triangles of the papers need
+/// a label at each of their vertices, so a corner whose cut left such a vertex in its middle
+/// had none (synth fandisk at 96-128). A vertex with a corner triangle in its two-ring is left
+/// to that triangle (its centre would snap to the same point). Candidates are found first and
+/// moved nearest first (ties by index), so the result does not depend on the vertex order.
 fn unlabelled_corner_vertices(run: &mut Run, placed: &mut Vec<DVec3>, moved: &mut Vec<u32>) {
     let nv = run.mesh.positions.len();
     let mut kept: Vec<(u32, LabelPlane)> = Vec::new();
+    // (distance, vertex, target, the three label planes, the vertex's mean edge)
+    let mut candidates: Vec<(f64, u32, DVec3, [LabelPlane; 3], f64)> = Vec::new();
     for v in 0..nv as u32 {
         let f = run.s.vflags[v as usize];
         if f & V_USED == 0
@@ -1276,7 +1282,7 @@ fn unlabelled_corner_vertices(run: &mut Run, placed: &mut Vec<DVec3>, moved: &mu
                 }
             }
         }
-        if kept.len() < 3 || k == 0 {
+        if kept.len() < 3 || k == 0 || near_corner_triangle(run, v) {
             continue;
         }
         let mean = len / k as f64;
@@ -1323,11 +1329,16 @@ fn unlabelled_corner_vertices(run: &mut Run, placed: &mut Vec<DVec3>, moved: &mu
                 }
             }
         }
-        let Some((_, w, triple)) = best else { continue };
+        if let Some((d, w, [i, j, l])) = best {
+            candidates.push((d, v, w, [kept[i].1, kept[j].1, kept[l].1], mean));
+        }
+    }
+    candidates.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+    let thin = run.opts.min_angle_degrees.to_radians();
+    for (_, v, w, planes, mean) in candidates {
         if placed.iter().any(|q| q.distance(w) < 0.5 * mean) {
             continue;
         }
-        let thin = run.opts.min_angle_degrees.to_radians();
         let fan_ok = run.table.vertex_corners(VertexId(v)).all(|cc| {
             let u = cc.index() / 3;
             let q =
@@ -1340,13 +1351,13 @@ fn unlabelled_corner_vertices(run: &mut Run, placed: &mut Vec<DVec3>, moved: &mu
         }
         run.positions[v as usize] = w;
         run.s.vflags[v as usize] |= V_MOVED | V_CHAMFER;
+        run.report.chamfer_vertices += 1;
         for cc in run.table.vertex_corners(VertexId(v)) {
             run.s.tflags[cc.index() / 3] |= T_TOUCHED;
         }
         run.s.lp_start[v as usize] = run.s.lps.len() as u32;
         run.s.lp_len[v as usize] = 3;
-        for i in triple {
-            let lp = kept[i].1;
+        for lp in planes {
             run.s.lps.push(LabelPlane {
                 label: lp.label,
                 plane: Plane {
@@ -1358,6 +1369,18 @@ fn unlabelled_corner_vertices(run: &mut Run, placed: &mut Vec<DVec3>, moved: &mu
         placed.push(w);
         moved.push(v);
     }
+}
+
+/// Whether a corner triangle (green) lies in the two-ring of `v`.
+fn near_corner_triangle(run: &Run, v: u32) -> bool {
+    let green = |t: usize| run.s.tflags[t] & crate::edge_sharpener::T_GREEN != 0;
+    run.table.vertex_corners(VertexId(v)).any(|c| {
+        green(c.index() / 3)
+            || run
+                .table
+                .vertex_corners(VertexId(run.cv(next(c.index()))))
+                .any(|cc| green(cc.index() / 3))
+    })
 }
 
 /// True when distance `d` beats the best so far (none yet counts as beaten).
