@@ -307,32 +307,60 @@ fn demote_corridors(run: &mut Run) {
     if !any {
         return;
     }
+    let mut gone: Vec<usize> = Vec::new();
     for t in 0..nt {
         let r = run.s.region[t];
         if r != NONE && demoted[r as usize] {
             run.s.region[t] = NONE;
             run.s.tflags[t] &= !T_RED;
+            gone.push(t);
         }
     }
-    // Filter 4 again for the red triangles that remain.
-    for f in run.s.vflags.iter_mut() {
-        *f &= !V_RED;
-    }
-    for f in run.s.cflags.iter_mut() {
-        *f &= !C_RED;
-    }
-    for t in 0..nt {
-        if run.s.tflags[t] & T_RED == 0 {
-            continue;
-        }
+    // Filter 4 again for the red triangles that remain, only where it can change: the edges
+    // and vertices of the demoted triangles (a corner is red when a triangle on either side
+    // of its edge is, a vertex when a triangle around it is). The same flags as running it over
+    // the whole mesh (test builds check), for a few hundred triangles instead of all.
+    let red = |run: &Run, t: usize| run.s.tflags[t] & T_RED != 0;
+    for &t in &gone {
         for c in 3 * t..3 * t + 3 {
-            run.s.cflags[c] |= C_RED;
-            if let Some(o) = run.table.opposite(CornerId(c as u32)) {
-                run.s.cflags[o.index()] |= C_RED;
+            let o = run.table.opposite(CornerId(c as u32));
+            let edge_red = o.is_some_and(|o| red(run, o.index() / 3));
+            set_flag(&mut run.s.cflags[c], C_RED, edge_red);
+            if let Some(o) = o {
+                set_flag(&mut run.s.cflags[o.index()], C_RED, edge_red);
             }
-            let v = run.cv(c) as usize;
-            run.s.vflags[v] |= V_RED;
+            let v = run.cv(c);
+            let vertex_red = run
+                .table
+                .vertex_corners(VertexId(v))
+                .any(|vc| red(run, vc.index() / 3));
+            set_flag(&mut run.s.vflags[v as usize], V_RED, vertex_red);
         }
+    }
+    #[cfg(debug_assertions)]
+    {
+        let mut vflags: Vec<u8> = run.s.vflags.iter().map(|f| f & !V_RED).collect();
+        let mut cflags: Vec<u8> = run.s.cflags.iter().map(|f| f & !C_RED).collect();
+        for t in (0..nt).filter(|&t| red(run, t)) {
+            for c in 3 * t..3 * t + 3 {
+                cflags[c] |= C_RED;
+                if let Some(o) = run.table.opposite(CornerId(c as u32)) {
+                    cflags[o.index()] |= C_RED;
+                }
+                vflags[run.cv(c) as usize] |= V_RED;
+            }
+        }
+        debug_assert!(vflags == run.s.vflags && cflags == run.s.cflags);
+    }
+}
+
+/// Sets or clears `bit` in `flags`.
+#[inline]
+fn set_flag(flags: &mut u8, bit: u8, on: bool) {
+    if on {
+        *flags |= bit;
+    } else {
+        *flags &= !bit;
     }
 }
 
