@@ -31,17 +31,6 @@ const SMOOTH: [(&str, [f64; 4]); 5] = [
     ("rocker_arm.off", [2.0, 4.0, 6.0, 8.0]),
 ];
 
-/// The CAD rows of `sharpen_figures -- swing` (rocker_arm, without a crease, is a smooth row).
-const CAD: [(&str, [f64; 3]); 7] = [
-    ("fandisk.off", [1.6, 2.6, 4.4]),
-    ("cad_box_hole.off", [1.1, 1.9, 3.1]),
-    ("cad_bracket.off", [1.2, 2.0, 3.5]),
-    ("cad_cyl_fillet.off", [0.9, 1.6, 2.8]),
-    ("block.off", [1.7, 2.8, 4.6]),
-    ("partLp.off", [2.0, 3.3, 5.2]),
-    ("joint.off", [1.0, 1.8, 3.3]),
-];
-
 fn samples() -> Option<usize> {
     std::env::var("SHARPEN_FIGURES_SAMPLES")
         .ok()
@@ -76,7 +65,11 @@ fn main() {
             }
         }
         if set == "cad" || set == "all" {
-            for (name, rates) in CAD {
+            // The CAD rows of the swing table (rocker_arm, without a crease, is a smooth row).
+            for &(name, rates) in swing_inputs::SWING_FIXTURES
+                .iter()
+                .filter(|(name, _)| *name != "rocker_arm.off")
+            {
                 for r in rates {
                     jobs.push((name.to_string(), r, a, true));
                 }

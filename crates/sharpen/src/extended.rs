@@ -1217,44 +1217,20 @@ pub(crate) fn corner_vertices(run: &mut Run) -> Vec<u32> {
         if d > CORNER_MOVE_LIMIT * mean || placed.iter().any(|q| q.distance(w) < 0.5 * mean) {
             continue;
         }
-        let thin = run.opts.min_angle_degrees.to_radians();
-        let fan_ok = run.table.vertex_corners(VertexId(v)).all(|cc| {
-            let u = cc.index() / 3;
-            let q =
-                run.mesh.triangles[u].map(|x| if x == v { w } else { run.positions[x as usize] });
-            let area = (q[1] - q[0]).cross(q[2] - q[0]);
-            area.dot(run.mesh.face_cross(u)) > 0.0 && crate::edge_sharpener::min_angle(&q) >= thin
-        });
-        if !fan_ok {
+        if !fan_stays_unfolded(run, v, w) {
             continue;
-        }
-        run.positions[v as usize] = w;
-        run.s.vflags[v as usize] |= V_MOVED;
-        for cc in run.table.vertex_corners(VertexId(v)) {
-            run.s.tflags[cc.index() / 3] |= T_TOUCHED;
         }
         // The corner vertex lies on the three surfaces: it takes their label planes (found
         // again among the triangle's vertices by their normals).
-        let labels: Vec<u32> = [a, b, c]
-            .iter()
-            .map(|pl| {
-                tri.iter()
-                    .flat_map(|&x| planes_of(run, x))
-                    .find(|lp| lp.plane.normal == pl.normal)
-                    .map_or(NONE, |lp| lp.label)
-            })
-            .collect();
-        run.s.lp_start[v as usize] = run.s.lps.len() as u32;
-        run.s.lp_len[v as usize] = 3;
-        for (i, pl) in [a, b, c].into_iter().enumerate() {
-            run.s.lps.push(LabelPlane {
-                label: labels[i],
-                plane: Plane {
-                    point: w,
-                    normal: pl.normal,
-                },
-            });
-        }
+        let labels = [a, b, c].map(|pl| {
+            let label = tri
+                .iter()
+                .flat_map(|&x| planes_of(run, x))
+                .find(|lp| lp.plane.normal == pl.normal)
+                .map_or(NONE, |lp| lp.label);
+            (label, pl.normal)
+        });
+        move_to_corner(run, v, w, labels);
         placed.push(w);
         moved.push(v);
     }
@@ -1362,40 +1338,48 @@ fn unlabelled_corner_vertices(run: &mut Run, placed: &mut Vec<DVec3>, moved: &mu
         }
     }
     candidates.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
-    let thin = run.opts.min_angle_degrees.to_radians();
     for (_, v, w, planes, mean) in candidates {
         if placed.iter().any(|q| q.distance(w) < 0.5 * mean) {
             continue;
         }
-        let fan_ok = run.table.vertex_corners(VertexId(v)).all(|cc| {
-            let u = cc.index() / 3;
-            let q =
-                run.mesh.triangles[u].map(|x| if x == v { w } else { run.positions[x as usize] });
-            let area = (q[1] - q[0]).cross(q[2] - q[0]);
-            area.dot(run.mesh.face_cross(u)) > 0.0 && crate::edge_sharpener::min_angle(&q) >= thin
-        });
-        if !fan_ok {
+        if !fan_stays_unfolded(run, v, w) {
             continue;
         }
-        run.positions[v as usize] = w;
-        run.s.vflags[v as usize] |= V_MOVED | V_CHAMFER;
+        run.s.vflags[v as usize] |= V_CHAMFER;
         run.report.chamfer_vertices += 1;
-        for cc in run.table.vertex_corners(VertexId(v)) {
-            run.s.tflags[cc.index() / 3] |= T_TOUCHED;
-        }
-        run.s.lp_start[v as usize] = run.s.lps.len() as u32;
-        run.s.lp_len[v as usize] = 3;
-        for lp in planes {
-            run.s.lps.push(LabelPlane {
-                label: lp.label,
-                plane: Plane {
-                    point: w,
-                    normal: lp.plane.normal,
-                },
-            });
-        }
+        move_to_corner(run, v, w, planes.map(|lp| (lp.label, lp.plane.normal)));
         placed.push(w);
         moved.push(v);
+    }
+}
+
+/// Whether moving input vertex `v` to `w` keeps its fan unfolded (every triangle facing as
+/// in the input) and free of triangles thinner than the sliver threshold.
+fn fan_stays_unfolded(run: &Run, v: u32, w: DVec3) -> bool {
+    let thin = run.opts.min_angle_degrees.to_radians();
+    run.table.vertex_corners(VertexId(v)).all(|cc| {
+        let u = cc.index() / 3;
+        let q = run.mesh.triangles[u].map(|x| if x == v { w } else { run.positions[x as usize] });
+        let area = (q[1] - q[0]).cross(q[2] - q[0]);
+        area.dot(run.mesh.face_cross(u)) > 0.0 && crate::edge_sharpener::min_angle(&q) >= thin
+    })
+}
+
+/// Moves input vertex `v` onto corner point `w`, touches its triangles and gives it the three
+/// label planes `(label, normal)` through `w`.
+fn move_to_corner(run: &mut Run, v: u32, w: DVec3, labels: [(u32, DVec3); 3]) {
+    run.positions[v as usize] = w;
+    run.s.vflags[v as usize] |= V_MOVED;
+    for cc in run.table.vertex_corners(VertexId(v)) {
+        run.s.tflags[cc.index() / 3] |= T_TOUCHED;
+    }
+    run.s.lp_start[v as usize] = run.s.lps.len() as u32;
+    run.s.lp_len[v as usize] = 3;
+    for (label, normal) in labels {
+        run.s.lps.push(LabelPlane {
+            label,
+            plane: Plane { point: w, normal },
+        });
     }
 }
 

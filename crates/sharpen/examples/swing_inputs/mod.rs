@@ -15,6 +15,23 @@
 use whet_mesh::Mesh;
 use whet_swing::{ErrorOf, Rate, SwingOptions};
 
+/// The CAD fixtures of the swing table of `sharpen_figures` and the CAD rows of
+/// `swing_sweep` (rocker_arm, the last entry: mostly smooth blends, a case that must not
+/// get worse) and their rates in bits per original vertex: about 0.5x, 1x and 2x the
+/// fixture's vertex count at 6 angle bits (re-chosen 2026-12-02 for the current encoder by a
+/// log-log fit of the vertex ratio against the rate from a run at the previous rates: a
+/// retiled vertex now costs 1.6-3.3 bits at 1x, a little more at 0.5x and less at 2x).
+pub const SWING_FIXTURES: [(&str, [f64; 3]); 8] = [
+    ("fandisk.off", [1.6, 2.6, 4.4]),
+    ("cad_box_hole.off", [1.1, 1.9, 3.1]),
+    ("cad_bracket.off", [1.2, 2.0, 3.5]),
+    ("cad_cyl_fillet.off", [0.9, 1.6, 2.8]),
+    ("block.off", [1.7, 2.8, 4.6]),
+    ("partLp.off", [2.0, 3.3, 5.2]),
+    ("joint.off", [1.0, 1.8, 3.3]),
+    ("rocker_arm.off", [1.6, 2.8, 4.8]),
+];
+
 /// The angle quantization of a swing input.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Angles {
