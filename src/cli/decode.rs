@@ -25,9 +25,11 @@ pub struct DecodeArgs {
     /// EdgeSharpener's smooth-edge factor.
     #[arg(long, default_value_t = 2.0)]
     smooth_factor: f64,
-    /// EdgeSharpener's method: extended (default) or papers.
-    #[arg(long, default_value = "extended")]
-    method: String,
+    /// EdgeSharpener's method: extended or papers. Without it, a swing stream encoded with
+    /// `--optimize-for sharpened` names the method its encoder measured best against the
+    /// original (or no sharpening, for a part it would make worse); otherwise extended.
+    #[arg(long)]
+    method: Option<String>,
     /// Subdiv streams: subdivision levels, overriding the header (0 gives the control mesh).
     #[arg(long)]
     levels: Option<u32>,
@@ -82,23 +84,47 @@ pub fn run(args: &DecodeArgs) -> CliResult {
     })?;
     let mesh = if args.sharpen {
         check_sharpen_memory(mesh.triangles.len() as u64, args.max_memory)?;
-        let opts = super::sharpen::sharpen_options(&args.method, args.smooth_factor)?;
+        let header = whet_format::parse(&bytes, &limits).ok().map(|c| c.header);
+        let hint = header.as_ref().and_then(whet_codec::SharpenHint::of);
+        let method = match (&args.method, hint) {
+            (Some(m), _) => m.as_str(),
+            (None, Some(h)) => h.name(),
+            (None, None) => "extended",
+        };
+        if method == whet_codec::SharpenHint::Unsharpened.name() {
+            // The encoder measured both methods worse than the decoded mesh: what `whet
+            // decode` gives without --sharpen (the stream's own surface filter included).
+            eprintln!(
+                "whet: the stream's encoder measured sharpening as no gain on this mesh; \
+                 decoding without it (--method extended|papers sharpens anyway)"
+            );
+            let plain = if args.no_surface_filter {
+                mesh
+            } else {
+                let opts = DecodeOptions::DEFAULT.with_limits(limits);
+                whet::decode_with_levels(&bytes, &opts, args.levels)
+                    .map_err(|e| Failure::other(anyhow::Error::new(e)))?
+            };
+            return match args.bend {
+                Some(levels) => {
+                    let bent = bend_levels(&plain, &[], levels, args.max_memory)?;
+                    write_decoded(args, &bent)
+                }
+                None => write_decoded(args, &plain),
+            };
+        }
+        let opts = super::sharpen::sharpen_options(method, args.smooth_factor)?;
         let mut s = super::sharpen::run_sharpen(&mesh, &opts)?;
         if !args.no_surface_filter {
             // A swing stream's filter for after sharpening: the smooth parts the sharpener
             // left alone get the surface filter fitted for them (docs/swing.md section 2).
-            if let Ok(c) = whet_format::parse(&bytes, &limits) {
-                whet_codec::SurfaceFilter::after_sharpening_of(&c.header)
+            if let Some(h) = &header {
+                whet_codec::SurfaceFilter::after_sharpening_of(h)
                     .apply_after_sharpening(&mesh, &mut s.mesh);
             }
         }
         match args.bend {
-            Some(levels) if levels > 8 => {
-                return Err(Failure::input(anyhow::anyhow!(
-                    "--bend {levels}: at most 8 levels"
-                )))
-            }
-            Some(levels) => super::sharpen::run_bend(
+            Some(levels) => bend_levels(
                 &s.mesh,
                 &super::sharpen::tag_edges(&s.tags),
                 levels,
@@ -109,12 +135,31 @@ pub fn run(args: &DecodeArgs) -> CliResult {
     } else {
         mesh
     };
+    write_decoded(args, &mesh)
+}
+
+fn write_decoded(args: &DecodeArgs, mesh: &whet::Mesh) -> CliResult {
     write_mesh(
         &args.output,
-        &mesh,
+        mesh,
         args.output_format,
         &whet::io::WriteOptions::DEFAULT,
     )
+}
+
+/// Bender over `mesh` with its sharp-edge tags (at most 8 levels).
+fn bend_levels(
+    mesh: &whet::Mesh,
+    tags: &[[u32; 2]],
+    levels: u32,
+    max_memory: u64,
+) -> CliResult<whet::Mesh> {
+    if levels > 8 {
+        return Err(Failure::input(anyhow::anyhow!(
+            "--bend {levels}: at most 8 levels"
+        )));
+    }
+    super::sharpen::run_bend(mesh, tags, levels, max_memory)
 }
 
 /// Refuses (exit code 2) sharpening `triangles` triangles past `max_memory` bytes at the

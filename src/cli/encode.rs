@@ -391,6 +391,11 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh) -> CliResult {
                 "normal": out.sharpened_filter.factors().0,
                 "smoothed": out.sharpened_filter.factors().1,
             },
+            "sharpen_method": out.sharpen_hint.map(|h| h.name()),
+            "sharpen_trials": out.sharpen_trials.iter().map(|&(h, e)| json!({
+                "method": h.name(),
+                "rms_error_pct": e,
+            })).collect::<Vec<_>>(),
             "search": out.search.iter().map(|&(f, b)| json!([f, b])).collect::<Vec<_>>(),
             "angle_trials": out.angle_trials.iter().map(|t| json!({
                 "angle_bits": t.angle_bits,

@@ -173,8 +173,9 @@ impl Codec for SubdivCodec {
     }
 }
 
-fn sharpened(mesh: &Mesh) -> Result<whet_sharpen::Sharpened, String> {
-    let run = |m: &Mesh| whet_sharpen::sharpen(m, &whet_sharpen::SharpenOptions::DEFAULT);
+fn sharpened(mesh: &Mesh, method: whet_sharpen::Method) -> Result<whet_sharpen::Sharpened, String> {
+    let opts = whet_sharpen::SharpenOptions::DEFAULT.with_method(method);
+    let run = |m: &Mesh| whet_sharpen::sharpen(m, &opts);
     match run(mesh) {
         Ok(s) => Ok(s),
         Err(whet_sharpen::Error::InvalidInput(_)) => {
@@ -186,27 +187,41 @@ fn sharpened(mesh: &Mesh) -> Result<whet_sharpen::Sharpened, String> {
     }
 }
 
-/// [`sharpened`] as `whet decode --sharpen` does it: then the stream's filter for after
-/// sharpening (swing streams that carry one) on the vertices the sharpener left alone.
-fn sharpened_from_stream(mesh: &Mesh, bytes: &[u8]) -> Result<whet_sharpen::Sharpened, String> {
-    let mut s = sharpened(mesh)?;
-    if let Ok(c) = whet_format::parse(bytes, &whet_format::Limits::UNLIMITED) {
-        whet_codec::SurfaceFilter::after_sharpening_of(&c.header)
-            .apply_after_sharpening(mesh, &mut s.mesh);
+/// What `whet decode --sharpen` makes of a stream, with the sharp-edge tags for Bender: the
+/// sharpening its header names (`SharpenHint`; extended without one), then its filter for
+/// after sharpening (swing streams that carry one) on the vertices the sharpener left
+/// alone; for a stream whose encoder measured no sharpening best, the plain decoded mesh
+/// (its surface filter included) and no tags.
+fn sharpened_from_stream(mesh: &Mesh, bytes: &[u8]) -> Result<(Mesh, Vec<[u32; 2]>), String> {
+    let header = whet_format::parse(bytes, &whet_format::Limits::UNLIMITED)
+        .ok()
+        .map(|c| c.header);
+    let hint = header.as_ref().and_then(whet_codec::SharpenHint::of);
+    let method = match hint {
+        Some(whet_codec::SharpenHint::Unsharpened) => {
+            let plain = whet::decode(bytes, &own_streams()).map_err(|e| e.to_string())?;
+            return Ok((plain, Vec::new()));
+        }
+        Some(whet_codec::SharpenHint::Papers) => whet_sharpen::Method::Papers,
+        _ => whet_sharpen::Method::Extended,
+    };
+    let mut s = sharpened(mesh, method)?;
+    if let Some(h) = &header {
+        whet_codec::SurfaceFilter::after_sharpening_of(h).apply_after_sharpening(mesh, &mut s.mesh);
     }
-    Ok(s)
+    let tags = super::sharpen::tag_edges(&s.tags);
+    Ok((s.mesh, tags))
 }
 
 fn stage_by_name(name: &str) -> Result<Stage, Failure> {
     match name {
         "decoded" => Ok(Stage::decoded()),
         "sharpened" => Ok(Stage::with_stream("sharpened", |m, b| {
-            sharpened_from_stream(m, b).map(|s| s.mesh)
+            sharpened_from_stream(m, b).map(|s| s.0)
         })),
         "bent" => Ok(Stage::with_stream("bent", |m, b| {
-            let s = sharpened_from_stream(m, b)?;
-            let tags = super::sharpen::tag_edges(&s.tags);
-            whet_bend::bend_levels(&s.mesh, &tags, 1)
+            let (sharp, tags) = sharpened_from_stream(m, b)?;
+            whet_bend::bend_levels(&sharp, &tags, 1)
                 .map(|b| b.mesh)
                 .map_err(|e| e.to_string())
         })),

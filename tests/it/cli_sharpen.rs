@@ -316,3 +316,85 @@ fn bend_and_subdivide_repair_non_manifold_input() {
         assert_eq!(j["triangles"], 12, "{cmd}: {j}");
     }
 }
+
+/// `whet decode --sharpen` follows the sharpening a swing stream names (header field 21,
+/// written by `--optimize-for sharpened`) unless `--method` is given; a stream that names
+/// no sharpening decodes as plain `whet decode` does.
+#[test]
+fn decode_sharpen_follows_the_streams_hint() {
+    let dir = scratch_dir("cli-decode-sharpen-hint");
+    let mc = dir.join("cube.off");
+    let o = whet(&[
+        "synth",
+        "cube",
+        "-o",
+        s(&mc),
+        "--resolution",
+        "20",
+        "--rotate",
+        "0,1,1,30",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stream = dir.join("c.whet");
+    let j = whet_json(&[
+        "encode",
+        s(&mc),
+        "-o",
+        s(&stream),
+        "--bpv",
+        "3",
+        "--optimize-for",
+        "sharpened",
+        "--json",
+    ]);
+    // The encoder measured three candidates and kept the lowest error it reports.
+    let trials = j["sharpen_trials"].as_array().unwrap();
+    assert_eq!(trials.len(), 3, "{j}");
+    let chosen = j["sharpen_method"].as_str().unwrap();
+    let chosen_error = trials
+        .iter()
+        .find(|t| t["method"] == chosen)
+        .map(|t| t["rms_error_pct"].as_f64().unwrap())
+        .unwrap();
+    assert_eq!(j["rms_error_pct"].as_f64().unwrap(), chosen_error);
+    for t in trials {
+        assert!(chosen_error <= t["rms_error_pct"].as_f64().unwrap(), "{j}");
+    }
+    // The same stream stating each hint in turn.
+    let bytes = std::fs::read(&stream).unwrap();
+    let container = whet_format::parse(&bytes, &whet_format::Limits::DEFAULT).unwrap();
+    let decode = |input: &std::path::Path, extra: &[&str], name: &str| {
+        let out = dir.join(name);
+        let mut args = vec!["decode", s(input), "-o", s(&out)];
+        args.extend_from_slice(extra);
+        let o = whet(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        (
+            std::fs::read(&out).unwrap(),
+            String::from_utf8_lossy(&o.stderr).into_owned(),
+        )
+    };
+    let plain = decode(&stream, &[], "plain.off").0;
+    let extended = decode(&stream, &["--sharpen", "--method", "extended"], "e.off").0;
+    let papers = decode(&stream, &["--sharpen", "--method", "papers"], "p.off").0;
+    assert_ne!(extended, plain);
+    for (code, expected) in [(0u64, &extended), (1, &papers), (2, &plain)] {
+        let mut c = container.clone();
+        c.header = c
+            .header
+            .clone()
+            .with(whet_format::tag::SHARPEN_METHOD, code);
+        let hinted = dir.join(format!("h{code}.whet"));
+        std::fs::write(&hinted, c.to_bytes().unwrap()).unwrap();
+        let (got, err) = decode(&hinted, &["--sharpen"], &format!("h{code}.off"));
+        assert!(got == *expected, "hint {code}: not the expected mesh");
+        assert_eq!(err.contains("no gain"), code == 2, "hint {code}: {err}");
+        // An explicit method wins over the hint.
+        let forced = decode(
+            &hinted,
+            &["--sharpen", "--method", "extended"],
+            &format!("f{code}.off"),
+        );
+        assert!(forced.0 == extended, "hint {code} with --method extended");
+    }
+}

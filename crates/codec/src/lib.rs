@@ -32,6 +32,7 @@ mod exact;
 mod fuzz;
 mod parallelogram;
 mod quantize;
+mod sharpen_hint;
 pub mod surface_filter;
 pub mod swing;
 
@@ -47,6 +48,7 @@ pub use exact::ExactPayloads;
 pub use fuzz::{fuzz_decode, fuzz_exact_payloads, fuzz_swing_payloads, swing_payload_seed};
 pub use parallelogram::{average, candidates, gate_fallback, MAX_CANDIDATES};
 pub use quantize::Quantizer;
+pub use sharpen_hint::SharpenHint;
 pub use surface_filter::{untouched_by_sharpening, FilterFields, SurfaceFilter};
 pub use swing::{
     encode_retiled, AngleTable, RetiledMesh, SwingEncoded, SwingFrame, SwingGeometry, SwingParams,

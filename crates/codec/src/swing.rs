@@ -927,6 +927,9 @@ pub struct SwingStreamInfo<'a> {
     /// The surface filter for after EdgeSharpener ([`SurfaceFilter::apply_after_sharpening`];
     /// optional header fields 17 and 19, written when not [`SurfaceFilter::NONE`]).
     pub sharpened_filter: SurfaceFilter,
+    /// The sharpening the encoder measured best (optional header field 21, written when
+    /// `Some`; [`SharpenHint`]).
+    pub sharpen_hint: Option<crate::SharpenHint>,
 }
 
 /// Writes the swing stream of a retiled mesh, after checking that Edgebreaker reproduces the
@@ -1372,6 +1375,10 @@ fn write_stream(
                 info.sharpened_filter.smoothed,
             );
     }
+    if let Some(hint) = info.sharpen_hint {
+        // Optional (odd) too: an older reader sharpens with its default.
+        header = header.with(tag::SHARPEN_METHOD, hint.code());
+    }
     header.set_bbox(min, max);
     let container = Container::new(header)
         .with_section(SectionKind::CONNECTIVITY, connectivity)
@@ -1812,6 +1819,33 @@ mod tests {
             dropped_unused_vertices: 0,
             filter: SurfaceFilter::NONE,
             sharpened_filter: SurfaceFilter::NONE,
+            sharpen_hint: None,
+        }
+    }
+
+    #[test]
+    fn the_sharpen_hint_is_written_only_when_given_and_changes_no_geometry() {
+        let (retiled, params) = tetrahedron(-20);
+        let plain = encode_retiled(&retiled, &params, &info()).unwrap();
+        let header = |b: &[u8]| {
+            whet_format::parse(b, &crate::Limits::DEFAULT)
+                .unwrap()
+                .header
+        };
+        assert_eq!(crate::SharpenHint::of(&header(&plain.bytes)), None);
+        for hint in crate::SharpenHint::ALL {
+            let with = SwingStreamInfo {
+                sharpen_hint: Some(hint),
+                ..info()
+            };
+            let enc = encode_retiled(&retiled, &params, &with).unwrap();
+            assert_eq!(crate::SharpenHint::of(&header(&enc.bytes)), Some(hint));
+            // Two bytes (key and value), and the same decoded mesh.
+            assert_eq!(enc.bytes.len(), plain.bytes.len() + 2);
+            assert_eq!(
+                crate::decode(&enc.bytes, &crate::DecodeOptions::DEFAULT).unwrap(),
+                plain.decoded
+            );
         }
     }
 

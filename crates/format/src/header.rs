@@ -156,9 +156,13 @@ pub mod tag {
     /// i64 (format 1.2, optional): factor of the one-ring mean in that filter (swing;
     /// absent: 0).
     pub const SHARPENED_FILTER_SMOOTHED: u64 = 19;
+    /// u64 (format 1.2, optional): how the encoder measured `whet decode --sharpen` best
+    /// served: 0 EdgeSharpener's extended method, 1 the papers' method, 2 no sharpening
+    /// (swing; absent or another value: the decoder's default).
+    pub const SHARPEN_METHOD: u64 = 21;
 
     /// Every tag this crate knows, with its name and value type.
-    pub const KNOWN: [(u64, &str, ValueType); 11] = [
+    pub const KNOWN: [(u64, &str, ValueType); 12] = [
         (ENCODER, "encoder", ValueType::Bytes),
         (COMPONENT_COUNT, "component_count", ValueType::U64),
         (QUANT_BITS, "quant_bits", ValueType::U64),
@@ -178,6 +182,7 @@ pub mod tag {
             "sharpened_filter_smoothed",
             ValueType::I64,
         ),
+        (SHARPEN_METHOD, "sharpen_method", ValueType::U64),
     ];
 
     /// Name and type of a known tag.

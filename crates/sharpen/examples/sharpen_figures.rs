@@ -29,6 +29,7 @@ mod swing_inputs;
 
 use std::time::Instant;
 
+use whet_codec::SharpenHint;
 use whet_mesh::Mesh;
 use whet_sharpen::{sharpen, Method, SharpenOptions};
 use whet_synth::{add_noise, marching_cubes, Shape, ShapeKind, ShapeParams};
@@ -45,19 +46,27 @@ fn samples() -> Option<usize> {
 }
 
 fn row(label: &str, reference: &Mesh, input: &Mesh) {
+    println!("{}", row_line(label, reference, input).0);
+}
+
+/// One table row, and the `(RMS, max)` of the input and of each method's output (papers,
+/// extended).
+fn row_line(label: &str, reference: &Mesh, input: &Mesh) -> (String, [(f64, f64); 3]) {
     let e0 = error(reference, input, samples());
+    let mut errors = [(e0.rms_pct, e0.max_pct); 3];
     let mut line = format!(
         "| {label} | {} | {:.4} | {:.3} |",
         input.positions.len(),
         e0.rms_pct,
         e0.max_pct
     );
-    for method in [Method::Papers, Method::Extended] {
+    for (i, method) in [Method::Papers, Method::Extended].into_iter().enumerate() {
         let t = Instant::now();
         let out = sharpen(input, &SharpenOptions::DEFAULT.with_method(method))
             .unwrap_or_else(|e| panic!("{label}: {e}"));
         let ms = t.elapsed().as_secs_f64() * 1e3;
         let e = error(reference, &out.mesh, samples());
+        errors[i + 1] = (e.rms_pct, e.max_pct);
         let c = check(reference, input, &out);
         let valid = c.manifold && c.new_boundary_edges == 0 && c.min_new_angle >= 1.0 - 1e-9;
         let worse = e.rms_pct > e0.rms_pct * 1.0001 || e.max_pct > e0.max_pct * 1.0001;
@@ -73,7 +82,7 @@ fn row(label: &str, reference: &Mesh, input: &Mesh) {
             if worse { " WORSE" } else { "" },
         );
     }
-    println!("{line}");
+    (line, errors)
 }
 
 fn header(first: &str) {
@@ -127,7 +136,12 @@ fn retile(only: Option<String>) {
 
 fn swing(only: Option<String>) {
     println!("\n### Swing-decoded fixtures (reference: the original fixture)\n");
-    header("fixture, bpv, angle bits (V ratio)");
+    println!(
+        "| fixture, bpv, angle bits (V ratio) | V | RMS % | max % | papers RMS % | max % | RMS gain \
+         | max gain | reversed/new | ms | extended RMS % | max % | RMS gain | max gain | \
+         reversed/new | ms | encoder's choice | RMS gain | max gain |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for (name, rates) in swing_inputs::SWING_FIXTURES {
         if only.as_deref().is_some_and(|o| !name.starts_with(o)) {
             continue;
@@ -140,10 +154,21 @@ fn swing(only: Option<String>) {
                     Angles::Fixed(b) => b.to_string(),
                     Angles::AutoSharpened => format!("auto {}", s.angle_bits),
                 };
-                row(
+                let (line, e) = row_line(
                     &format!("{name} {:.2} {bits} ({ratio:.2}x)", s.bpv),
                     &s.original,
                     &s.decoded,
+                );
+                // What `whet decode --sharpen` runs: the sharpening the stream names.
+                let (name, (rms, max)) = match s.sharpen_hint {
+                    Some(SharpenHint::Papers) => ("papers", e[1]),
+                    Some(SharpenHint::Unsharpened) => ("none", e[0]),
+                    _ => ("extended", e[2]),
+                };
+                println!(
+                    "{line} {name} | {:.2}x | {:.2}x |",
+                    e[0].0 / rms,
+                    e[0].1 / max
                 );
             }
         }

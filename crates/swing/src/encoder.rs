@@ -6,8 +6,8 @@
 use crate::retiler::{retile_fitted, RetileStats, RetileTuning};
 use crate::Error;
 use whet_codec::{
-    encode_retiled, prepare_mesh, EncodeReport, SurfaceFilter, SwingEncoded, SwingGeometry,
-    SwingParams, SwingStreamInfo, Version,
+    encode_retiled, prepare_mesh, EncodeReport, SharpenHint, SurfaceFilter, SwingEncoded,
+    SwingGeometry, SwingParams, SwingStreamInfo, Version,
 };
 use whet_mesh::Mesh;
 use whet_metro::{metro, MetroOptions};
@@ -214,6 +214,13 @@ pub struct SwingOutput {
     /// The surface filter for after EdgeSharpener carried in the stream (optional header
     /// fields 17 and 19; `SurfaceFilter::apply_after_sharpening`).
     pub sharpened_filter: SurfaceFilter,
+    /// The sharpening the stream recommends to `whet decode --sharpen` (optional header
+    /// field 21): chosen by measurement when [`SwingOptions::error_of`] is
+    /// [`ErrorOf::Sharpened`], `None` otherwise.
+    pub sharpen_hint: Option<SharpenHint>,
+    /// The candidates of that choice with their measured symmetric RMS error (% of the
+    /// diagonal; empty when no choice was made).
+    pub sharpen_trials: Vec<(SharpenHint, f64)>,
     /// How far the original's surface strays from the retiling, in units of `L`: the
     /// largest distance of a sample of the original's vertices, outside the components
     /// coded as pillows, to the retiled mesh (see `MAX_COVERAGE_GAP`); infinite when a
@@ -317,10 +324,77 @@ impl SwingEncoder {
             dropped: p.dropped_unused_vertices,
             mesh: p.mesh,
         };
-        if o.auto_angle_bits {
-            return self.encode_auto_angle_bits(&prep);
+        let out = if o.auto_angle_bits {
+            self.encode_auto_angle_bits(&prep)?
+        } else {
+            self.encode_prepared(&prep)?
+        };
+        if o.error_of == ErrorOf::Sharpened {
+            return self.choose_sharpening(&prep, out);
         }
-        self.encode_prepared(&prep)
+        Ok(out)
+    }
+
+    /// Which sharpening `whet decode --sharpen` should run on `out`'s stream, measured
+    /// against the original (docs/swing.md section 7): EdgeSharpener's extended method, the
+    /// papers' method, or none. The classes a decoder-side rule must tell apart overlap
+    /// (the extended method's rules for surface samplings keep organic parts from getting
+    /// worse and refuse some CAD snaps the papers' method makes; rocker_arm's blends get
+    /// worse under the papers' method), while the encoder holds the original and can simply
+    /// measure. Costs one more retiling (the papers' filter for after sharpening is fitted
+    /// on its own output) and up to three Metro measurements.
+    fn choose_sharpening(&self, prep: &Prepared, out: SwingOutput) -> Result<SwingOutput, Error> {
+        // Ties go to the default, then to leaving the mesh alone: a method must gain more
+        // than the sampling noise of a measurement (about 0.3 % at 300 000 samples).
+        const MARGIN: f64 = 0.995;
+        let extended = match out.rms_pct {
+            Some(r) => r,
+            None => self.measure_as(
+                prep,
+                &out,
+                ErrorOf::Sharpened,
+                whet_sharpen::Method::Extended,
+            )?,
+        };
+        let decoded =
+            self.measure_as(prep, &out, ErrorOf::Decoded, whet_sharpen::Method::Extended)?;
+        let mut trials = vec![(SharpenHint::Extended, extended)];
+        let papers = self.encode_at_for(prep, out.edge_length_fraction, Some(SharpenHint::Papers));
+        let papers = match papers {
+            // The same retiling (the retiler is deterministic); only the hint and the filter
+            // for after sharpening differ.
+            Ok(p) if p.retiled == out.retiled => {
+                let r =
+                    self.measure_as(prep, &p, ErrorOf::Sharpened, whet_sharpen::Method::Papers)?;
+                trials.push((SharpenHint::Papers, r));
+                Some((p, r))
+            }
+            _ => None,
+        };
+        trials.push((SharpenHint::Unsharpened, decoded));
+        let mut best = (SharpenHint::Extended, extended);
+        if let Some((_, r)) = &papers {
+            if *r < MARGIN * best.1 {
+                best = (SharpenHint::Papers, *r);
+            }
+        }
+        if decoded < MARGIN * best.1 {
+            best = (SharpenHint::Unsharpened, decoded);
+        }
+        let mut chosen = match (best.0, papers) {
+            (SharpenHint::Papers, Some((mut p, _))) => {
+                // The searches' records stay those of the search that found the rate.
+                p.search = out.search;
+                p.angle_trials = out.angle_trials;
+                p
+            }
+            (SharpenHint::Unsharpened, _) => restate_hint(out, SharpenHint::Unsharpened)?,
+            _ => out,
+        };
+        chosen.rms_pct = Some(best.1);
+        chosen.sharpen_hint = Some(best.0);
+        chosen.sharpen_trials = trials;
+        Ok(chosen)
     }
 
     /// Encodes a prepared mesh at the options' angle bits.
@@ -473,18 +547,37 @@ impl SwingEncoder {
         Ok(out)
     }
 
-    /// Retiles and encodes at edge length `fraction · diagonal`.
+    /// Retiles and encodes at edge length `fraction · diagonal`. Streams optimised for
+    /// sharpening carry a sharpening hint (extended until [`Self::choose_sharpening`] has
+    /// measured the others), so that the size searches count its two bytes.
     fn encode_at(&self, prep: &Prepared, fraction: f64) -> Result<SwingOutput, Error> {
+        let hint = (self.opts.error_of == ErrorOf::Sharpened).then_some(SharpenHint::Extended);
+        self.encode_at_for(prep, fraction, hint)
+    }
+
+    /// [`Self::encode_at`] with the stream stating `hint`, its filter for after sharpening
+    /// fitted for the method the hint names (extended without a hint).
+    fn encode_at_for(
+        &self,
+        prep: &Prepared,
+        fraction: f64,
+        hint: Option<SharpenHint>,
+    ) -> Result<SwingOutput, Error> {
         let o = &self.opts;
         let l = fraction * prep.diagonal;
         let params = SwingParams::new(l, o.angle_bits, &prep.mesh.bounding_box(), o.quant_bits)?;
-        let retiled = retile_fitted(&prep.mesh, &params, &o.tuning, o.surface_filter)?;
+        let method = match hint {
+            Some(SharpenHint::Papers) => whet_sharpen::Method::Papers,
+            _ => whet_sharpen::Method::Extended,
+        };
+        let retiled = retile_fitted(&prep.mesh, &params, &o.tuning, o.surface_filter, method)?;
         let info = SwingStreamInfo {
             version: o.version,
             repair: &prep.repair,
             dropped_unused_vertices: prep.dropped,
             filter: retiled.filter,
             sharpened_filter: retiled.sharpened_filter,
+            sharpen_hint: hint,
         };
         let enc: SwingEncoded = encode_retiled(&retiled.mesh, &params, &info)?;
         let coverage_gap = coverage_gap(&prep.mesh, &retiled.pillowed_vertices, &enc.decoded, l);
@@ -505,6 +598,8 @@ impl SwingEncoder {
             angle_trials: Vec::new(),
             surface_filter: info.filter,
             sharpened_filter: info.sharpened_filter,
+            sharpen_hint: hint,
+            sharpen_trials: Vec::new(),
         })
     }
 
@@ -668,8 +763,24 @@ impl SwingEncoder {
     /// Measures the symmetric RMS error of `out` (decoded, or sharpened: [`ErrorOf`])
     /// against the original, in % of its diagonal.
     fn measure(&self, prep: &Prepared, out: &SwingOutput) -> Result<f64, Error> {
+        self.measure_as(
+            prep,
+            out,
+            self.opts.error_of,
+            whet_sharpen::Method::Extended,
+        )
+    }
+
+    /// [`Self::measure`] of `error_of`, sharpening with `method`.
+    fn measure_as(
+        &self,
+        prep: &Prepared,
+        out: &SwingOutput,
+        error_of: ErrorOf,
+        method: whet_sharpen::Method,
+    ) -> Result<f64, Error> {
         let (sharpened, unfiltered);
-        let mesh = match self.opts.error_of {
+        let mesh = match error_of {
             ErrorOf::Decoded => &out.retiled,
             ErrorOf::Sharpened => {
                 // `whet decode --sharpen`: the mesh without its surface filter, sharpened.
@@ -684,7 +795,8 @@ impl SwingEncoder {
                     unfiltered = whet_codec::decode(&out.bytes, &opts)?;
                     &unfiltered
                 };
-                match whet_sharpen::sharpen(input, &whet_sharpen::SharpenOptions::DEFAULT) {
+                let opts = whet_sharpen::SharpenOptions::DEFAULT.with_method(method);
+                match whet_sharpen::sharpen(input, &opts) {
                     Ok(s) => {
                         sharpened = {
                             let mut m = s.mesh;
@@ -897,6 +1009,20 @@ fn outside_stuck(mut f: f64, stuck_at: &[f64], floor: f64) -> f64 {
 /// Encodes `mesh` with `opts` (see [`SwingEncoder`]).
 pub fn encode(mesh: &Mesh, opts: &SwingOptions) -> Result<SwingOutput, Error> {
     SwingEncoder::new(*opts).encode(mesh)
+}
+
+/// `out` with its stream's sharpening hint changed to `hint` (the field's value is one byte
+/// whatever the hint, so the size does not change).
+fn restate_hint(mut out: SwingOutput, hint: SharpenHint) -> Result<SwingOutput, Error> {
+    let mut container = whet_format::parse(&out.bytes, &whet_codec::Limits::UNLIMITED)
+        .map_err(whet_codec::Error::from)?;
+    container.header = container
+        .header
+        .clone()
+        .with(whet_format::tag::SHARPEN_METHOD, hint.code());
+    out.bytes = container.to_bytes().map_err(whet_codec::Error::from)?;
+    out.sharpen_hint = Some(hint);
+    Ok(out)
 }
 
 #[cfg(test)]

@@ -331,16 +331,18 @@ pub fn retile(
     params: &SwingParams,
     tune: &RetileTuning,
 ) -> Result<Retiled, Error> {
-    retile_fitted(mesh, params, tune, false)
+    retile_fitted(mesh, params, tune, false, whet_sharpen::Method::Extended)
 }
 
 /// [`retile`], and with `fit` also the surface filter fitted to `mesh`
-/// ([`crate::fit_surface_filter`], on the retiler's own grid of the original).
+/// ([`crate::fit_surface_filter`], on the retiler's own grid of the original) and the one for
+/// after sharpening with `sharpen_method`.
 pub(crate) fn retile_fitted(
     mesh: &whet_mesh::Mesh,
     params: &SwingParams,
     tune: &RetileTuning,
     fit: bool,
+    sharpen_method: whet_sharpen::Method,
 ) -> Result<Retiled, Error> {
     let l = params.edge_length;
     // Expected triangles: 2.4 · area / L² (algorithms.md 1.9). Checked first: the grid of
@@ -487,7 +489,8 @@ pub(crate) fn retile_fitted(
         // One set of fields serves both fits (fit_surface_filter computes the same).
         let fields = whet_codec::FilterFields::new(&kept);
         let filter = crate::fit_displacements(&kept, &fields.normal, &fields.smoothed, closest);
-        (filter, fit_after_sharpening(&kept, &fields, closest))
+        let after = fit_after_sharpening(&kept, &fields, sharpen_method, closest);
+        (filter, after)
     } else {
         (SurfaceFilter::NONE, SurfaceFilter::NONE)
     };
@@ -522,7 +525,7 @@ pub(crate) fn retile_fitted(
 }
 
 /// The factors of the filter for after sharpening: `kept` (the unfiltered decoded mesh)
-/// sharpened with whet-sharpen's defaults, the filter's fields of `kept` on the vertices
+/// sharpened with whet-sharpen's defaults and `method`, the filter's fields of `kept` on the vertices
 /// the sharpener left alone, fitted to the original (docs/swing.md section 2). On a smooth
 /// part the sharpener changes little and the fit finds the decoded filter again; on a CAD
 /// part it fits the flat faces between the restored creases. No filter when the sharpener
@@ -530,9 +533,11 @@ pub(crate) fn retile_fitted(
 fn fit_after_sharpening(
     kept: &whet_mesh::Mesh,
     fields: &whet_codec::FilterFields,
+    method: whet_sharpen::Method,
     closest: impl FnMut(DVec3) -> Option<DVec3>,
 ) -> SurfaceFilter {
-    let Ok(sharp) = whet_sharpen::sharpen(kept, &whet_sharpen::SharpenOptions::DEFAULT) else {
+    let opts = whet_sharpen::SharpenOptions::DEFAULT.with_method(method);
+    let Ok(sharp) = whet_sharpen::sharpen(kept, &opts) else {
         return SurfaceFilter::NONE;
     };
     let sharp = sharp.mesh;

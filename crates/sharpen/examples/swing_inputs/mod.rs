@@ -1,7 +1,9 @@
 //! Swing-decoded inputs of the EdgeSharpener figures: a shared fixture encoded by whet-swing
 //! (the SwingWrapper retiler) at a rate in bits per original vertex, with fixed or automatic
-//! angle bits, and decoded by whet-codec, exactly what `whet encode --bpv R [--angle-bits B |
-//! --angle-bits auto --optimize-for sharpened]` then `whet decode` produce.
+//! angle bits, optimised for the sharpened output (so the stream also names the sharpening
+//! its encoder measured best), and decoded by whet-codec without its surface filter, exactly
+//! what `whet encode --bpv R --angle-bits B|auto --optimize-for sharpened` then `whet decode
+//! --no-surface-filter` produce (the mesh `whet decode --sharpen` sharpens).
 //!
 //! whet-swing depends on whet-sharpen (its automatic angle-bit choice measures the sharpened
 //! output), so it is a dev-dependency of whet-sharpen: a cycle cargo allows, and which keeps
@@ -60,6 +62,8 @@ pub struct SwingInput {
     pub bpv: f64,
     /// Angle bits the stream uses.
     pub angle_bits: u32,
+    /// The sharpening the stream names for `whet decode --sharpen` (the encoder's choice).
+    pub sharpen_hint: Option<whet_codec::SharpenHint>,
 }
 
 /// Encodes the shared fixture `name` at `bpv` bits per original vertex and decodes it.
@@ -68,7 +72,7 @@ pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
         .unwrap_or_else(|e| panic!("{name}: {e}"));
     let dir = whet_testkit::workspace_root().join("target/sharpen-swing");
     let _ = std::fs::create_dir_all(&dir);
-    let path = dir.join(format!("v1-{name}-{bpv}-{}.off", angles.tag()));
+    let path = dir.join(format!("v2-{name}-{bpv}-{}.off", angles.tag()));
     let meta = path.with_extension("meta");
     if let (Ok(decoded), Ok(m)) = (
         whet_io::read_path(&path, None),
@@ -77,21 +81,23 @@ pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
         let mut w = m.split_whitespace();
         let got_bpv = w.next().and_then(|s| s.parse().ok());
         let bits = w.next().and_then(|s| s.parse().ok());
-        if let (Some(bpv), Some(angle_bits)) = (got_bpv, bits) {
+        let hint = w.next().and_then(|s| s.parse().ok());
+        if let (Some(bpv), Some(angle_bits), Some(hint)) = (got_bpv, bits, hint) {
             return SwingInput {
                 original,
                 decoded,
                 bpv,
                 angle_bits,
+                sharpen_hint: whet_codec::SharpenHint::from_code(hint),
             };
         }
     }
-    let mut opts = SwingOptions::DEFAULT.with_rate(Rate::BitsPerVertex(bpv));
+    let mut opts = SwingOptions::DEFAULT
+        .with_rate(Rate::BitsPerVertex(bpv))
+        .with_error_of(ErrorOf::Sharpened);
     opts = match angles {
         Angles::Fixed(b) => opts.with_angle_bits(b),
-        Angles::AutoSharpened => opts
-            .with_auto_angle_bits(true)
-            .with_error_of(ErrorOf::Sharpened),
+        Angles::AutoSharpened => opts.with_auto_angle_bits(true),
     };
     let out = whet_swing::encode(&original, &opts)
         .unwrap_or_else(|e| panic!("{name} at {bpv} bpv: encode: {e}"));
@@ -102,11 +108,14 @@ pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
     .unwrap_or_else(|e| panic!("{name} at {bpv} bpv: decode: {e}"));
     let got = out.bits_per_original_vertex();
     let _ = whet_io::write_path(&path, &decoded, None, &whet_io::WriteOptions::DEFAULT);
-    let _ = std::fs::write(&meta, format!("{got} {}\n", out.angle_bits));
+    // The hint's code, or one no hint has.
+    let hint = out.sharpen_hint.map_or(u64::MAX, |h| h.code());
+    let _ = std::fs::write(&meta, format!("{got} {} {hint}\n", out.angle_bits));
     SwingInput {
         original,
         decoded,
         bpv: got,
         angle_bits: out.angle_bits,
+        sharpen_hint: out.sharpen_hint,
     }
 }

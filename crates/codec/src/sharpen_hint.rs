@@ -1,0 +1,94 @@
+//! The sharpening a swing stream's encoder measured best for `whet decode --sharpen`
+//! (optional header field 21, docs/format.md section 3; docs/swing.md section 7).
+//!
+//! whet-codec does not carry the sharpener: this is only the value the stream states, which
+//! the caller maps onto whet-sharpen's methods.
+
+/// What `whet decode --sharpen` should do with a swing stream, as its encoder measured it
+/// against the original (`--optimize-for sharpened`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SharpenHint {
+    /// EdgeSharpener's extended method (whet's default).
+    Extended,
+    /// The papers' method.
+    Papers,
+    /// No sharpening: both methods measured worse than the decoded mesh (a part without a
+    /// crease, or one whose creases the retiling already keeps).
+    Unsharpened,
+}
+
+impl SharpenHint {
+    /// Every hint, in code order.
+    pub const ALL: [SharpenHint; 3] = [
+        SharpenHint::Extended,
+        SharpenHint::Papers,
+        SharpenHint::Unsharpened,
+    ];
+
+    /// The value of header field 21.
+    pub const fn code(self) -> u64 {
+        match self {
+            SharpenHint::Extended => 0,
+            SharpenHint::Papers => 1,
+            SharpenHint::Unsharpened => 2,
+        }
+    }
+
+    /// The hint of a field value; `None` for a value this whet does not know (a newer
+    /// encoder's: the decoder then sharpens with its default).
+    pub const fn from_code(code: u64) -> Option<SharpenHint> {
+        match code {
+            0 => Some(SharpenHint::Extended),
+            1 => Some(SharpenHint::Papers),
+            2 => Some(SharpenHint::Unsharpened),
+            _ => None,
+        }
+    }
+
+    /// Name shown by the CLI (`extended`, `papers`, `none`).
+    pub const fn name(self) -> &'static str {
+        match self {
+            SharpenHint::Extended => "extended",
+            SharpenHint::Papers => "papers",
+            SharpenHint::Unsharpened => "none",
+        }
+    }
+
+    /// The hint a stream's header states: swing streams only, `None` without the field or
+    /// with an unknown value.
+    pub fn of(header: &whet_format::Header) -> Option<SharpenHint> {
+        if header.mode != whet_format::Mode::Swing {
+            return None;
+        }
+        header
+            .get_u64(whet_format::tag::SHARPEN_METHOD)
+            .and_then(SharpenHint::from_code)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn codes_round_trip_and_unknown_codes_are_no_hint() {
+        for h in SharpenHint::ALL {
+            assert_eq!(SharpenHint::from_code(h.code()), Some(h));
+        }
+        assert_eq!(SharpenHint::from_code(3), None);
+        assert_eq!(SharpenHint::from_code(u64::MAX), None);
+    }
+
+    #[test]
+    fn only_swing_headers_carry_a_hint() {
+        let swing = whet_format::Header::new(whet_format::Mode::Swing, 0, 0);
+        assert_eq!(SharpenHint::of(&swing), None);
+        let papers = swing.clone().with(whet_format::tag::SHARPEN_METHOD, 1u64);
+        assert_eq!(SharpenHint::of(&papers), Some(SharpenHint::Papers));
+        let unknown = swing.with(whet_format::tag::SHARPEN_METHOD, 9u64);
+        assert_eq!(SharpenHint::of(&unknown), None);
+        let exact = whet_format::Header::new(whet_format::Mode::Exact, 0, 0)
+            .with(whet_format::tag::SHARPEN_METHOD, 2u64);
+        assert_eq!(SharpenHint::of(&exact), None);
+    }
+}
