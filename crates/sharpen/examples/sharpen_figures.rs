@@ -13,9 +13,12 @@
 //!
 //! `swing` encodes the CAD fixtures with whet-swing at three rates per fixture (about 0.5x, 1x
 //! and 2x the fixture's vertex count at 6 angle bits: `swing_inputs::SWING_FIXTURES`), once with 6 angle bits
-//! and once with `--angle-bits auto --optimize-for sharpened`, decodes them with whet-codec
-//! (`examples/swing_inputs`) and sharpens the decoded meshes. `retile` is the marching-cubes
-//! stand-in measured before the swing codec existed.
+//! and once with `--angle-bits auto`, both `--optimize-for sharpened`, decodes them with
+//! whet-codec (`examples/swing_inputs`) and sharpens the decoded meshes with both methods; its
+//! last columns are what `whet decode --sharpen` writes: the sharpening the stream names (the
+//! encoder's measured choice, docs/swing.md section 2) and the stream's filter for after
+//! sharpening, or the filtered decoded mesh for "none", against the same input error. `retile`
+//! is the marching-cubes stand-in measured before the swing codec existed.
 //!
 //! Errors are symmetric Metro figures (whet-metro, default sampling: at least 10 samples per
 //! face and 1M per direction) in percent of the reference's bounding-box diagonal; the
@@ -139,9 +142,11 @@ fn swing(only: Option<String>) {
     println!(
         "| fixture, bpv, angle bits (V ratio) | V | RMS % | max % | papers RMS % | max % | RMS gain \
          | max gain | reversed/new | ms | extended RMS % | max % | RMS gain | max gain | \
-         reversed/new | ms | encoder's choice | RMS gain | max gain |"
+         reversed/new | ms | `decode --sharpen`: method | RMS % | max % | RMS gain | max gain |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!(
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+    );
     for (name, rates) in swing_inputs::SWING_FIXTURES {
         if only.as_deref().is_some_and(|o| !name.starts_with(o)) {
             continue;
@@ -159,16 +164,16 @@ fn swing(only: Option<String>) {
                     &s.original,
                     &s.decoded,
                 );
-                // What `whet decode --sharpen` runs: the sharpening the stream names.
-                let (name, (rms, max)) = match s.sharpen_hint {
-                    Some(SharpenHint::Papers) => ("papers", e[1]),
-                    Some(SharpenHint::Unsharpened) => ("none", e[0]),
-                    _ => ("extended", e[2]),
-                };
+                // What `whet decode --sharpen` writes: the sharpening the stream names and
+                // the stream's filter for after sharpening, or the filtered decoded mesh.
+                let name = s.sharpen_hint.map_or("extended", SharpenHint::name);
+                let d = error(&s.original, &s.decode_sharpen(), samples());
                 println!(
-                    "{line} {name} | {:.2}x | {:.2}x |",
-                    e[0].0 / rms,
-                    e[0].1 / max
+                    "{line} {name} | {:.4} | {:.3} | {:.2}x | {:.2}x |",
+                    d.rms_pct,
+                    d.max_pct,
+                    e[0].0 / d.rms_pct,
+                    e[0].1 / d.max_pct
                 );
             }
         }

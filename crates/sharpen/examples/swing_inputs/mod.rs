@@ -8,7 +8,7 @@
 //! whet-swing depends on whet-sharpen (its automatic angle-bit choice measures the sharpened
 //! output), so it is a dev-dependency of whet-sharpen: a cycle cargo allows, and which keeps
 //! the figures a library call (no dependence on a CLI binary being built and current).
-//! Encodings are cached under `target/sharpen-swing/`: a rate search runs several retilings.
+//! Streams are cached under `target/sharpen-swing/`: a rate search runs several retilings.
 //! With automatic angle bits optimised for the sharpened output, the encoder measures with the
 //! sharpener it was linked with, so the choice can change with the sharpener: delete the cache
 //! to re-run it.
@@ -56,7 +56,7 @@ impl Angles {
 pub struct SwingInput {
     /// The fixture.
     pub original: Mesh,
-    /// The decoded mesh.
+    /// The decoded mesh without its surface filter: what `whet decode --sharpen` sharpens.
     pub decoded: Mesh,
     /// Whole-stream bits per original vertex.
     pub bpv: f64,
@@ -64,6 +64,33 @@ pub struct SwingInput {
     pub angle_bits: u32,
     /// The sharpening the stream names for `whet decode --sharpen` (the encoder's choice).
     pub sharpen_hint: Option<whet_codec::SharpenHint>,
+    /// The stream.
+    pub bytes: Vec<u8>,
+}
+
+impl SwingInput {
+    /// What `whet decode --sharpen` writes for this stream (src/cli/decode.rs): the
+    /// sharpening the stream names, then its filter for after sharpening on the vertices the
+    /// sharpener left alone; for a stream naming none, the plain decoded mesh with its
+    /// surface filter.
+    pub fn decode_sharpen(&self) -> Mesh {
+        let header = whet_format::parse(&self.bytes, &whet_format::Limits::UNLIMITED)
+            .unwrap_or_else(|e| panic!("{e}"))
+            .header;
+        let method = match self.sharpen_hint {
+            Some(whet_codec::SharpenHint::Unsharpened) => {
+                return whet_codec::decode(&self.bytes, &whet_codec::DecodeOptions::DEFAULT)
+                    .unwrap_or_else(|e| panic!("{e}"));
+            }
+            Some(whet_codec::SharpenHint::Papers) => whet_sharpen::Method::Papers,
+            _ => whet_sharpen::Method::Extended,
+        };
+        let opts = whet_sharpen::SharpenOptions::DEFAULT.with_method(method);
+        let mut s = whet_sharpen::sharpen(&self.decoded, &opts).unwrap_or_else(|e| panic!("{e}"));
+        whet_codec::SurfaceFilter::after_sharpening_of(&header)
+            .apply_after_sharpening(&self.decoded, &mut s.mesh);
+        s.mesh
+    }
 }
 
 /// Encodes the shared fixture `name` at `bpv` bits per original vertex and decodes it.
@@ -72,50 +99,39 @@ pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
         .unwrap_or_else(|e| panic!("{name}: {e}"));
     let dir = whet_testkit::workspace_root().join("target/sharpen-swing");
     let _ = std::fs::create_dir_all(&dir);
-    let path = dir.join(format!("v2-{name}-{bpv}-{}.off", angles.tag()));
-    let meta = path.with_extension("meta");
-    if let (Ok(decoded), Ok(m)) = (
-        whet_io::read_path(&path, None),
-        std::fs::read_to_string(&meta),
-    ) {
-        let mut w = m.split_whitespace();
-        let got_bpv = w.next().and_then(|s| s.parse().ok());
-        let bits = w.next().and_then(|s| s.parse().ok());
-        let hint = w.next().and_then(|s| s.parse().ok());
-        if let (Some(bpv), Some(angle_bits), Some(hint)) = (got_bpv, bits, hint) {
-            return SwingInput {
-                original,
-                decoded,
-                bpv,
-                angle_bits,
-                sharpen_hint: whet_codec::SharpenHint::from_code(hint),
+    let path = dir.join(format!("v3-{name}-{bpv}-{}.whet", angles.tag()));
+    let bytes = match std::fs::read(&path) {
+        Ok(b) => b,
+        Err(_) => {
+            let mut opts = SwingOptions::DEFAULT
+                .with_rate(Rate::BitsPerVertex(bpv))
+                .with_error_of(ErrorOf::Sharpened);
+            opts = match angles {
+                Angles::Fixed(b) => opts.with_angle_bits(b),
+                Angles::AutoSharpened => opts.with_auto_angle_bits(true),
             };
+            let out = whet_swing::encode(&original, &opts)
+                .unwrap_or_else(|e| panic!("{name} at {bpv} bpv: encode: {e}"));
+            let _ = std::fs::write(&path, &out.bytes);
+            out.bytes
         }
-    }
-    let mut opts = SwingOptions::DEFAULT
-        .with_rate(Rate::BitsPerVertex(bpv))
-        .with_error_of(ErrorOf::Sharpened);
-    opts = match angles {
-        Angles::Fixed(b) => opts.with_angle_bits(b),
-        Angles::AutoSharpened => opts.with_auto_angle_bits(true),
     };
-    let out = whet_swing::encode(&original, &opts)
-        .unwrap_or_else(|e| panic!("{name} at {bpv} bpv: encode: {e}"));
     let decoded = whet_codec::decode(
-        &out.bytes,
+        &bytes,
         &whet_codec::DecodeOptions::DEFAULT.with_surface_filter(false),
     )
     .unwrap_or_else(|e| panic!("{name} at {bpv} bpv: decode: {e}"));
-    let got = out.bits_per_original_vertex();
-    let _ = whet_io::write_path(&path, &decoded, None, &whet_io::WriteOptions::DEFAULT);
-    // The hint's code, or one no hint has.
-    let hint = out.sharpen_hint.map_or(u64::MAX, |h| h.code());
-    let _ = std::fs::write(&meta, format!("{got} {} {hint}\n", out.angle_bits));
+    let header = whet_format::parse(&bytes, &whet_format::Limits::UNLIMITED)
+        .unwrap_or_else(|e| panic!("{name} at {bpv} bpv: {e}"))
+        .header;
     SwingInput {
+        bpv: bytes.len() as f64 * 8.0 / original.positions.len() as f64,
+        angle_bits: header
+            .get_u64(whet_format::tag::ANGLE_BITS)
+            .map_or(0, |b| b as u32),
+        sharpen_hint: whet_codec::SharpenHint::of(&header),
         original,
         decoded,
-        bpv: got,
-        angle_bits: out.angle_bits,
-        sharpen_hint: out.sharpen_hint,
+        bytes,
     }
 }
