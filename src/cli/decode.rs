@@ -22,9 +22,10 @@ pub struct DecodeArgs {
     /// Then refine with Bender this many levels (needs --sharpen for its tags).
     #[arg(long, value_name = "N", requires = "sharpen")]
     bend: Option<u32>,
-    /// EdgeSharpener's smooth-edge factor.
-    #[arg(long, default_value_t = 2.0)]
-    smooth_factor: f64,
+    /// EdgeSharpener's smooth-edge factor. Without it, the one a swing stream names with
+    /// its method (see --method); otherwise 2.
+    #[arg(long)]
+    smooth_factor: Option<f64>,
     /// EdgeSharpener's method: extended or papers. Without it, a swing stream encoded with
     /// `--optimize-for sharpened` names the method its encoder measured best against the
     /// original (or no sharpening, for a part it would make worse); otherwise extended.
@@ -113,7 +114,15 @@ pub fn run(args: &DecodeArgs) -> CliResult {
                 None => write_decoded(args, &plain),
             };
         }
-        let opts = super::sharpen::sharpen_options(method, args.smooth_factor)?;
+        // The stream's factor goes with the stream's method only.
+        let stream_factor = match &args.method {
+            None => header
+                .as_ref()
+                .and_then(whet_codec::SharpenHint::smooth_factor_of),
+            Some(_) => None,
+        };
+        let smooth_factor = args.smooth_factor.or(stream_factor).unwrap_or(2.0);
+        let opts = super::sharpen::sharpen_options(method, smooth_factor)?;
         let mut s = super::sharpen::run_sharpen(&mesh, &opts)?;
         if !args.no_surface_filter {
             // A swing stream's filter for after sharpening: the smooth parts the sharpener

@@ -392,9 +392,11 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh) -> CliResult {
                 "smoothed": out.sharpened_filter.factors().1,
             },
             "sharpen_method": out.sharpen_hint.map(|h| h.name()),
-            "sharpen_trials": out.sharpen_trials.iter().map(|&(h, e)| json!({
-                "method": h.name(),
-                "rms_error_pct": e,
+            "sharpen_smooth_factor": out.sharpen_hint.and(out.sharpen_smooth_factor),
+            "sharpen_trials": out.sharpen_trials.iter().map(|t| json!({
+                "method": t.hint.name(),
+                "smooth_factor": t.smooth_factor,
+                "rms_error_pct": t.rms_pct,
             })).collect::<Vec<_>>(),
             "search": out.search.iter().map(|&(f, b)| json!([f, b])).collect::<Vec<_>>(),
             "angle_trials": out.angle_trials.iter().map(|t| json!({

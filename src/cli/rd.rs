@@ -173,8 +173,14 @@ impl Codec for SubdivCodec {
     }
 }
 
-fn sharpened(mesh: &Mesh, method: whet_sharpen::Method) -> Result<whet_sharpen::Sharpened, String> {
-    let opts = whet_sharpen::SharpenOptions::DEFAULT.with_method(method);
+fn sharpened(
+    mesh: &Mesh,
+    method: whet_sharpen::Method,
+    smooth_factor: f64,
+) -> Result<whet_sharpen::Sharpened, String> {
+    let opts = whet_sharpen::SharpenOptions::DEFAULT
+        .with_method(method)
+        .with_smooth_factor(smooth_factor);
     let run = |m: &Mesh| whet_sharpen::sharpen(m, &opts);
     match run(mesh) {
         Ok(s) => Ok(s),
@@ -205,7 +211,11 @@ fn sharpened_from_stream(mesh: &Mesh, bytes: &[u8]) -> Result<(Mesh, Vec<[u32; 2
         Some(whet_codec::SharpenHint::Papers) => whet_sharpen::Method::Papers,
         _ => whet_sharpen::Method::Extended,
     };
-    let mut s = sharpened(mesh, method)?;
+    let smooth_factor = header
+        .as_ref()
+        .and_then(whet_codec::SharpenHint::smooth_factor_of)
+        .unwrap_or(2.0);
+    let mut s = sharpened(mesh, method, smooth_factor)?;
     if let Some(h) = &header {
         whet_codec::SurfaceFilter::after_sharpening_of(h).apply_after_sharpening(mesh, &mut s.mesh);
     }

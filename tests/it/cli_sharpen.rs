@@ -347,13 +347,16 @@ fn decode_sharpen_follows_the_streams_hint() {
         "sharpened",
         "--json",
     ]);
-    // The encoder measured three candidates and kept the lowest error it reports.
+    // The encoder measured seven candidates and kept the lowest error it reports.
     let trials = j["sharpen_trials"].as_array().unwrap();
-    assert_eq!(trials.len(), 3, "{j}");
+    assert_eq!(trials.len(), 7, "{j}");
     let chosen = j["sharpen_method"].as_str().unwrap();
     let chosen_error = trials
         .iter()
-        .find(|t| t["method"] == chosen)
+        .find(|t| {
+            t["method"] == chosen
+                && (chosen == "none" || t["smooth_factor"] == j["sharpen_smooth_factor"])
+        })
         .map(|t| t["rms_error_pct"].as_f64().unwrap())
         .unwrap();
     assert_eq!(j["rms_error_pct"].as_f64().unwrap(), chosen_error);
@@ -383,13 +386,30 @@ fn decode_sharpen_follows_the_streams_hint() {
         c.header = c
             .header
             .clone()
-            .with(whet_format::tag::SHARPEN_METHOD, code);
+            .with(whet_format::tag::SHARPEN_METHOD, code)
+            .with(whet_format::tag::SHARPEN_SMOOTH_FACTOR, 200u64);
         let hinted = dir.join(format!("h{code}.whet"));
         std::fs::write(&hinted, c.to_bytes().unwrap()).unwrap();
         let (got, err) = decode(&hinted, &["--sharpen"], &format!("h{code}.off"));
         assert!(got == *expected, "hint {code}: not the expected mesh");
         assert_eq!(err.contains("no gain"), code == 2, "hint {code}: {err}");
-        // An explicit method wins over the hint.
+        // A smooth factor goes with the stream's method.
+        c.header = c
+            .header
+            .clone()
+            .with(whet_format::tag::SHARPEN_SMOOTH_FACTOR, 150u64);
+        std::fs::write(&hinted, c.to_bytes().unwrap()).unwrap();
+        let at_150 = decode(&hinted, &["--sharpen"], &format!("s{code}.off")).0;
+        let method = ["extended", "papers"].get(code as usize);
+        let expected_150 = match method {
+            Some(m) => {
+                let args = ["--sharpen", "--method", m, "--smooth-factor", "1.5"];
+                decode(&stream, &args, &format!("m{code}.off")).0
+            }
+            None => plain.clone(),
+        };
+        assert!(at_150 == expected_150, "hint {code} at factor 1.5");
+        // An explicit method wins over the hint (and its factor).
         let forced = decode(
             &hinted,
             &["--sharpen", "--method", "extended"],

@@ -54,6 +54,28 @@ impl SharpenHint {
         }
     }
 
+    /// The smooth factor a swing stream's header states for its sharpening (field 23, in
+    /// hundredths): `None` without the field, for other modes, or outside
+    /// [`Self::SMOOTH_FACTOR_HUNDREDTHS`].
+    pub fn smooth_factor_of(header: &whet_format::Header) -> Option<f64> {
+        if header.mode != whet_format::Mode::Swing {
+            return None;
+        }
+        header
+            .get_u64(whet_format::tag::SHARPEN_SMOOTH_FACTOR)
+            .filter(|h| Self::SMOOTH_FACTOR_HUNDREDTHS.contains(h))
+            .map(|h| h as f64 / 100.0)
+    }
+
+    /// The smooth factors field 23 can state, in hundredths (0.01 to 10).
+    pub const SMOOTH_FACTOR_HUNDREDTHS: std::ops::RangeInclusive<u64> = 1..=1000;
+
+    /// Field 23's value for `factor` (rounded to hundredths), `None` outside the range.
+    pub fn smooth_factor_code(factor: f64) -> Option<u64> {
+        let h = (factor * 100.0).round();
+        (1.0..=1000.0).contains(&h).then_some(h as u64)
+    }
+
     /// The hint a stream's header states: swing streams only, `None` without the field or
     /// with an unknown value.
     pub fn of(header: &whet_format::Header) -> Option<SharpenHint> {
@@ -88,7 +110,32 @@ mod tests {
         let unknown = swing.with(whet_format::tag::SHARPEN_METHOD, 9u64);
         assert_eq!(SharpenHint::of(&unknown), None);
         let exact = whet_format::Header::new(whet_format::Mode::Exact, 0, 0)
-            .with(whet_format::tag::SHARPEN_METHOD, 2u64);
+            .with(whet_format::tag::SHARPEN_METHOD, 2u64)
+            .with(whet_format::tag::SHARPEN_SMOOTH_FACTOR, 150u64);
         assert_eq!(SharpenHint::of(&exact), None);
+        assert_eq!(SharpenHint::smooth_factor_of(&exact), None);
+    }
+
+    #[test]
+    fn smooth_factors_are_hundredths_within_range() {
+        let swing = whet_format::Header::new(whet_format::Mode::Swing, 0, 0);
+        assert_eq!(SharpenHint::smooth_factor_of(&swing), None);
+        for (code, factor) in [(1u64, Some(0.01)), (150, Some(1.5)), (1000, Some(10.0))] {
+            let h = swing
+                .clone()
+                .with(whet_format::tag::SHARPEN_SMOOTH_FACTOR, code);
+            assert_eq!(SharpenHint::smooth_factor_of(&h), factor);
+        }
+        for code in [0u64, 1001, u64::MAX] {
+            let h = swing
+                .clone()
+                .with(whet_format::tag::SHARPEN_SMOOTH_FACTOR, code);
+            assert_eq!(SharpenHint::smooth_factor_of(&h), None, "{code}");
+        }
+        assert_eq!(SharpenHint::smooth_factor_code(1.5), Some(150));
+        assert_eq!(SharpenHint::smooth_factor_code(2.0), Some(200));
+        assert_eq!(SharpenHint::smooth_factor_code(0.0), None);
+        assert_eq!(SharpenHint::smooth_factor_code(f64::NAN), None);
+        assert_eq!(SharpenHint::smooth_factor_code(11.0), None);
     }
 }

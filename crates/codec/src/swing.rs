@@ -930,6 +930,9 @@ pub struct SwingStreamInfo<'a> {
     /// The sharpening the encoder measured best (optional header field 21, written when
     /// `Some`; [`SharpenHint`]).
     pub sharpen_hint: Option<crate::SharpenHint>,
+    /// Its smooth factor (optional header field 23, written when `Some` and the hint is;
+    /// [`SharpenHint::smooth_factor_code`]).
+    pub sharpen_smooth_factor: Option<f64>,
 }
 
 /// Writes the swing stream of a retiled mesh, after checking that Edgebreaker reproduces the
@@ -1378,6 +1381,12 @@ fn write_stream(
     if let Some(hint) = info.sharpen_hint {
         // Optional (odd) too: an older reader sharpens with its default.
         header = header.with(tag::SHARPEN_METHOD, hint.code());
+        if let Some(code) = info
+            .sharpen_smooth_factor
+            .and_then(crate::SharpenHint::smooth_factor_code)
+        {
+            header = header.with(tag::SHARPEN_SMOOTH_FACTOR, code);
+        }
     }
     header.set_bbox(min, max);
     let container = Container::new(header)
@@ -1820,6 +1829,7 @@ mod tests {
             filter: SurfaceFilter::NONE,
             sharpened_filter: SurfaceFilter::NONE,
             sharpen_hint: None,
+            sharpen_smooth_factor: None,
         }
     }
 

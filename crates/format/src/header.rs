@@ -160,9 +160,13 @@ pub mod tag {
     /// served: 0 EdgeSharpener's extended method, 1 the papers' method, 2 no sharpening
     /// (swing; absent or another value: the decoder's default).
     pub const SHARPEN_METHOD: u64 = 21;
+    /// u64 (format 1.2, optional): the EdgeSharpener smooth factor that goes with
+    /// [`SHARPEN_METHOD`], in hundredths (swing; absent or outside 1..=1000: the decoder's
+    /// default, 2).
+    pub const SHARPEN_SMOOTH_FACTOR: u64 = 23;
 
     /// Every tag this crate knows, with its name and value type.
-    pub const KNOWN: [(u64, &str, ValueType); 12] = [
+    pub const KNOWN: [(u64, &str, ValueType); 13] = [
         (ENCODER, "encoder", ValueType::Bytes),
         (COMPONENT_COUNT, "component_count", ValueType::U64),
         (QUANT_BITS, "quant_bits", ValueType::U64),
@@ -183,6 +187,11 @@ pub mod tag {
             ValueType::I64,
         ),
         (SHARPEN_METHOD, "sharpen_method", ValueType::U64),
+        (
+            SHARPEN_SMOOTH_FACTOR,
+            "sharpen_smooth_factor",
+            ValueType::U64,
+        ),
     ];
 
     /// Name and type of a known tag.

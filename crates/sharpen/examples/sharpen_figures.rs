@@ -166,7 +166,14 @@ fn swing(only: Option<String>) {
                 );
                 // What `whet decode --sharpen` writes: the sharpening the stream names and
                 // the stream's filter for after sharpening, or the filtered decoded mesh.
-                let name = s.sharpen_hint.map_or("extended", SharpenHint::name);
+                let name = match s.sharpen_hint {
+                    Some(SharpenHint::Unsharpened) => "none".to_string(),
+                    h => format!(
+                        "{} {}",
+                        h.map_or("extended", SharpenHint::name),
+                        s.smooth_factor
+                    ),
+                };
                 let d = error(&s.original, &s.decode_sharpen(), samples());
                 println!(
                     "{line} {name} | {:.4} | {:.3} | {:.2}x | {:.2}x |",

@@ -51,6 +51,17 @@ pub struct AngleTrial {
     pub rms_pct: Option<f64>,
 }
 
+/// One sharpening measured by the encoder's choice ([`SwingOutput::sharpen_trials`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SharpenTrial {
+    /// The method (or none).
+    pub hint: SharpenHint,
+    /// EdgeSharpener's smooth factor (irrelevant for [`SharpenHint::Unsharpened`]).
+    pub smooth_factor: f64,
+    /// Measured symmetric RMS error of `whet decode --sharpen`'s output, % of the diagonal.
+    pub rms_pct: f64,
+}
+
 /// Options of [`SwingEncoder`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
@@ -218,9 +229,11 @@ pub struct SwingOutput {
     /// field 21): chosen by measurement when [`SwingOptions::error_of`] is
     /// [`ErrorOf::Sharpened`], `None` otherwise.
     pub sharpen_hint: Option<SharpenHint>,
+    /// The smooth factor that goes with [`Self::sharpen_hint`] (optional header field 23).
+    pub sharpen_smooth_factor: Option<f64>,
     /// The candidates of that choice with their measured symmetric RMS error (% of the
     /// diagonal; empty when no choice was made).
-    pub sharpen_trials: Vec<(SharpenHint, f64)>,
+    pub sharpen_trials: Vec<SharpenTrial>,
     /// How far the original's surface strays from the retiling, in units of `L`: the
     /// largest distance of a sample of the original's vertices, outside the components
     /// coded as pillows, to the retiled mesh (see `MAX_COVERAGE_GAP`); infinite when a
@@ -336,63 +349,86 @@ impl SwingEncoder {
     }
 
     /// Which sharpening `whet decode --sharpen` should run on `out`'s stream, measured
-    /// against the original (docs/swing.md section 7): EdgeSharpener's extended method, the
-    /// papers' method, or none. The classes a decoder-side rule must tell apart overlap
-    /// (the extended method's rules for surface samplings keep organic parts from getting
-    /// worse and refuse some CAD snaps the papers' method makes; rocker_arm's blends get
-    /// worse under the papers' method), while the encoder holds the original and can simply
-    /// measure. Costs one more retiling (the papers' filter for after sharpening is fitted
-    /// on its own output) and up to three Metro measurements.
+    /// against the original (docs/swing.md section 2, "Which sharpening"): EdgeSharpener's
+    /// extended or papers' method at smooth factors 2, 1.5 and 1, or none. The classes a
+    /// decoder-side rule must tell apart overlap (the extended method's rules for surface
+    /// samplings keep organic parts from getting worse and refuse some CAD snaps the papers'
+    /// method makes; rocker_arm's blends get worse under the papers' method; a lower smooth
+    /// factor finds more chamfers on coarse CAD retilings, whose curved faces raise the mean
+    /// normal angle), while the encoder holds the original and can simply measure. Each
+    /// candidate after the first costs one retiling at the same length (the filter for after
+    /// sharpening is fitted on that candidate's output) and one Metro measurement.
     fn choose_sharpening(&self, prep: &Prepared, out: SwingOutput) -> Result<SwingOutput, Error> {
-        // Ties go to the default, then to leaving the mesh alone: a method must gain more
-        // than the sampling noise of a measurement (about 0.3 % at 300 000 samples).
+        // A candidate must beat the ones before it (the default first, no sharpening last)
+        // by more than the sampling noise of a measurement (about 0.3 % at 300 000
+        // samples).
         const MARGIN: f64 = 0.995;
-        let extended = match out.rms_pct {
-            Some(r) => r,
-            None => self.measure_as(
-                prep,
-                &out,
-                ErrorOf::Sharpened,
-                whet_sharpen::Method::Extended,
-            )?,
-        };
-        let decoded =
-            self.measure_as(prep, &out, ErrorOf::Decoded, whet_sharpen::Method::Extended)?;
-        let mut trials = vec![(SharpenHint::Extended, extended)];
-        let papers = self.encode_at_for(prep, out.edge_length_fraction, Some(SharpenHint::Papers));
-        let papers = match papers {
-            // The same retiling (the retiler is deterministic); only the hint and the filter
-            // for after sharpening differ.
-            Ok(p) if p.retiled == out.retiled => {
-                let r =
-                    self.measure_as(prep, &p, ErrorOf::Sharpened, whet_sharpen::Method::Papers)?;
-                trials.push((SharpenHint::Papers, r));
-                Some((p, r))
-            }
-            _ => None,
-        };
-        trials.push((SharpenHint::Unsharpened, decoded));
-        let mut best = (SharpenHint::Extended, extended);
-        if let Some((_, r)) = &papers {
-            if *r < MARGIN * best.1 {
-                best = (SharpenHint::Papers, *r);
+        const CANDIDATES: [(SharpenHint, f64); 6] = [
+            (SharpenHint::Extended, DEFAULT_SMOOTH_FACTOR),
+            (SharpenHint::Papers, DEFAULT_SMOOTH_FACTOR),
+            (SharpenHint::Extended, 1.5),
+            (SharpenHint::Papers, 1.5),
+            (SharpenHint::Extended, 1.0),
+            (SharpenHint::Papers, 1.0),
+        ];
+        let fraction = out.edge_length_fraction;
+        let mut trials = Vec::new();
+        let mut best: Option<(SharpenTrial, Option<SwingOutput>)> = None;
+        for (i, (hint, smooth_factor)) in CANDIDATES.into_iter().enumerate() {
+            let opts = sharpen_options(hint, smooth_factor);
+            let (rms, stream) = if i == 0 {
+                // `out` was encoded for this one.
+                let rms = match out.rms_pct {
+                    Some(r) => r,
+                    None => self.measure_as(prep, &out, ErrorOf::Sharpened, &opts)?,
+                };
+                (rms, None)
+            } else {
+                match self.encode_at_for(prep, fraction, Some(hint), smooth_factor) {
+                    // The same retiling (the retiler is deterministic); only the hint and
+                    // the filter for after sharpening differ.
+                    Ok(p) if p.retiled == out.retiled => {
+                        let rms = self.measure_as(prep, &p, ErrorOf::Sharpened, &opts)?;
+                        (rms, Some(p))
+                    }
+                    _ => continue,
+                }
+            };
+            let trial = SharpenTrial {
+                hint,
+                smooth_factor,
+                rms_pct: rms,
+            };
+            trials.push(trial);
+            if best.as_ref().is_none_or(|(b, _)| rms < MARGIN * b.rms_pct) {
+                best = Some((trial, stream));
             }
         }
-        if decoded < MARGIN * best.1 {
-            best = (SharpenHint::Unsharpened, decoded);
-        }
-        let mut chosen = match (best.0, papers) {
-            (SharpenHint::Papers, Some((mut p, _))) => {
+        let opts = whet_sharpen::SharpenOptions::DEFAULT;
+        let decoded = self.measure_as(prep, &out, ErrorOf::Decoded, &opts)?;
+        let none = SharpenTrial {
+            hint: SharpenHint::Unsharpened,
+            smooth_factor: DEFAULT_SMOOTH_FACTOR,
+            rms_pct: decoded,
+        };
+        trials.push(none);
+        let (chosen_trial, stream) = match best {
+            Some((b, s)) if decoded >= MARGIN * b.rms_pct => (b, s),
+            _ => (none, None),
+        };
+        let mut chosen = match stream {
+            Some(mut p) => {
                 // The searches' records stay those of the search that found the rate.
                 p.search = out.search;
                 p.angle_trials = out.angle_trials;
                 p
             }
-            (SharpenHint::Unsharpened, _) => restate_hint(out, SharpenHint::Unsharpened)?,
-            _ => out,
+            None if chosen_trial.hint == SharpenHint::Unsharpened => {
+                restate_hint(out, SharpenHint::Unsharpened)?
+            }
+            None => out,
         };
-        chosen.rms_pct = Some(best.1);
-        chosen.sharpen_hint = Some(best.0);
+        chosen.rms_pct = Some(chosen_trial.rms_pct);
         chosen.sharpen_trials = trials;
         Ok(chosen)
     }
@@ -552,25 +588,23 @@ impl SwingEncoder {
     /// measured the others), so that the size searches count its two bytes.
     fn encode_at(&self, prep: &Prepared, fraction: f64) -> Result<SwingOutput, Error> {
         let hint = (self.opts.error_of == ErrorOf::Sharpened).then_some(SharpenHint::Extended);
-        self.encode_at_for(prep, fraction, hint)
+        self.encode_at_for(prep, fraction, hint, DEFAULT_SMOOTH_FACTOR)
     }
 
-    /// [`Self::encode_at`] with the stream stating `hint`, its filter for after sharpening
-    /// fitted for the method the hint names (extended without a hint).
+    /// [`Self::encode_at`] with the stream stating `hint` and `smooth_factor`, its filter for
+    /// after sharpening fitted for that sharpening (extended at factor 2 without a hint).
     fn encode_at_for(
         &self,
         prep: &Prepared,
         fraction: f64,
         hint: Option<SharpenHint>,
+        smooth_factor: f64,
     ) -> Result<SwingOutput, Error> {
         let o = &self.opts;
         let l = fraction * prep.diagonal;
         let params = SwingParams::new(l, o.angle_bits, &prep.mesh.bounding_box(), o.quant_bits)?;
-        let method = match hint {
-            Some(SharpenHint::Papers) => whet_sharpen::Method::Papers,
-            _ => whet_sharpen::Method::Extended,
-        };
-        let retiled = retile_fitted(&prep.mesh, &params, &o.tuning, o.surface_filter, method)?;
+        let sharpen = sharpen_options(hint.unwrap_or(SharpenHint::Extended), smooth_factor);
+        let retiled = retile_fitted(&prep.mesh, &params, &o.tuning, o.surface_filter, &sharpen)?;
         let info = SwingStreamInfo {
             version: o.version,
             repair: &prep.repair,
@@ -578,6 +612,9 @@ impl SwingEncoder {
             filter: retiled.filter,
             sharpened_filter: retiled.sharpened_filter,
             sharpen_hint: hint,
+            // Always written with a hint, so that the size searches count its bytes (the
+            // default's 200 hundredths take as many as any other choice).
+            sharpen_smooth_factor: hint.map(|_| smooth_factor),
         };
         let enc: SwingEncoded = encode_retiled(&retiled.mesh, &params, &info)?;
         let coverage_gap = coverage_gap(&prep.mesh, &retiled.pillowed_vertices, &enc.decoded, l);
@@ -599,6 +636,7 @@ impl SwingEncoder {
             surface_filter: info.filter,
             sharpened_filter: info.sharpened_filter,
             sharpen_hint: hint,
+            sharpen_smooth_factor: info.sharpen_smooth_factor,
             sharpen_trials: Vec::new(),
         })
     }
@@ -763,21 +801,17 @@ impl SwingEncoder {
     /// Measures the symmetric RMS error of `out` (decoded, or sharpened: [`ErrorOf`])
     /// against the original, in % of its diagonal.
     fn measure(&self, prep: &Prepared, out: &SwingOutput) -> Result<f64, Error> {
-        self.measure_as(
-            prep,
-            out,
-            self.opts.error_of,
-            whet_sharpen::Method::Extended,
-        )
+        let opts = whet_sharpen::SharpenOptions::DEFAULT;
+        self.measure_as(prep, out, self.opts.error_of, &opts)
     }
 
-    /// [`Self::measure`] of `error_of`, sharpening with `method`.
+    /// [`Self::measure`] of `error_of`, sharpening with `sharpen`.
     fn measure_as(
         &self,
         prep: &Prepared,
         out: &SwingOutput,
         error_of: ErrorOf,
-        method: whet_sharpen::Method,
+        sharpen: &whet_sharpen::SharpenOptions,
     ) -> Result<f64, Error> {
         let (sharpened, unfiltered);
         let mesh = match error_of {
@@ -795,8 +829,7 @@ impl SwingEncoder {
                     unfiltered = whet_codec::decode(&out.bytes, &opts)?;
                     &unfiltered
                 };
-                let opts = whet_sharpen::SharpenOptions::DEFAULT.with_method(method);
-                match whet_sharpen::sharpen(input, &opts) {
+                match whet_sharpen::sharpen(input, sharpen) {
                     Ok(s) => {
                         sharpened = {
                             let mut m = s.mesh;
@@ -1009,6 +1042,22 @@ fn outside_stuck(mut f: f64, stuck_at: &[f64], floor: f64) -> f64 {
 /// Encodes `mesh` with `opts` (see [`SwingEncoder`]).
 pub fn encode(mesh: &Mesh, opts: &SwingOptions) -> Result<SwingOutput, Error> {
     SwingEncoder::new(*opts).encode(mesh)
+}
+
+/// EdgeSharpener's default smooth factor (seed 000 section 3), what a stream without field
+/// 23 is sharpened with.
+const DEFAULT_SMOOTH_FACTOR: f64 = 2.0;
+
+/// The sharpener options a hint and smooth factor stand for (extended for "none": its
+/// filter for after sharpening is never applied).
+fn sharpen_options(hint: SharpenHint, smooth_factor: f64) -> whet_sharpen::SharpenOptions {
+    let method = match hint {
+        SharpenHint::Papers => whet_sharpen::Method::Papers,
+        _ => whet_sharpen::Method::Extended,
+    };
+    whet_sharpen::SharpenOptions::DEFAULT
+        .with_method(method)
+        .with_smooth_factor(smooth_factor)
 }
 
 /// `out` with its stream's sharpening hint changed to `hint` (the field's value is one byte

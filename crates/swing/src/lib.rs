@@ -26,8 +26,8 @@ mod retiler;
 mod surface;
 
 pub use encoder::{
-    encode, valence6_fraction, AngleTrial, ErrorOf, Rate, SwingEncoder, SwingOptions, SwingOutput,
-    MAX_COVERAGE_GAP,
+    encode, valence6_fraction, AngleTrial, ErrorOf, Rate, SharpenTrial, SwingEncoder, SwingOptions,
+    SwingOutput, MAX_COVERAGE_GAP,
 };
 pub use filter_fit::{fit_displacements, fit_surface_filter};
 pub use retiler::{retile, RetileStats, RetileTuning, Retiled};

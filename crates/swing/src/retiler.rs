@@ -331,18 +331,19 @@ pub fn retile(
     params: &SwingParams,
     tune: &RetileTuning,
 ) -> Result<Retiled, Error> {
-    retile_fitted(mesh, params, tune, false, whet_sharpen::Method::Extended)
+    let sharpen = whet_sharpen::SharpenOptions::DEFAULT;
+    retile_fitted(mesh, params, tune, false, &sharpen)
 }
 
 /// [`retile`], and with `fit` also the surface filter fitted to `mesh`
 /// ([`crate::fit_surface_filter`], on the retiler's own grid of the original) and the one for
-/// after sharpening with `sharpen_method`.
+/// after sharpening with `sharpen`.
 pub(crate) fn retile_fitted(
     mesh: &whet_mesh::Mesh,
     params: &SwingParams,
     tune: &RetileTuning,
     fit: bool,
-    sharpen_method: whet_sharpen::Method,
+    sharpen: &whet_sharpen::SharpenOptions,
 ) -> Result<Retiled, Error> {
     let l = params.edge_length;
     // Expected triangles: 2.4 · area / L² (algorithms.md 1.9). Checked first: the grid of
@@ -489,7 +490,7 @@ pub(crate) fn retile_fitted(
         // One set of fields serves both fits (fit_surface_filter computes the same).
         let fields = whet_codec::FilterFields::new(&kept);
         let filter = crate::fit_displacements(&kept, &fields.normal, &fields.smoothed, closest);
-        let after = fit_after_sharpening(&kept, &fields, sharpen_method, closest);
+        let after = fit_after_sharpening(&kept, &fields, sharpen, closest);
         (filter, after)
     } else {
         (SurfaceFilter::NONE, SurfaceFilter::NONE)
@@ -525,7 +526,7 @@ pub(crate) fn retile_fitted(
 }
 
 /// The factors of the filter for after sharpening: `kept` (the unfiltered decoded mesh)
-/// sharpened with whet-sharpen's defaults and `method`, the filter's fields of `kept` on the vertices
+/// sharpened with `sharpen` (whet-sharpen's defaults, or a stream's choice), the filter's fields of `kept` on the vertices
 /// the sharpener left alone, fitted to the original (docs/swing.md section 2). On a smooth
 /// part the sharpener changes little and the fit finds the decoded filter again; on a CAD
 /// part it fits the flat faces between the restored creases. No filter when the sharpener
@@ -533,11 +534,10 @@ pub(crate) fn retile_fitted(
 fn fit_after_sharpening(
     kept: &whet_mesh::Mesh,
     fields: &whet_codec::FilterFields,
-    method: whet_sharpen::Method,
+    sharpen: &whet_sharpen::SharpenOptions,
     closest: impl FnMut(DVec3) -> Option<DVec3>,
 ) -> SurfaceFilter {
-    let opts = whet_sharpen::SharpenOptions::DEFAULT.with_method(method);
-    let Ok(sharp) = whet_sharpen::sharpen(kept, &opts) else {
+    let Ok(sharp) = whet_sharpen::sharpen(kept, sharpen) else {
         return SurfaceFilter::NONE;
     };
     let sharp = sharp.mesh;

@@ -64,6 +64,8 @@ pub struct SwingInput {
     pub angle_bits: u32,
     /// The sharpening the stream names for `whet decode --sharpen` (the encoder's choice).
     pub sharpen_hint: Option<whet_codec::SharpenHint>,
+    /// Its smooth factor (2 when the stream names none).
+    pub smooth_factor: f64,
     /// The stream.
     pub bytes: Vec<u8>,
 }
@@ -85,7 +87,10 @@ impl SwingInput {
             Some(whet_codec::SharpenHint::Papers) => whet_sharpen::Method::Papers,
             _ => whet_sharpen::Method::Extended,
         };
-        let opts = whet_sharpen::SharpenOptions::DEFAULT.with_method(method);
+        let factor = whet_codec::SharpenHint::smooth_factor_of(&header).unwrap_or(2.0);
+        let opts = whet_sharpen::SharpenOptions::DEFAULT
+            .with_method(method)
+            .with_smooth_factor(factor);
         let mut s = whet_sharpen::sharpen(&self.decoded, &opts).unwrap_or_else(|e| panic!("{e}"));
         whet_codec::SurfaceFilter::after_sharpening_of(&header)
             .apply_after_sharpening(&self.decoded, &mut s.mesh);
@@ -99,7 +104,7 @@ pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
         .unwrap_or_else(|e| panic!("{name}: {e}"));
     let dir = whet_testkit::workspace_root().join("target/sharpen-swing");
     let _ = std::fs::create_dir_all(&dir);
-    let path = dir.join(format!("v3-{name}-{bpv}-{}.whet", angles.tag()));
+    let path = dir.join(format!("v4-{name}-{bpv}-{}.whet", angles.tag()));
     let bytes = match std::fs::read(&path) {
         Ok(b) => b,
         Err(_) => {
@@ -130,6 +135,7 @@ pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
             .get_u64(whet_format::tag::ANGLE_BITS)
             .map_or(0, |b| b as u32),
         sharpen_hint: whet_codec::SharpenHint::of(&header),
+        smooth_factor: whet_codec::SharpenHint::smooth_factor_of(&header).unwrap_or(2.0),
         original,
         decoded,
         bytes,
