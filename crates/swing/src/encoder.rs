@@ -372,6 +372,12 @@ impl SwingEncoder {
             (SharpenHint::Papers, 1.0),
         ];
         let fraction = out.edge_length_fraction;
+        // The candidates are retiled at `out`'s angle bits (the automatic choice's, when on).
+        let at_bits = SwingEncoder::new(
+            self.opts
+                .with_angle_bits(out.angle_bits)
+                .with_auto_angle_bits(false),
+        );
         let mut trials = Vec::new();
         let mut best: Option<(SharpenTrial, Option<SwingOutput>)> = None;
         for (i, (hint, smooth_factor)) in CANDIDATES.into_iter().enumerate() {
@@ -384,7 +390,7 @@ impl SwingEncoder {
                 };
                 (rms, None)
             } else {
-                match self.encode_at_for(prep, fraction, Some(hint), smooth_factor) {
+                match at_bits.encode_at_for(prep, fraction, Some(hint), smooth_factor) {
                     // The same retiling (the retiler is deterministic); only the hint and
                     // the filter for after sharpening differ.
                     Ok(p) if p.retiled == out.retiled => {

@@ -207,6 +207,9 @@ fn automatic_angle_bits_climb_on_flat_parts_and_stay_low_on_smooth_ones() {
     assert!((out.bits_per_original_vertex() / 3.0 - 1.0).abs() <= 0.05);
     let decoded = whet_codec::decode(&out.bytes, &whet_codec::DecodeOptions::DEFAULT).unwrap();
     assert_eq!(decoded, out.retiled);
+    // The sharpening choice retiled its candidates at the chosen bits (six methods and
+    // factors, each the same retiling, and none).
+    assert_eq!(out.sharpen_trials.len(), 7, "{:?}", out.sharpen_trials);
 
     // spot, smooth: every bit is paid for on curved patches (measured: 5-6 bits best).
     let out = encode(
