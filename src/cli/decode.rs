@@ -26,9 +26,11 @@ pub struct DecodeArgs {
     /// its method (see --method); otherwise 2.
     #[arg(long)]
     smooth_factor: Option<f64>,
-    /// EdgeSharpener's method: extended or papers. Without it, a swing stream encoded with
-    /// `--optimize-for sharpened` names the method its encoder measured best against the
-    /// original (or no sharpening, for a part it would make worse); otherwise extended.
+    /// EdgeSharpener's method: extended, papers, or none (decode as without --sharpen, then
+    /// --bend with filter 3bis's tags). Without it, a swing stream encoded with
+    /// `--optimize-for sharpened` names the method (and smooth factor) its encoder measured
+    /// best against the original, or none for a part sharpening makes worse; otherwise
+    /// extended.
     #[arg(long)]
     method: Option<String>,
     /// Subdiv streams: subdivision levels, overriding the header (0 gives the control mesh).
@@ -93,12 +95,14 @@ pub fn run(args: &DecodeArgs) -> CliResult {
             (None, None) => "extended",
         };
         if method == whet_codec::SharpenHint::Unsharpened.name() {
-            // The encoder measured both methods worse than the decoded mesh: what `whet
-            // decode` gives without --sharpen (the stream's own surface filter included).
-            eprintln!(
-                "whet: the stream's encoder measured sharpening as no gain on this mesh; \
-                 decoding without it (--method extended|papers sharpens anyway)"
-            );
+            // No candidate beat the decoded mesh (or `--method none`): what `whet decode`
+            // gives without --sharpen (the stream's own surface filter included).
+            if args.method.is_none() {
+                eprintln!(
+                    "whet: the stream's encoder measured sharpening as no gain on this mesh; \
+                     decoding without it (--method extended|papers sharpens anyway)"
+                );
+            }
             let plain = if args.no_surface_filter {
                 mesh
             } else {
@@ -108,18 +112,21 @@ pub fn run(args: &DecodeArgs) -> CliResult {
             };
             return match args.bend {
                 Some(levels) => {
-                    let bent = bend_levels(&plain, &[], levels, args.max_memory)?;
+                    // No sharpening, so no tags from it: filter 3bis's, as `whet bend`
+                    // without --tags, so that creases the retiling kept stay sharp.
+                    let tags = super::sharpen::fallback_tags(&plain)?;
+                    let bent = bend_levels(&plain, &tags, levels, args.max_memory)?;
                     write_decoded(args, &bent)
                 }
                 None => write_decoded(args, &plain),
             };
         }
-        // The stream's factor goes with the stream's method only.
-        let stream_factor = match &args.method {
-            None => header
+        // The stream's factor goes with the stream's method only (a method this whet knows).
+        let stream_factor = match (&args.method, hint) {
+            (None, Some(_)) => header
                 .as_ref()
                 .and_then(whet_codec::SharpenHint::smooth_factor_of),
-            Some(_) => None,
+            _ => None,
         };
         let smooth_factor = args.smooth_factor.or(stream_factor).unwrap_or(2.0);
         let opts = super::sharpen::sharpen_options(method, smooth_factor)?;

@@ -205,16 +205,23 @@ fn sharpened_from_stream(mesh: &Mesh, bytes: &[u8]) -> Result<(Mesh, Vec<[u32; 2
     let hint = header.as_ref().and_then(whet_codec::SharpenHint::of);
     let method = match hint {
         Some(whet_codec::SharpenHint::Unsharpened) => {
+            // As `whet decode --sharpen --bend`: filter 3bis's tags for Bender.
             let plain = whet::decode(bytes, &own_streams()).map_err(|e| e.to_string())?;
-            return Ok((plain, Vec::new()));
+            let tags =
+                super::sharpen::fallback_tags(&plain).map_err(|e| format!("{:#}", e.error))?;
+            return Ok((plain, tags));
         }
         Some(whet_codec::SharpenHint::Papers) => whet_sharpen::Method::Papers,
         _ => whet_sharpen::Method::Extended,
     };
-    let smooth_factor = header
-        .as_ref()
-        .and_then(whet_codec::SharpenHint::smooth_factor_of)
-        .unwrap_or(2.0);
+    // The factor goes with a method this whet knows.
+    let smooth_factor = match hint {
+        Some(_) => header
+            .as_ref()
+            .and_then(whet_codec::SharpenHint::smooth_factor_of),
+        None => None,
+    }
+    .unwrap_or(2.0);
     let mut s = sharpened(mesh, method, smooth_factor)?;
     if let Some(h) = &header {
         whet_codec::SurfaceFilter::after_sharpening_of(h).apply_after_sharpening(mesh, &mut s.mesh);

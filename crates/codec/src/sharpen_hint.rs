@@ -1,5 +1,6 @@
 //! The sharpening a swing stream's encoder measured best for `whet decode --sharpen`
-//! (optional header field 21, docs/format.md section 3; docs/swing.md section 7).
+//! (optional header fields 21 and 23, docs/format.md section 3; docs/swing.md section 2,
+//! "Which sharpening").
 //!
 //! whet-codec does not carry the sharpener: this is only the value the stream states, which
 //! the caller maps onto whet-sharpen's methods.
@@ -12,8 +13,8 @@ pub enum SharpenHint {
     Extended,
     /// The papers' method.
     Papers,
-    /// No sharpening: both methods measured worse than the decoded mesh (a part without a
-    /// crease, or one whose creases the retiling already keeps).
+    /// No sharpening: no method and smooth factor the encoder tried beat the decoded mesh
+    /// by its margin (a part without a real crease, like rocker_arm's blends).
     Unsharpened,
 }
 

@@ -397,7 +397,10 @@ impl SwingEncoder {
                         let rms = self.measure_as(prep, &p, ErrorOf::Sharpened, &opts)?;
                         (rms, Some(p))
                     }
-                    _ => continue,
+                    // Should the retiling differ after all, or the retiler get stuck where
+                    // it did not before, the candidate is left out (not in the trials).
+                    Ok(_) | Err(Error::Stuck(_)) => continue,
+                    Err(e) => return Err(e),
                 }
             };
             let trial = SharpenTrial {
@@ -591,7 +594,7 @@ impl SwingEncoder {
 
     /// Retiles and encodes at edge length `fraction · diagonal`. Streams optimised for
     /// sharpening carry a sharpening hint (extended until [`Self::choose_sharpening`] has
-    /// measured the others), so that the size searches count its two bytes.
+    /// measured the others), so that the size searches count its four or five bytes.
     fn encode_at(&self, prep: &Prepared, fraction: f64) -> Result<SwingOutput, Error> {
         let hint = (self.opts.error_of == ErrorOf::Sharpened).then_some(SharpenHint::Extended);
         self.encode_at_for(prep, fraction, hint, DEFAULT_SMOOTH_FACTOR)
@@ -619,7 +622,7 @@ impl SwingEncoder {
             sharpened_filter: retiled.sharpened_filter,
             sharpen_hint: hint,
             // Always written with a hint, so that the size searches count its bytes (the
-            // default's 200 hundredths take as many as any other choice).
+            // default's 200 hundredths take two, as 150 does; 100 takes one).
             sharpen_smooth_factor: hint.map(|_| smooth_factor),
         };
         let enc: SwingEncoded = encode_retiled(&retiled.mesh, &params, &info)?;

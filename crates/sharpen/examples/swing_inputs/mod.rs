@@ -87,7 +87,7 @@ impl SwingInput {
             Some(whet_codec::SharpenHint::Papers) => whet_sharpen::Method::Papers,
             _ => whet_sharpen::Method::Extended,
         };
-        let factor = whet_codec::SharpenHint::smooth_factor_of(&header).unwrap_or(2.0);
+        let factor = self.smooth_factor;
         let opts = whet_sharpen::SharpenOptions::DEFAULT
             .with_method(method)
             .with_smooth_factor(factor);
@@ -135,7 +135,9 @@ pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
             .get_u64(whet_format::tag::ANGLE_BITS)
             .map_or(0, |b| b as u32),
         sharpen_hint: whet_codec::SharpenHint::of(&header),
-        smooth_factor: whet_codec::SharpenHint::smooth_factor_of(&header).unwrap_or(2.0),
+        smooth_factor: whet_codec::SharpenHint::of(&header)
+            .and_then(|_| whet_codec::SharpenHint::smooth_factor_of(&header))
+            .unwrap_or(2.0),
         original,
         decoded,
         bytes,
