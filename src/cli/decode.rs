@@ -88,11 +88,13 @@ pub fn run(args: &DecodeArgs) -> CliResult {
     let mesh = if args.sharpen {
         check_sharpen_memory(mesh.triangles.len() as u64, args.max_memory)?;
         let header = whet_format::parse(&bytes, &limits).ok().map(|c| c.header);
-        let hint = header.as_ref().and_then(whet_codec::SharpenHint::of);
-        let method = match (&args.method, hint) {
-            (Some(m), _) => m.as_str(),
-            (None, Some(h)) => h.name(),
-            (None, None) => "extended",
+        // The stream's choice (`SharpenHint::stated`); an explicit --method replaces it,
+        // factor included.
+        let stated = header.as_ref().and_then(whet_codec::SharpenHint::stated);
+        let (method, stream_factor) = match (&args.method, stated) {
+            (Some(m), _) => (m.as_str(), None),
+            (None, Some((h, f))) => (h.name(), Some(f)),
+            (None, None) => ("extended", None),
         };
         if method == whet_codec::SharpenHint::Unsharpened.name() {
             // No candidate beat the decoded mesh (or `--method none`): what `whet decode`
@@ -121,13 +123,6 @@ pub fn run(args: &DecodeArgs) -> CliResult {
                 None => write_decoded(args, &plain),
             };
         }
-        // The stream's factor goes with the stream's method only (a method this whet knows).
-        let stream_factor = match (&args.method, hint) {
-            (None, Some(_)) => header
-                .as_ref()
-                .and_then(whet_codec::SharpenHint::smooth_factor_of),
-            _ => None,
-        };
         let smooth_factor = args.smooth_factor.or(stream_factor).unwrap_or(2.0);
         let opts = super::sharpen::sharpen_options(method, smooth_factor)?;
         let mut s = super::sharpen::run_sharpen(&mesh, &opts)?;

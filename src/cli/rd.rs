@@ -202,7 +202,8 @@ fn sharpened_from_stream(mesh: &Mesh, bytes: &[u8]) -> Result<(Mesh, Vec<[u32; 2
     let header = whet_format::parse(bytes, &whet_format::Limits::UNLIMITED)
         .ok()
         .map(|c| c.header);
-    let hint = header.as_ref().and_then(whet_codec::SharpenHint::of);
+    let stated = header.as_ref().and_then(whet_codec::SharpenHint::stated);
+    let (hint, smooth_factor) = stated.map_or((None, 2.0), |(h, f)| (Some(h), f));
     let method = match hint {
         Some(whet_codec::SharpenHint::Unsharpened) => {
             // As `whet decode --sharpen --bend`: filter 3bis's tags for Bender.
@@ -214,14 +215,6 @@ fn sharpened_from_stream(mesh: &Mesh, bytes: &[u8]) -> Result<(Mesh, Vec<[u32; 2
         Some(whet_codec::SharpenHint::Papers) => whet_sharpen::Method::Papers,
         _ => whet_sharpen::Method::Extended,
     };
-    // The factor goes with a method this whet knows.
-    let smooth_factor = match hint {
-        Some(_) => header
-            .as_ref()
-            .and_then(whet_codec::SharpenHint::smooth_factor_of),
-        None => None,
-    }
-    .unwrap_or(2.0);
     let mut s = sharpened(mesh, method, smooth_factor)?;
     if let Some(h) = &header {
         whet_codec::SurfaceFilter::after_sharpening_of(h).apply_after_sharpening(mesh, &mut s.mesh);

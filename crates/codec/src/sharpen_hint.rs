@@ -77,6 +77,15 @@ impl SharpenHint {
         (1.0..=1000.0).contains(&h).then_some(h as u64)
     }
 
+    /// What a stream's header states for `whet decode --sharpen`: its hint (field 21) and
+    /// the smooth factor that goes with it (field 23; 2 when absent or out of range). `None`
+    /// without a hint this whet knows, and then field 23 is not read either: a factor goes
+    /// with its method only.
+    pub fn stated(header: &whet_format::Header) -> Option<(SharpenHint, f64)> {
+        let hint = Self::of(header)?;
+        Some((hint, Self::smooth_factor_of(header).unwrap_or(2.0)))
+    }
+
     /// The hint a stream's header states: swing streams only, `None` without the field or
     /// with an unknown value.
     pub fn of(header: &whet_format::Header) -> Option<SharpenHint> {
@@ -138,5 +147,25 @@ mod tests {
         assert_eq!(SharpenHint::smooth_factor_code(0.0), None);
         assert_eq!(SharpenHint::smooth_factor_code(f64::NAN), None);
         assert_eq!(SharpenHint::smooth_factor_code(11.0), None);
+    }
+
+    #[test]
+    fn a_factor_is_stated_only_with_a_known_method() {
+        let factor = whet_format::Header::new(whet_format::Mode::Swing, 0, 0)
+            .with(whet_format::tag::SHARPEN_SMOOTH_FACTOR, 150u64);
+        assert_eq!(SharpenHint::stated(&factor), None);
+        let unknown = factor.clone().with(whet_format::tag::SHARPEN_METHOD, 7u64);
+        assert_eq!(SharpenHint::stated(&unknown), None);
+        let papers = factor.clone().with(whet_format::tag::SHARPEN_METHOD, 1u64);
+        assert_eq!(
+            SharpenHint::stated(&papers),
+            Some((SharpenHint::Papers, 1.5))
+        );
+        let default = whet_format::Header::new(whet_format::Mode::Swing, 0, 0)
+            .with(whet_format::tag::SHARPEN_METHOD, 0u64);
+        assert_eq!(
+            SharpenHint::stated(&default),
+            Some((SharpenHint::Extended, 2.0))
+        );
     }
 }

@@ -134,10 +134,8 @@ pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
         angle_bits: header
             .get_u64(whet_format::tag::ANGLE_BITS)
             .map_or(0, |b| b as u32),
-        sharpen_hint: whet_codec::SharpenHint::of(&header),
-        smooth_factor: whet_codec::SharpenHint::of(&header)
-            .and_then(|_| whet_codec::SharpenHint::smooth_factor_of(&header))
-            .unwrap_or(2.0),
+        sharpen_hint: whet_codec::SharpenHint::stated(&header).map(|s| s.0),
+        smooth_factor: whet_codec::SharpenHint::stated(&header).map_or(2.0, |s| s.1),
         original,
         decoded,
         bytes,
