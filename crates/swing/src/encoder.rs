@@ -355,9 +355,10 @@ impl SwingEncoder {
     /// samplings keep organic parts from getting worse and refuse some CAD snaps the papers'
     /// method makes; rocker_arm's blends get worse under the papers' method; a lower smooth
     /// factor finds more chamfers on coarse CAD retilings, whose curved faces raise the mean
-    /// normal angle), while the encoder holds the original and can simply measure. Each
-    /// candidate after the first costs one retiling at the same length (the filter for after
-    /// sharpening is fitted on that candidate's output) and one Metro measurement.
+    /// normal angle), while the encoder holds the original and can simply measure. The
+    /// candidates after the first cost one more retiling at the same length (with a filter
+    /// for after sharpening fitted on each candidate's output) and one Metro measurement
+    /// each.
     fn choose_sharpening(&self, prep: &Prepared, out: SwingOutput) -> Result<SwingOutput, Error> {
         // A candidate must beat the ones before it (the default first, no sharpening last)
         // by more than the sampling noise of a measurement (about 0.3 % at 300 000
@@ -378,6 +379,17 @@ impl SwingEncoder {
                 .with_angle_bits(out.angle_bits)
                 .with_auto_angle_bits(false),
         );
+        let others: Vec<_> = CANDIDATES[1..].iter().map(|&(h, f)| (Some(h), f)).collect();
+        let mut streams = match at_bits.encode_at_for(prep, fraction, &others) {
+            // The same retiling (the retiler is deterministic); only the hint and the filter
+            // for after sharpening differ.
+            Ok(s) if s.first().is_some_and(|p| p.retiled == out.retiled) => s,
+            // Should the retiling differ after all, or the retiler get stuck where it did
+            // not before, only the default is measured against no sharpening.
+            Ok(_) | Err(Error::Stuck(_)) => Vec::new(),
+            Err(e) => return Err(e),
+        }
+        .into_iter();
         let mut trials = Vec::new();
         let mut best: Option<(SharpenTrial, Option<SwingOutput>)> = None;
         for (i, (hint, smooth_factor)) in CANDIDATES.into_iter().enumerate() {
@@ -390,18 +402,11 @@ impl SwingEncoder {
                 };
                 (rms, None)
             } else {
-                match at_bits.encode_at_for(prep, fraction, Some(hint), smooth_factor) {
-                    // The same retiling (the retiler is deterministic); only the hint and
-                    // the filter for after sharpening differ.
-                    Ok(p) if p.retiled == out.retiled => {
-                        let rms = self.measure_as(prep, &p, ErrorOf::Sharpened, &opts)?;
-                        (rms, Some(p))
-                    }
-                    // Should the retiling differ after all, or the retiler get stuck where
-                    // it did not before, the candidate is left out (not in the trials).
-                    Ok(_) | Err(Error::Stuck(_)) => continue,
-                    Err(e) => return Err(e),
-                }
+                let Some(p) = streams.next() else { break };
+                (
+                    self.measure_as(prep, &p, ErrorOf::Sharpened, &opts)?,
+                    Some(p),
+                )
             };
             let trial = SharpenTrial {
                 hint,
@@ -597,57 +602,72 @@ impl SwingEncoder {
     /// measured the others), so that the size searches count its four or five bytes.
     fn encode_at(&self, prep: &Prepared, fraction: f64) -> Result<SwingOutput, Error> {
         let hint = (self.opts.error_of == ErrorOf::Sharpened).then_some(SharpenHint::Extended);
-        self.encode_at_for(prep, fraction, hint, DEFAULT_SMOOTH_FACTOR)
+        let mut outs = self.encode_at_for(prep, fraction, &[(hint, DEFAULT_SMOOTH_FACTOR)])?;
+        outs.pop()
+            .ok_or_else(|| Error::Internal("a retiling gave no stream".into()))
     }
 
-    /// [`Self::encode_at`] with the stream stating `hint` and `smooth_factor`, its filter for
-    /// after sharpening fitted for that sharpening (extended at factor 2 without a hint).
+    /// [`Self::encode_at`] once per candidate `(hint, smooth factor)`, from one retiling:
+    /// each stream states its candidate and carries the filter for after sharpening fitted
+    /// for that sharpening (extended at factor 2 without a hint).
     fn encode_at_for(
         &self,
         prep: &Prepared,
         fraction: f64,
-        hint: Option<SharpenHint>,
-        smooth_factor: f64,
-    ) -> Result<SwingOutput, Error> {
+        candidates: &[(Option<SharpenHint>, f64)],
+    ) -> Result<Vec<SwingOutput>, Error> {
         let o = &self.opts;
         let l = fraction * prep.diagonal;
         let params = SwingParams::new(l, o.angle_bits, &prep.mesh.bounding_box(), o.quant_bits)?;
-        let sharpen = sharpen_options(hint.unwrap_or(SharpenHint::Extended), smooth_factor);
+        let sharpen: Vec<_> = candidates
+            .iter()
+            .map(|&(h, f)| sharpen_options(h.unwrap_or(SharpenHint::Extended), f))
+            .collect();
         let retiled = retile_fitted(&prep.mesh, &params, &o.tuning, o.surface_filter, &sharpen)?;
-        let info = SwingStreamInfo {
-            version: o.version,
-            repair: &prep.repair,
-            dropped_unused_vertices: prep.dropped,
-            filter: retiled.filter,
-            sharpened_filter: retiled.sharpened_filter,
-            sharpen_hint: hint,
-            // Always written with a hint, so that the size searches count its bytes (the
-            // default's 200 hundredths take two, as 150 does; 100 takes one).
-            sharpen_smooth_factor: hint.map(|_| smooth_factor),
-        };
-        let enc: SwingEncoded = encode_retiled(&retiled.mesh, &params, &info)?;
-        let coverage_gap = coverage_gap(&prep.mesh, &retiled.pillowed_vertices, &enc.decoded, l);
-        Ok(SwingOutput {
-            coverage_gap,
-            bytes: enc.bytes,
-            report: enc.report,
-            retiled: enc.decoded,
-            geometry: enc.geometry,
-            edge_length: l,
-            edge_length_fraction: fraction,
-            angle_bits: o.angle_bits,
-            original_vertices: prep.mesh.positions.len(),
-            original_triangles: prep.mesh.triangles.len(),
-            stats: retiled.stats,
-            rms_pct: None,
-            search: Vec::new(),
-            angle_trials: Vec::new(),
-            surface_filter: info.filter,
-            sharpened_filter: info.sharpened_filter,
-            sharpen_hint: hint,
-            sharpen_smooth_factor: info.sharpen_smooth_factor,
-            sharpen_trials: Vec::new(),
-        })
+        let mut outs = Vec::with_capacity(candidates.len());
+        // The same decoded mesh for every candidate (they differ in header fields only).
+        let mut coverage = None;
+        for (&(hint, smooth_factor), &sharpened_filter) in
+            candidates.iter().zip(&retiled.sharpened_filters)
+        {
+            let info = SwingStreamInfo {
+                version: o.version,
+                repair: &prep.repair,
+                dropped_unused_vertices: prep.dropped,
+                filter: retiled.filter,
+                sharpened_filter,
+                sharpen_hint: hint,
+                // Always written with a hint, so that the size searches count its bytes (the
+                // default's 200 hundredths take two, as 150 does; 100 takes one).
+                sharpen_smooth_factor: hint.map(|_| smooth_factor),
+            };
+            let enc: SwingEncoded = encode_retiled(&retiled.mesh, &params, &info)?;
+            let coverage_gap = *coverage.get_or_insert_with(|| {
+                coverage_gap(&prep.mesh, &retiled.pillowed_vertices, &enc.decoded, l)
+            });
+            outs.push(SwingOutput {
+                coverage_gap,
+                bytes: enc.bytes,
+                report: enc.report,
+                retiled: enc.decoded,
+                geometry: enc.geometry,
+                edge_length: l,
+                edge_length_fraction: fraction,
+                angle_bits: o.angle_bits,
+                original_vertices: prep.mesh.positions.len(),
+                original_triangles: prep.mesh.triangles.len(),
+                stats: retiled.stats.clone(),
+                rms_pct: None,
+                search: Vec::new(),
+                angle_trials: Vec::new(),
+                surface_filter: info.filter,
+                sharpened_filter: info.sharpened_filter,
+                sharpen_hint: hint,
+                sharpen_smooth_factor: info.sharpen_smooth_factor,
+                sharpen_trials: Vec::new(),
+            });
+        }
+        Ok(outs)
     }
 
     /// [`Self::encode_at`], retrying at slightly different lengths when the retiler gets

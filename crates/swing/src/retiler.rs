@@ -192,10 +192,11 @@ pub struct Retiled {
     pub pillowed_vertices: Vec<bool>,
     /// The surface filter fitted to the original ([`SurfaceFilter::NONE`] unless asked for).
     pub filter: SurfaceFilter,
-    /// The filter for after EdgeSharpener (`SurfaceFilter::apply_after_sharpening`), fitted
-    /// on the retiling sharpened with whet-sharpen's defaults, as `whet decode --sharpen`
-    /// does ([`SurfaceFilter::NONE`] unless asked for).
-    pub sharpened_filter: SurfaceFilter,
+    /// The filters for after EdgeSharpener (`SurfaceFilter::apply_after_sharpening`), one
+    /// per sharpening asked for, each fitted on the retiling sharpened that way, as `whet
+    /// decode --sharpen` does ([`SurfaceFilter::NONE`] unless asked for; empty when none
+    /// was asked for).
+    pub sharpened_filters: Vec<SurfaceFilter>,
 }
 
 const NONE: u32 = u32::MAX;
@@ -331,19 +332,19 @@ pub fn retile(
     params: &SwingParams,
     tune: &RetileTuning,
 ) -> Result<Retiled, Error> {
-    let sharpen = whet_sharpen::SharpenOptions::DEFAULT;
-    retile_fitted(mesh, params, tune, false, &sharpen)
+    retile_fitted(mesh, params, tune, false, &[])
 }
 
 /// [`retile`], and with `fit` also the surface filter fitted to `mesh`
-/// ([`crate::fit_surface_filter`], on the retiler's own grid of the original) and the one for
-/// after sharpening with `sharpen`.
+/// ([`crate::fit_surface_filter`], on the retiler's own grid of the original) and one for
+/// after sharpening per entry of `sharpen` (one retiling serves every sharpening the
+/// encoder's choice measures).
 pub(crate) fn retile_fitted(
     mesh: &whet_mesh::Mesh,
     params: &SwingParams,
     tune: &RetileTuning,
     fit: bool,
-    sharpen: &whet_sharpen::SharpenOptions,
+    sharpen: &[whet_sharpen::SharpenOptions],
 ) -> Result<Retiled, Error> {
     let l = params.edge_length;
     // Expected triangles: 2.4 · area / L² (algorithms.md 1.9). Checked first: the grid of
@@ -471,7 +472,7 @@ pub(crate) fn retile_fitted(
         None => Vec::new(),
     };
     r.stats.deleted_triangles = deleted.iter().filter(|&&d| d).count();
-    let (filter, sharpened_filter) = if fit {
+    let (filter, sharpened_filters) = if fit {
         // The decoder's output: the kept triangles (unused vertices do not matter to the
         // filter). Closest points on the original only, not on the filler over its holes.
         let kept = whet_mesh::Mesh::new(
@@ -490,10 +491,16 @@ pub(crate) fn retile_fitted(
         // One set of fields serves both fits (fit_surface_filter computes the same).
         let fields = whet_codec::FilterFields::new(&kept);
         let filter = crate::fit_displacements(&kept, &fields.normal, &fields.smoothed, closest);
-        let after = fit_after_sharpening(&kept, &fields, sharpen, closest);
+        let after = sharpen
+            .iter()
+            .map(|o| fit_after_sharpening(&kept, &fields, o, closest))
+            .collect();
         (filter, after)
     } else {
-        (SurfaceFilter::NONE, SurfaceFilter::NONE)
+        (
+            SurfaceFilter::NONE,
+            vec![SurfaceFilter::NONE; sharpen.len()],
+        )
     };
     // Vertices of pillowed components (the original's vertices come first in a capped mesh,
     // and its triangles first too).
@@ -521,7 +528,7 @@ pub(crate) fn retile_fitted(
         stats: r.stats,
         pillowed_vertices,
         filter,
-        sharpened_filter,
+        sharpened_filters,
     })
 }
 
