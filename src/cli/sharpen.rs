@@ -23,6 +23,11 @@ pub struct SharpenArgs {
     /// six filters only) or `normal-filter` (seed 002: blends, chamfers with samples, noise).
     #[arg(long, default_value = "extended")]
     method: String,
+    /// extended: do not weld the clusters of near-coincident vertices joined by zero-area
+    /// triangles (marching cubes' output); welded vertices otherwise stay at their index, used
+    /// by no triangle.
+    #[arg(long)]
+    no_weld: bool,
     /// normal-filter: neighbourhood radius in mean edge lengths (a little more than the widest
     /// feature to sharpen).
     #[arg(long, default_value_t = SharpenOptions::DEFAULT.rho)]
@@ -76,7 +81,8 @@ pub fn run(args: &SharpenArgs) -> CliResult {
     let opts = sharpen_options(&args.method, args.smooth_factor)?
         .with_rho(args.rho)
         .with_eta(args.eta)
-        .with_lambda(args.lambda);
+        .with_lambda(args.lambda)
+        .with_weld_clusters(!args.no_weld);
     opts.validate().map_err(Failure::input)?;
     let out = match &args.select {
         None => run_sharpen(&mesh, &opts)?,

@@ -20,7 +20,7 @@
 //! place (the angle of each to its nearest reference face, the distance of its vertices to the
 //! reference, into how many pieces it was cut) and the vertices there in the frame of the two
 //! nearest reference faces; `DIAG_V=<vertex>` prints that input vertex's input and output
-//! positions.
+//! positions; `DIAG_NO_WELD=1` turns off the extended method's cluster welding (`--no-weld`).
 
 mod support;
 mod swing_inputs;
@@ -83,7 +83,12 @@ fn main() {
         )
     };
     let out = or_die(
-        sharpen(&input, &SharpenOptions::DEFAULT.with_method(method)),
+        sharpen(
+            &input,
+            &SharpenOptions::DEFAULT
+                .with_method(method)
+                .with_weld_clusters(std::env::var_os("DIAG_NO_WELD").is_none()),
+        ),
         "sharpen",
     );
     println!("{}", out.report.to_json());

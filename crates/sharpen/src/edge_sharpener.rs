@@ -218,22 +218,50 @@ impl EdgeSharpener {
                 count: mesh.positions.len() + 2 * mesh.triangles.len(),
             }));
         }
-        let mut run = Run {
-            mesh,
-            table: &table,
-            opts: &self.options,
-            s: &mut self.scratch,
-            report,
-            positions: Vec::new(),
-            max_edge: 0.0,
-            limits: SnapLimits::new(0.0),
-            ref_normals: Vec::new(),
-            snap_cache: Vec::new(),
-            corner_cache: Vec::new(),
-            surface_samples: false,
+        let welded = if self.options.method == Method::Extended
+            && self.options.weld_clusters
+            && !crate::extended::is_surface_sampling(mesh)
+        {
+            crate::weld::weld_clusters(mesh, &table, self.options.min_angle_degrees.to_radians())
+                .and_then(|w| {
+                    // The merge checks keep the manifold; the full check comes with the table
+                    // the run needs anyway.
+                    let welded_table = CornerTable::new(&w.mesh).ok()?;
+                    Some((w, welded_table))
+                })
+        } else {
+            None
         };
-        let (out, parents, tags) = run.run();
-        let mut report = run.report;
+        let mut result = None;
+        if let Some((w, welded_table)) = &welded {
+            let welded_report = SharpenReport {
+                welded_vertices: w.merged,
+                ..report.clone()
+            };
+            let mut run = Run::new(
+                &w.mesh,
+                welded_table,
+                &self.options,
+                &mut self.scratch,
+                welded_report,
+            );
+            let (out, mut parents, tags) = run.run();
+            // Nothing sharpened: the input comes back as it was, unwelded (below).
+            if run.report.new_vertices > 0 || run.report.moved_input_vertices > 0 {
+                for p in &mut parents {
+                    *p = FaceId(w.input_triangle[p.index()]);
+                }
+                result = Some((out, parents, tags, run.report));
+            }
+        }
+        let (out, parents, tags, mut report) = match result {
+            Some(r) => r,
+            None => {
+                let mut run = Run::new(mesh, &table, &self.options, &mut self.scratch, report);
+                let (out, parents, tags) = run.run();
+                (out, parents, tags, run.report)
+            }
+        };
         report.time = start.elapsed();
         Ok(Sharpened {
             mesh: out,
@@ -296,7 +324,31 @@ pub(crate) fn prev(c: usize) -> usize {
     }
 }
 
-impl Run<'_> {
+impl<'a> Run<'a> {
+    /// A run over `mesh` (whose table is `table`) starting from `report`.
+    fn new(
+        mesh: &'a Mesh,
+        table: &'a CornerTable,
+        opts: &'a SharpenOptions,
+        s: &'a mut Scratch,
+        report: SharpenReport,
+    ) -> Run<'a> {
+        Run {
+            mesh,
+            table,
+            opts,
+            s,
+            report,
+            positions: Vec::new(),
+            max_edge: 0.0,
+            limits: SnapLimits::new(0.0),
+            ref_normals: Vec::new(),
+            snap_cache: Vec::new(),
+            corner_cache: Vec::new(),
+            surface_samples: false,
+        }
+    }
+
     fn run(&mut self) -> (Mesh, Vec<FaceId>, SharpTags) {
         self.detect();
         self.insert_vertices();
@@ -1527,20 +1579,7 @@ mod tests {
     fn with_run<R>(mesh: &Mesh, opts: &SharpenOptions, f: impl FnOnce(&mut Run) -> R) -> R {
         let table = CornerTable::new(mesh).unwrap();
         let mut scratch = Scratch::default();
-        let mut run = Run {
-            mesh,
-            table: &table,
-            opts,
-            s: &mut scratch,
-            report: SharpenReport::default(),
-            positions: Vec::new(),
-            max_edge: 0.0,
-            limits: SnapLimits::new(0.0),
-            ref_normals: Vec::new(),
-            snap_cache: Vec::new(),
-            corner_cache: Vec::new(),
-            surface_samples: false,
-        };
+        let mut run = Run::new(mesh, &table, opts, &mut scratch, SharpenReport::default());
         f(&mut run)
     }
 
@@ -1606,20 +1645,7 @@ mod tests {
         let table = CornerTable::new(&mesh).unwrap();
         let opts = SharpenOptions::DEFAULT;
         let mut scratch = Scratch::default();
-        let mut run = Run {
-            mesh: &mesh,
-            table: &table,
-            opts: &opts,
-            s: &mut scratch,
-            report: SharpenReport::default(),
-            positions: Vec::new(),
-            max_edge: 0.0,
-            limits: SnapLimits::new(0.0),
-            ref_normals: Vec::new(),
-            snap_cache: Vec::new(),
-            corner_cache: Vec::new(),
-            surface_samples: false,
-        };
+        let mut run = Run::new(&mesh, &table, &opts, &mut scratch, SharpenReport::default());
         run.detect();
         run.insert_vertices();
         run.reset_reference_normals();

@@ -35,6 +35,7 @@ mod report;
 mod slivers;
 mod snap;
 mod tags;
+mod weld;
 
 pub use edge_sharpener::EdgeSharpener;
 
@@ -56,7 +57,9 @@ use whet_mesh::{FaceId, Mesh, MeshError};
 #[derive(Clone, Debug)]
 #[non_exhaustive]
 pub struct Sharpened {
-    /// The sharpened mesh: the input vertices at their input indices, then the new vertices.
+    /// The sharpened mesh: the input vertices at their input indices (those the extended
+    /// method welded into a near-coincident neighbour are used by no triangle), then the new
+    /// vertices.
     pub mesh: Mesh,
     /// For each triangle of `mesh`, the input triangle it was cut from (or is): lets callers
     /// carry per-face attributes over, and is what the orientation guarantee refers to.

@@ -80,6 +80,11 @@ pub struct SharpenOptions {
     /// Normal filter: the neighbourhood flood does not cross an edge whose normals' dot product
     /// is `lambda` or less (an edge that is already sharp). In `[-1, 1]`.
     pub lambda: f64,
+    /// Extended method: weld marching cubes' clusters of near-coincident input vertices
+    /// (joined by slivers) before detection, unless the input is a surface sampling
+    /// (docs/sharpen.md, "What we extend", step 10); welded vertices stay at their indices,
+    /// used by no triangle. Default on.
+    pub weld_clusters: bool,
 }
 
 impl SharpenOptions {
@@ -92,6 +97,7 @@ impl SharpenOptions {
         rho: 4.0,
         eta: 0.1,
         lambda: 0.0,
+        weld_clusters: true,
     };
 
     /// The papers' algorithm with their constants (`--method papers`).
@@ -130,6 +136,12 @@ impl SharpenOptions {
     /// Sets the normal filter's flood stop.
     pub const fn with_lambda(mut self, lambda: f64) -> Self {
         self.lambda = lambda;
+        self
+    }
+
+    /// Sets whether the extended method welds marching cubes' vertex clusters.
+    pub const fn with_weld_clusters(mut self, weld: bool) -> Self {
+        self.weld_clusters = weld;
         self
     }
 

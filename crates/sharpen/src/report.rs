@@ -102,6 +102,10 @@ pub struct SharpenReport {
     pub moved_input_vertices: usize,
     /// Triangles removed by the sliver pass's edge collapses.
     pub collapsed_triangles: usize,
+    /// Extended method: input vertices welded into a near-coincident neighbour (marching
+    /// cubes' clusters; docs/sharpen.md, "What we extend", step 10). They keep their index,
+    /// used by no triangle.
+    pub welded_vertices: usize,
     /// Subdivided triangles the sliver pass restored to their input triangles (docs/sharpen.md,
     /// "The sliver pass").
     pub restored_triangles: usize,
@@ -203,13 +207,14 @@ impl SharpenReport {
         let _ = write!(
             s,
             "}},\"moved_input_vertices\":{},\"collapsed_triangles\":{},\"restored_triangles\":{},\
-             \"tagged_vertices\":{},\"sharp_edges\":{},\"time_ms\":{},",
+             \"tagged_vertices\":{},\"sharp_edges\":{},\"time_ms\":{},\"welded_vertices\":{},",
             self.moved_input_vertices,
             self.collapsed_triangles,
             self.restored_triangles,
             self.tagged_vertices,
             self.sharp_edges,
             json_num(self.time.as_secs_f64() * 1e3),
+            self.welded_vertices,
         );
         let _ = write!(
             s,

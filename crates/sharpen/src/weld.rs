@@ -1,0 +1,328 @@
+//! Extended method: welding marching cubes' clusters of near-coincident input vertices
+//! (docs/sharpen.md, "What we extend", step 10).
+//!
+//! Where a grid value is near zero, marching cubes puts the vertices of every crossing grid
+//! edge at that grid point: clusters of three or four input vertices within a few hundredths
+//! of an edge, joined by zero-area triangles. A chamfer edge that is a long edge of such a
+//! sliver cannot be split (the piece holding the sliver's short edge would be as thin), so the
+//! crease keeps a gap there and the max error sits in it. Welding each cluster into one vertex
+//! removes the slivers and lets the chamfer be cut.
+//!
+//! A cluster is seeded by a *sliver* (an angle under the sliver threshold) with an edge shorter
+//! than [`CLUSTER_EDGE`] mean edge lengths, and holds the vertices joined to that edge by such
+//! short edges. Its vertices merge into the lowest-numbered one, which keeps its position; the
+//! others stay at their indices with no triangle using them (the output promise "input vertex
+//! `i` is output vertex `i`" holds), and the triangles that had two of them disappear. A
+//! cluster is left alone when it touches the boundary, when the merge would break the manifold
+//! around it, or when a changed triangle would be a sliver.
+
+use whet_mesh::{CornerTable, Mesh, VertexId};
+
+/// Vertices closer than this many mean edge lengths form a cluster. Marching cubes' clusters
+/// span up to a few hundredths of an edge (measured: welding within 0.01 changes nothing on
+/// the cube at 64, within 0.05 it welds its clusters); real features of a sampled surface
+/// are not this small.
+pub(crate) const CLUSTER_EDGE: f64 = 0.05;
+
+/// The welded input and how to map its triangles back.
+pub(crate) struct Welded {
+    /// Every input vertex at its input index; the merged ones are used by no triangle.
+    pub mesh: Mesh,
+    /// Input triangle of each welded triangle.
+    pub input_triangle: Vec<u32>,
+    /// Vertices merged into another.
+    pub merged: usize,
+}
+
+/// Welds the clusters of `mesh` (whose table is `table`) seeded by slivers, triangles with an
+/// angle under `min_angle` (radians). `None` when no cluster could be welded.
+pub(crate) fn weld_clusters(mesh: &Mesh, table: &CornerTable, min_angle: f64) -> Option<Welded> {
+    let nv = mesh.positions.len();
+    let limit = CLUSTER_EDGE * mean_edge_length(mesh, table);
+    // Also refuses a NaN length (no finite mean edge).
+    if limit.is_nan() || limit <= 0.0 {
+        return None;
+    }
+    let limit2 = limit * limit;
+    let close = |a: u32, b: u32| {
+        mesh.positions[a as usize].distance_squared(mesh.positions[b as usize]) < limit2
+    };
+    // Representative of each vertex (itself unless merged).
+    let mut rep: Vec<u32> = Vec::new();
+    let mut alive: Vec<bool> = Vec::new();
+    let mut in_cluster: Vec<bool> = Vec::new();
+    let mut merged = 0usize;
+    let mut cluster: Vec<u32> = Vec::new();
+    let mut around: Vec<u32> = Vec::new();
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        // The shortest edge first (three squared lengths: most triangles stop here), then the
+        // sliver test.
+        let p = mesh.triangle_positions(t);
+        let (a, b, d) = (0..3)
+            .map(|k| {
+                (
+                    tri[k],
+                    tri[(k + 1) % 3],
+                    p[k].distance_squared(p[(k + 1) % 3]),
+                )
+            })
+            .fold((tri[0], tri[1], f64::INFINITY), |m, e| {
+                if e.2 < m.2 {
+                    e
+                } else {
+                    m
+                }
+            });
+        if d >= limit2 || crate::edge_sharpener::min_angle(&p) >= min_angle {
+            continue;
+        }
+        if rep.is_empty() {
+            rep = (0..nv as u32).collect();
+            alive = vec![true; mesh.triangles.len()];
+            in_cluster = vec![false; nv];
+        }
+        if a == b || in_cluster[a as usize] || in_cluster[b as usize] {
+            continue;
+        }
+        // Grow the cluster over short edges.
+        cluster.clear();
+        cluster.extend([a, b]);
+        in_cluster[a as usize] = true;
+        in_cluster[b as usize] = true;
+        let mut i = 0;
+        let mut open = false;
+        while i < cluster.len() {
+            let v = cluster[i];
+            i += 1;
+            open |= table.is_boundary_vertex(VertexId(v));
+            for c in table.vertex_corners(VertexId(v)) {
+                for w in [table.vertex(table.next(c)).0, table.vertex(table.prev(c)).0] {
+                    if !in_cluster[w as usize] && close(v, w) {
+                        in_cluster[w as usize] = true;
+                        cluster.push(w);
+                    }
+                }
+            }
+        }
+        if open || cluster.len() > 8 {
+            // On the boundary (welding would change it), or not a marching-cubes cluster.
+            continue;
+        }
+        let root = *cluster.iter().min().unwrap_or(&a);
+        around.clear();
+        for &v in &cluster {
+            around.extend(table.vertex_corners(VertexId(v)).map(|c| c.0 / 3));
+        }
+        around.sort_unstable();
+        around.dedup();
+        around.retain(|&t| alive[t as usize]);
+        for &v in &cluster {
+            rep[v as usize] = root;
+        }
+        if merge_keeps_manifold(mesh, &rep, &around, root, min_angle) {
+            for &t in &around {
+                let [x, y, z] = mesh.triangles[t as usize].map(|v| rep[v as usize]);
+                if x == y || y == z || z == x {
+                    alive[t as usize] = false;
+                }
+            }
+            merged += cluster.len() - 1;
+        } else {
+            for &v in &cluster {
+                rep[v as usize] = v;
+            }
+        }
+    }
+    if merged == 0 {
+        return None;
+    }
+    let mut triangles = Vec::with_capacity(mesh.triangles.len());
+    let mut input_triangle = Vec::with_capacity(mesh.triangles.len());
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        if alive[t] {
+            triangles.push(tri.map(|v| rep[v as usize]));
+            input_triangle.push(t as u32);
+        }
+    }
+    Some(Welded {
+        mesh: Mesh::new(mesh.positions.clone(), triangles),
+        input_triangle,
+        merged,
+    })
+}
+
+/// Mean length of the edges of `mesh`, each once (the table pairs them; `Mesh`'s own mean
+/// hashes every edge, a third of a sharpening's time on marching cubes).
+fn mean_edge_length(mesh: &Mesh, table: &CornerTable) -> f64 {
+    let opposite = table.opposites();
+    let (mut sum, mut count) = (0.0, 0usize);
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        for k in 0..3 {
+            let c = 3 * t + k;
+            // Each interior edge from its lower corner, each boundary edge once.
+            if opposite[c] != u32::MAX && (opposite[c] as usize) < c {
+                continue;
+            }
+            let (a, b) = (tri[(k + 1) % 3], tri[(k + 2) % 3]);
+            sum += mesh.positions[a as usize].distance(mesh.positions[b as usize]);
+            count += 1;
+        }
+    }
+    if count == 0 {
+        0.0
+    } else {
+        sum / count as f64
+    }
+}
+
+/// Whether merging (per `rep`) leaves the triangles `around` (every live triangle touching
+/// the cluster now represented by `root`) an oriented manifold patch: no directed edge or
+/// triangle twice, and the triangles around `root` one closed fan. Only these triangles
+/// change, and only their edges with `root` are new, so this is the whole check. A changed
+/// triangle is a new triangle of the output, so none may have an angle under `min_angle`
+/// (radians), the sliver pass's rule.
+fn merge_keeps_manifold(
+    mesh: &Mesh,
+    rep: &[u32],
+    around: &[u32],
+    root: u32,
+    min_angle: f64,
+) -> bool {
+    // A few dozen triangles: sorted vectors, no hashing.
+    let mut edges: Vec<(u32, u32)> = Vec::with_capacity(3 * around.len());
+    let mut faces: Vec<[u32; 3]> = Vec::with_capacity(around.len());
+    // Around `root`: the edge opposite it in each triangle, as `from -> to`.
+    let mut fan: Vec<(u32, u32)> = Vec::new();
+    for &t in around {
+        let tri = mesh.triangles[t as usize].map(|v| rep[v as usize]);
+        if tri[0] == tri[1] || tri[1] == tri[2] || tri[2] == tri[0] {
+            continue;
+        }
+        if tri != mesh.triangles[t as usize]
+            && crate::edge_sharpener::min_angle(&tri.map(|v| mesh.positions[v as usize]))
+                < min_angle
+        {
+            return false;
+        }
+        edges.extend((0..3).map(|k| (tri[k], tri[(k + 1) % 3])));
+        let mut key = tri;
+        key.sort_unstable();
+        faces.push(key);
+        if let Some(k) = tri.iter().position(|&v| v == root) {
+            fan.push((tri[(k + 1) % 3], tri[(k + 2) % 3]));
+        }
+    }
+    edges.sort_unstable();
+    faces.sort_unstable();
+    if edges.windows(2).any(|w| w[0] == w[1]) || faces.windows(2).any(|w| w[0] == w[1]) {
+        return false;
+    }
+    // One closed cycle: every `from` once, and following the links from any edge comes back
+    // to it after visiting them all.
+    if fan.len() < 3 {
+        return false;
+    }
+    fan.sort_unstable();
+    if fan.windows(2).any(|w| w[0].0 == w[1].0) {
+        return false;
+    }
+    let start = fan[0].0;
+    let mut v = start;
+    for step in 0..fan.len() {
+        match fan.binary_search_by_key(&v, |e| e.0) {
+            Ok(i) => v = fan[i].1,
+            Err(_) => return false,
+        }
+        if v == start {
+            return step + 1 == fan.len();
+        }
+    }
+    false
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    /// A bipyramid (apexes 0 and 1, equator 2..8) whose top apex is split into two
+    /// vertices `0` and `8` a millionth of an edge apart, joined by two zero-area triangles:
+    /// the shape of a marching-cubes cluster. Returns the mesh and the first sliver.
+    fn split_bipyramid() -> (Mesh, u32) {
+        let mut positions = vec![DVec3::Z, -DVec3::Z];
+        for i in 0..6 {
+            let a = i as f64 * std::f64::consts::TAU / 6.0;
+            positions.push(DVec3::new(a.cos(), a.sin(), 0.0));
+        }
+        positions.push(DVec3::new(1e-6, 0.0, 1.0));
+        let e = |i: u32| 2 + i % 6;
+        let (t, t2) = (0u32, 8u32);
+        let mut triangles = Vec::new();
+        for i in 0..6 {
+            triangles.push([1, e(i + 1), e(i)]);
+        }
+        for i in 0..3 {
+            triangles.push([t, e(i), e(i + 1)]);
+        }
+        for i in 3..6 {
+            triangles.push([t2, e(i), e(i + 1)]);
+        }
+        let sliver = triangles.len() as u32;
+        triangles.push([t, e(3), t2]);
+        triangles.push([t2, e(0), t]);
+        (Mesh::new(positions, triangles), sliver)
+    }
+
+    #[test]
+    fn a_cluster_welds_into_its_lowest_vertex() {
+        let (mesh, _) = split_bipyramid();
+        let table = CornerTable::new(&mesh).unwrap();
+        let w = weld_clusters(&mesh, &table, 1f64.to_radians()).unwrap();
+        assert_eq!(w.merged, 1);
+        // The two slivers are gone; every other triangle is kept, vertex 8 now 0.
+        assert_eq!(w.mesh.triangles.len(), mesh.triangles.len() - 2);
+        assert_eq!(w.input_triangle, (0..12).collect::<Vec<u32>>());
+        assert!(w.mesh.triangles.iter().all(|t| !t.contains(&8)));
+        assert_eq!(w.mesh.triangles[9], [0, 5, 6]);
+        // Positions untouched: vertex 8 keeps its index and place, used by no triangle.
+        assert_eq!(w.mesh.positions, mesh.positions);
+        CornerTable::new(&w.mesh).unwrap();
+    }
+
+    #[test]
+    fn clusters_that_would_break_the_manifold_or_make_slivers_stay() {
+        let (mesh, _) = split_bipyramid();
+        let table = CornerTable::new(&mesh).unwrap();
+        // Vertices far apart are no cluster.
+        let mut far = mesh.clone();
+        far.positions[8] = DVec3::new(0.2, 0.0, 1.0);
+        let far_table = CornerTable::new(&far).unwrap();
+        assert!(weld_clusters(&far, &far_table, 1f64.to_radians()).is_none());
+        // A minimum angle no remapped triangle meets refuses the merge.
+        assert!(weld_clusters(&mesh, &table, 50f64.to_radians()).is_none());
+        // A tetrahedron with two coincident vertices: merging them leaves a two-triangle
+        // pillow, which is refused.
+        let tet = Mesh::new(
+            vec![DVec3::ZERO, DVec3::new(1e-6, 0.0, 0.0), DVec3::Y, DVec3::Z],
+            vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]],
+        );
+        let tet_table = CornerTable::new(&tet).unwrap();
+        assert!(weld_clusters(&tet, &tet_table, 1f64.to_radians()).is_none());
+    }
+
+    #[test]
+    fn boundary_clusters_are_left_alone() {
+        let (mut mesh, _) = split_bipyramid();
+        // Open the bottom: the equator becomes a boundary, but the apex cluster is inside.
+        mesh.triangles.drain(0..6);
+        let table = CornerTable::new(&mesh).unwrap();
+        let w = weld_clusters(&mesh, &table, 1f64.to_radians()).unwrap();
+        assert_eq!(w.merged, 1);
+        // A cluster on the boundary: split an equator vertex instead.
+        let (mut open, _) = split_bipyramid();
+        open.triangles.drain(0..6);
+        open.triangles.retain(|t| !t.contains(&2));
+        let table = CornerTable::new(&open).unwrap();
+        assert!(weld_clusters(&open, &table, 1f64.to_radians()).is_none());
+    }
+}
