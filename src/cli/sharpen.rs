@@ -112,6 +112,15 @@ pub fn run(args: &SharpenArgs) -> CliResult {
             Failure::other(anyhow::Error::new(e).context(format!("cannot write {}", t.display())))
         })?;
     }
+    if out.report.welded_vertices > 0 {
+        // The file keeps them (input vertex i is output vertex i); say why they are unused.
+        eprintln!(
+            "whet: welded {} near-coincident input vertices into a neighbour (marching-cubes \
+             clusters); they stay in the output at their index, used by no triangle \
+             (--no-weld keeps them)",
+            out.report.welded_vertices
+        );
+    }
     if args.json {
         let v: serde_json::Value = serde_json::from_str(&out.report.to_json())
             .map_err(|e| Failure::other(anyhow::Error::new(e)))?;

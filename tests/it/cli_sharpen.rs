@@ -48,10 +48,29 @@ fn sharpen_then_bend_on_a_chamfered_cube() {
         "collapsed_triangles",
         "time_ms",
         "unmoved",
+        "welded_vertices",
     ] {
         assert!(!j[key].is_null(), "missing {key}: {j}");
     }
     assert!(j["chamfer_edges"].as_u64().unwrap() > 0);
+    // Marching cubes' clusters are welded (92 vertices here, measured 2026-12-02); the welded
+    // vertices stay in the file, used by no triangle, and the command says so.
+    let welded = j["welded_vertices"].as_u64().unwrap();
+    assert!(welded > 0, "{j}");
+    let o = whet(&["sharpen", s(&mc), "-o", s(&dir.join("w.off"))]);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("used by no triangle"));
+    let plain = dir.join("plain.off");
+    let j = whet_json(&["sharpen", s(&mc), "-o", s(&plain), "--no-weld", "--json"]);
+    assert_eq!(j["welded_vertices"], 0);
+    let info = whet_json(&["info", s(&plain), "--json"]);
+    assert_eq!(info["problem_count"], 0, "{info}");
+    let info = whet_json(&["info", s(&dir.join("w.off")), "--json"]);
+    assert_eq!(
+        info["problems"][0]["kind"], "unreferenced_vertices",
+        "{info}"
+    );
+    let message = info["problems"][0]["message"].as_str().unwrap();
+    assert!(message.starts_with(&format!("{welded} vertices")), "{info}");
     let (max0, rms0) = rms_pct(&truth, &mc);
     let (max1, rms1) = rms_pct(&truth, &sharp);
     assert!(rms1 < rms0 / 3.0, "RMS {rms0} -> {rms1}");
