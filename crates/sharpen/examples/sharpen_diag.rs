@@ -20,7 +20,8 @@
 //! place (the angle of each to its nearest reference face, the distance of its vertices to the
 //! reference, into how many pieces it was cut) and the vertices there in the frame of the two
 //! nearest reference faces; `DIAG_V=<vertex>` prints that input vertex's input and output
-//! positions; `DIAG_NO_WELD=1` turns off the extended method's cluster welding (`--no-weld`).
+//! positions; `DIAG_AT=x,y,z` dumps the neighbourhood of that point instead of the worst
+//! place; `DIAG_NO_WELD=1` turns off the extended method's cluster welding (`--no-weld`).
 
 mod support;
 mod swing_inputs;
@@ -229,8 +230,13 @@ fn main() {
         }
         println!("  cluster pairs within 2 edges of {p:.3}: {pairs}");
     }
-    if let Some(p) = shown.first() {
-        local_dump(&reference, &input, &out, *p);
+    // `DIAG_AT=x,y,z` dumps around that point instead of the worst place.
+    let at = std::env::var("DIAG_AT").ok().and_then(|s| {
+        let v: Vec<f64> = s.split(',').filter_map(|x| x.trim().parse().ok()).collect();
+        (v.len() == 3).then(|| glam::DVec3::new(v[0], v[1], v[2]))
+    });
+    if let Some(p) = at.or(shown.first().copied()) {
+        local_dump(&reference, &input, &out, p);
     }
 }
 
