@@ -24,8 +24,8 @@ pub struct SharpenArgs {
     #[arg(long, default_value = "extended")]
     method: String,
     /// extended: do not weld the clusters of near-coincident vertices joined by zero-area
-    /// triangles (marching cubes' output); welded vertices otherwise stay at their index, used
-    /// by no triangle.
+    /// triangles (marching cubes' output) that keep a chamfer from being cut; welded vertices
+    /// otherwise stay at their index, used by no triangle.
     #[arg(long)]
     no_weld: bool,
     /// normal-filter: neighbourhood radius in mean edge lengths (a little more than the widest

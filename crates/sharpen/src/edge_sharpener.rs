@@ -142,6 +142,9 @@ pub(crate) struct Scratch {
     pub region_turn: Vec<f32>,
     pub region_start: Vec<u32>,
     pub region_angles: Vec<f32>,
+    /// Extended method: input slivers (by triangle) with a long edge that is a chamfer edge
+    /// the sliver keeps from splitting (`crate::weld`).
+    pub blocked: Vec<u32>,
 }
 
 fn reset<T: Clone>(v: &mut Vec<T>, n: usize, x: T) {
@@ -218,47 +221,61 @@ impl EdgeSharpener {
                 count: mesh.positions.len() + 2 * mesh.triangles.len(),
             }));
         }
-        let welded = if self.options.method == Method::Extended
-            && self.options.weld_clusters
-            && !crate::extended::is_surface_sampling(mesh)
-        {
-            crate::weld::weld_clusters(mesh, &table, self.options.min_angle_degrees.to_radians())
-                .and_then(|w| {
-                    // The merge checks keep the manifold; the full check comes with the table
-                    // the run needs anyway.
-                    let welded_table = CornerTable::new(&w.mesh).ok()?;
-                    Some((w, welded_table))
-                })
+        let mut run = Run::new(
+            mesh,
+            &table,
+            &self.options,
+            &mut self.scratch,
+            report.clone(),
+        );
+        run.detect_chamfers();
+        let mut slivers = if self.options.method == Method::Extended && self.options.weld_clusters {
+            std::mem::take(&mut run.s.blocked)
         } else {
-            None
+            Vec::new()
         };
-        let mut result = None;
-        if let Some((w, welded_table)) = &welded {
-            let welded_report = SharpenReport {
-                welded_vertices: w.merged,
-                ..report.clone()
-            };
-            let mut run = Run::new(
-                &w.mesh,
-                welded_table,
-                &self.options,
-                &mut self.scratch,
-                welded_report,
-            );
-            let (out, mut parents, tags) = run.run();
-            // Nothing sharpened: the input comes back as it was, unwelded (below).
-            if run.report.new_vertices > 0 || run.report.moved_input_vertices > 0 {
+        slivers.sort_unstable();
+        slivers.dedup();
+        let welded = if slivers.is_empty() {
+            None
+        } else {
+            crate::weld::weld_clusters(
+                mesh,
+                &table,
+                &slivers,
+                self.options.min_angle_degrees.to_radians(),
+            )
+            .and_then(|w| {
+                // The merge checks keep the manifold; the full check comes with the table
+                // the second run needs anyway.
+                let welded_table = CornerTable::new(&w.mesh).ok()?;
+                Some((w, welded_table))
+            })
+        };
+        let (out, parents, tags, mut report) = match &welded {
+            None => {
+                run.finish_detection();
+                let (out, parents, tags) = run.after_detect();
+                (out, parents, tags, run.report)
+            }
+            Some((w, welded_table)) => {
+                // The whole run again on the welded mesh: the welds change the triangles,
+                // so the smooth threshold, the regions and the labels may change too.
+                let welded_report = SharpenReport {
+                    welded_vertices: w.merged,
+                    ..report
+                };
+                let mut run = Run::new(
+                    &w.mesh,
+                    welded_table,
+                    &self.options,
+                    &mut self.scratch,
+                    welded_report,
+                );
+                let (out, mut parents, tags) = run.run();
                 for p in &mut parents {
                     *p = FaceId(w.input_triangle[p.index()]);
                 }
-                result = Some((out, parents, tags, run.report));
-            }
-        }
-        let (out, parents, tags, mut report) = match result {
-            Some(r) => r,
-            None => {
-                let mut run = Run::new(mesh, &table, &self.options, &mut self.scratch, report);
-                let (out, parents, tags) = run.run();
                 (out, parents, tags, run.report)
             }
         };
@@ -351,6 +368,11 @@ impl<'a> Run<'a> {
 
     fn run(&mut self) -> (Mesh, Vec<FaceId>, SharpTags) {
         self.detect();
+        self.after_detect()
+    }
+
+    /// Everything after [`Run::detect`].
+    fn after_detect(&mut self) -> (Mesh, Vec<FaceId>, SharpTags) {
         self.insert_vertices();
         self.reset_reference_normals();
         self.settle_positions();
@@ -363,14 +385,22 @@ impl<'a> Run<'a> {
 
     /// Smooth edges, the filters, the extended classification, chamfer edges and corner
     /// triangles.
-    #[inline(never)] // one call per run; kept out of line so profiles show it
     fn detect(&mut self) {
+        self.detect_chamfers();
+        self.finish_detection();
+    }
+
+    /// [`Run::detect`] up to the chamfer edges and corner triangles, and the slivers that
+    /// keep a chamfer edge from splitting (which decide whether the input is welded first).
+    #[inline(never)] // one call per run; kept out of line so profiles show it
+    fn detect_chamfers(&mut self) {
         let nt = self.mesh.triangles.len();
         let nc = 3 * nt;
         let nv = self.mesh.positions.len();
         reset(&mut self.s.cflags, nc, 0);
         reset(&mut self.s.vflags, nv, 0);
         reset(&mut self.s.tflags, nt, 0);
+        self.s.blocked.clear();
         self.positions.clear();
         self.positions.reserve(nv + nt / 8);
         self.positions.extend_from_slice(&self.mesh.positions);
@@ -380,6 +410,11 @@ impl<'a> Run<'a> {
             self.extend_detection();
         }
         self.chamfer_edges();
+    }
+
+    /// The rest of [`Run::detect`]: the extended method's corner vertices and idle splits.
+    #[inline(never)] // one call per run; kept out of line so profiles show it
+    fn finish_detection(&mut self) {
         if self.opts.method == Method::Extended {
             let moved = crate::extended::corner_vertices(self);
             if !moved.is_empty() {
@@ -596,7 +631,7 @@ impl<'a> Run<'a> {
             } else {
                 self.s.vflags[a as usize] & V_RED != 0 && self.s.vflags[b as usize] & V_RED != 0
             };
-            if is_blue && !self.split_blocked(c) && !self.split_blocked(o.index()) {
+            if is_blue && self.split_allowed(c, o.index()) {
                 self.s.cflags[c] |= C_BLUE;
                 self.s.cflags[o.index()] |= C_BLUE;
                 blue += 1;
@@ -681,6 +716,22 @@ impl<'a> Run<'a> {
             })
             .count();
         self.report.corner_triangles = self.s.tflags.iter().filter(|&&f| f & T_GREEN != 0).count();
+    }
+
+    /// Whether the chamfer edge between corners `c` and `o` may be split: neither of its
+    /// triangles is an input sliver it is a long edge of. The extended method lists the
+    /// slivers that refuse it for [`crate::weld`].
+    fn split_allowed(&mut self, c: usize, o: usize) -> bool {
+        let mut allowed = true;
+        for x in [c, o] {
+            if self.split_blocked(x) {
+                allowed = false;
+                if self.opts.method == Method::Extended {
+                    self.s.blocked.push((x / 3) as u32);
+                }
+            }
+        }
+        allowed
     }
 
     /// True when the edge opposite corner `c` is a long edge of an input sliver (a triangle

@@ -80,8 +80,8 @@ pub struct SharpenOptions {
     /// Normal filter: the neighbourhood flood does not cross an edge whose normals' dot product
     /// is `lambda` or less (an edge that is already sharp). In `[-1, 1]`.
     pub lambda: f64,
-    /// Extended method: weld marching cubes' clusters of near-coincident input vertices
-    /// (joined by slivers) before detection, unless the input is a surface sampling
+    /// Extended method: weld marching cubes' clusters of near-coincident input vertices whose
+    /// slivers keep a chamfer edge from splitting, then run again on the welded mesh
     /// (docs/sharpen.md, "What we extend", step 10); welded vertices stay at their indices,
     /// used by no triangle. Default on.
     pub weld_clusters: bool,
@@ -139,7 +139,7 @@ impl SharpenOptions {
         self
     }
 
-    /// Sets whether the extended method welds marching cubes' vertex clusters.
+    /// Sets whether the extended method welds the vertex clusters that block chamfers.
     pub const fn with_weld_clusters(mut self, weld: bool) -> Self {
         self.weld_clusters = weld;
         self

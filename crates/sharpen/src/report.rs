@@ -102,9 +102,9 @@ pub struct SharpenReport {
     pub moved_input_vertices: usize,
     /// Triangles removed by the sliver pass's edge collapses.
     pub collapsed_triangles: usize,
-    /// Extended method: input vertices welded into a near-coincident neighbour (marching
-    /// cubes' clusters; docs/sharpen.md, "What we extend", step 10). They keep their index,
-    /// used by no triangle.
+    /// Extended method: input vertices welded into a near-coincident neighbour because their
+    /// cluster's slivers kept a chamfer edge from splitting (docs/sharpen.md, "What we extend",
+    /// step 10). They keep their index, used by no triangle.
     pub welded_vertices: usize,
     /// Subdivided triangles the sliver pass restored to their input triangles (docs/sharpen.md,
     /// "The sliver pass").

@@ -8,13 +8,15 @@
 //! crease keeps a gap there and the max error sits in it. Welding each cluster into one vertex
 //! removes the slivers and lets the chamfer be cut.
 //!
-//! A cluster is seeded by a *sliver* (an angle under the sliver threshold) with an edge shorter
-//! than [`CLUSTER_EDGE`] mean edge lengths, and holds the vertices joined to that edge by such
-//! short edges. Its vertices merge into the lowest-numbered one, which keeps its position; the
-//! others stay at their indices with no triangle using them (the output promise "input vertex
-//! `i` is output vertex `i`" holds), and the triangles that had two of them disappear. A
-//! cluster is left alone when it touches the boundary, when the merge would break the manifold
-//! around it, or when a changed triangle would be a sliver.
+//! Only the clusters whose slivers keep a chamfer edge from splitting are welded (the
+//! engine's first detection lists them), so smooth regions and meshes without chamfers
+//! (already sharp ones) are never touched. A cluster holds the vertices joined to such a
+//! sliver's shortest edge by edges shorter than [`CLUSTER_EDGE`] mean edge lengths. Its
+//! vertices merge into the one whose position turns the remapped triangles least; the others
+//! stay at their indices with no triangle using them (the output promise "input vertex `i` is
+//! output vertex `i`" holds), and the triangles that had two of them disappear. A cluster is
+//! left alone when it touches the boundary, when the merge would break the manifold around
+//! it, or when a changed triangle would be a sliver.
 
 use whet_mesh::{CornerTable, Mesh, VertexId};
 
@@ -34,9 +36,16 @@ pub(crate) struct Welded {
     pub merged: usize,
 }
 
-/// Welds the clusters of `mesh` (whose table is `table`) seeded by slivers, triangles with an
-/// angle under `min_angle` (radians). `None` when no cluster could be welded.
-pub(crate) fn weld_clusters(mesh: &Mesh, table: &CornerTable, min_angle: f64) -> Option<Welded> {
+/// Welds the clusters of `mesh` (whose table is `table`) seeded by the input triangles
+/// `slivers` (each one's shortest edge, if under [`CLUSTER_EDGE`] mean edges); `min_angle`
+/// (radians) is the sliver threshold no changed triangle may fall under. `None` when no
+/// cluster could be welded.
+pub(crate) fn weld_clusters(
+    mesh: &Mesh,
+    table: &CornerTable,
+    slivers: &[u32],
+    min_angle: f64,
+) -> Option<Welded> {
     let nv = mesh.positions.len();
     let limit = CLUSTER_EDGE * mean_edge_length(mesh, table);
     // Also refuses a NaN length (no finite mean edge).
@@ -54,10 +63,10 @@ pub(crate) fn weld_clusters(mesh: &Mesh, table: &CornerTable, min_angle: f64) ->
     let mut merged = 0usize;
     let mut cluster: Vec<u32> = Vec::new();
     let mut around: Vec<u32> = Vec::new();
-    for (t, tri) in mesh.triangles.iter().enumerate() {
-        // The shortest edge first (three squared lengths: most triangles stop here), then the
-        // sliver test.
-        let p = mesh.triangle_positions(t);
+    for &t in slivers {
+        let tri = mesh.triangles[t as usize];
+        let p = mesh.triangle_positions(t as usize);
+        // The sliver's shortest edge.
         let (a, b, d) = (0..3)
             .map(|k| {
                 (
@@ -73,7 +82,7 @@ pub(crate) fn weld_clusters(mesh: &Mesh, table: &CornerTable, min_angle: f64) ->
                     m
                 }
             });
-        if d >= limit2 || crate::edge_sharpener::min_angle(&p) >= min_angle {
+        if d >= limit2 {
             continue;
         }
         if rep.is_empty() {
@@ -108,7 +117,6 @@ pub(crate) fn weld_clusters(mesh: &Mesh, table: &CornerTable, min_angle: f64) ->
             // On the boundary (welding would change it), or not a marching-cubes cluster.
             continue;
         }
-        let root = *cluster.iter().min().unwrap_or(&a);
         around.clear();
         for &v in &cluster {
             around.extend(table.vertex_corners(VertexId(v)).map(|c| c.0 / 3));
@@ -116,6 +124,18 @@ pub(crate) fn weld_clusters(mesh: &Mesh, table: &CornerTable, min_angle: f64) ->
         around.sort_unstable();
         around.dedup();
         around.retain(|&t| alive[t as usize]);
+        // The member whose position turns the remapped triangles least.
+        let mut best = (f64::INFINITY, a);
+        for &r in &cluster {
+            for &v in &cluster {
+                rep[v as usize] = r;
+            }
+            let turn = largest_turn(mesh, &rep, &around);
+            if turn < best.0 || (turn == best.0 && r < best.1) {
+                best = (turn, r);
+            }
+        }
+        let root = best.1;
         for &v in &cluster {
             rep[v as usize] = root;
         }
@@ -149,6 +169,28 @@ pub(crate) fn weld_clusters(mesh: &Mesh, table: &CornerTable, min_angle: f64) ->
         input_triangle,
         merged,
     })
+}
+
+/// The largest angle by which merging (per `rep`) turns the normal of a triangle of `around`
+/// that keeps three distinct vertices.
+fn largest_turn(mesh: &Mesh, rep: &[u32], around: &[u32]) -> f64 {
+    let mut worst: f64 = 0.0;
+    for &t in around {
+        let before = mesh.triangles[t as usize];
+        let after = before.map(|v| rep[v as usize]);
+        if after == before || after[0] == after[1] || after[1] == after[2] || after[2] == after[0] {
+            continue;
+        }
+        let normal = |tri: [u32; 3]| {
+            let [p0, p1, p2] = tri.map(|v| mesh.positions[v as usize]);
+            (p1 - p0).cross(p2 - p0)
+        };
+        let (n0, n1) = (normal(before), normal(after));
+        if n0.length_squared() > 0.0 && n1.length_squared() > 0.0 {
+            worst = worst.max(n0.angle_between(n1));
+        }
+    }
+    worst
 }
 
 /// Mean length of the edges of `mesh`, each once (the table pairs them; `Mesh`'s own mean
@@ -273,18 +315,26 @@ mod tests {
         (Mesh::new(positions, triangles), sliver)
     }
 
+    /// Every triangle as a seed (the engine passes only the slivers that block a chamfer).
+    fn all(mesh: &Mesh) -> Vec<u32> {
+        (0..mesh.triangles.len() as u32).collect()
+    }
+
     #[test]
-    fn a_cluster_welds_into_its_lowest_vertex() {
+    fn a_cluster_welds_into_one_of_its_vertices() {
         let (mesh, _) = split_bipyramid();
         let table = CornerTable::new(&mesh).unwrap();
-        let w = weld_clusters(&mesh, &table, 1f64.to_radians()).unwrap();
+        let w = weld_clusters(&mesh, &table, &all(&mesh), 1f64.to_radians()).unwrap();
         assert_eq!(w.merged, 1);
-        // The two slivers are gone; every other triangle is kept, vertex 8 now 0.
+        // The two slivers are gone; every other triangle is kept, with one apex for both.
         assert_eq!(w.mesh.triangles.len(), mesh.triangles.len() - 2);
         assert_eq!(w.input_triangle, (0..12).collect::<Vec<u32>>());
-        assert!(w.mesh.triangles.iter().all(|t| !t.contains(&8)));
-        assert_eq!(w.mesh.triangles[9], [0, 5, 6]);
-        // Positions untouched: vertex 8 keeps its index and place, used by no triangle.
+        let uses = |v: u32| w.mesh.triangles.iter().filter(|t| t.contains(&v)).count();
+        let (kept, gone) = if uses(8) == 0 { (0, 8) } else { (8, 0) };
+        assert_eq!((uses(kept), uses(gone)), (6, 0));
+        assert_eq!(w.mesh.triangles[9], [kept, 5, 6]);
+        // Positions untouched: the merged vertex keeps its index and place, used by no
+        // triangle.
         assert_eq!(w.mesh.positions, mesh.positions);
         CornerTable::new(&w.mesh).unwrap();
     }
@@ -297,9 +347,9 @@ mod tests {
         let mut far = mesh.clone();
         far.positions[8] = DVec3::new(0.2, 0.0, 1.0);
         let far_table = CornerTable::new(&far).unwrap();
-        assert!(weld_clusters(&far, &far_table, 1f64.to_radians()).is_none());
+        assert!(weld_clusters(&far, &far_table, &all(&far), 1f64.to_radians()).is_none());
         // A minimum angle no remapped triangle meets refuses the merge.
-        assert!(weld_clusters(&mesh, &table, 50f64.to_radians()).is_none());
+        assert!(weld_clusters(&mesh, &table, &all(&mesh), 50f64.to_radians()).is_none());
         // A tetrahedron with two coincident vertices: merging them leaves a two-triangle
         // pillow, which is refused.
         let tet = Mesh::new(
@@ -307,7 +357,7 @@ mod tests {
             vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]],
         );
         let tet_table = CornerTable::new(&tet).unwrap();
-        assert!(weld_clusters(&tet, &tet_table, 1f64.to_radians()).is_none());
+        assert!(weld_clusters(&tet, &tet_table, &all(&tet), 1f64.to_radians()).is_none());
     }
 
     #[test]
@@ -316,13 +366,13 @@ mod tests {
         // Open the bottom: the equator becomes a boundary, but the apex cluster is inside.
         mesh.triangles.drain(0..6);
         let table = CornerTable::new(&mesh).unwrap();
-        let w = weld_clusters(&mesh, &table, 1f64.to_radians()).unwrap();
+        let w = weld_clusters(&mesh, &table, &all(&mesh), 1f64.to_radians()).unwrap();
         assert_eq!(w.merged, 1);
         // A cluster on the boundary: split an equator vertex instead.
         let (mut open, _) = split_bipyramid();
         open.triangles.drain(0..6);
         open.triangles.retain(|t| !t.contains(&2));
         let table = CornerTable::new(&open).unwrap();
-        assert!(weld_clusters(&open, &table, 1f64.to_radians()).is_none());
+        assert!(weld_clusters(&open, &table, &all(&open), 1f64.to_radians()).is_none());
     }
 }

@@ -203,4 +203,19 @@ fn issue6_welding_clears_the_cluster_gaps() {
     // The papers' method never welds.
     let papers = sharpen(&input, &SharpenOptions::PAPERS).unwrap();
     assert_eq!(papers.report.welded_vertices, 0);
+    // Only clusters at a chamfer are welded: a smooth marching-cubes sphere has clusters
+    // too, and welding them would join triangles across its slivers at angles above the
+    // smooth threshold (a sphere at resolution 100 got 207 spurious sharp tags that way, with
+    // every cluster welded); it comes out exactly as without welding.
+    let sphere = marching_cubes(
+        &Shape::new(ShapeKind::Sphere, &ShapeParams::default()).unwrap(),
+        48,
+    )
+    .unwrap();
+    let (a, b) = (
+        sharpen(&sphere, &SharpenOptions::DEFAULT).unwrap(),
+        sharpen(&sphere, &SharpenOptions::DEFAULT.with_weld_clusters(false)).unwrap(),
+    );
+    assert_eq!(a.report.welded_vertices, 0);
+    assert_eq!((a.mesh, a.tags), (b.mesh, b.tags));
 }
