@@ -47,7 +47,7 @@ pub(crate) fn weld_clusters(
     min_angle: f64,
 ) -> Option<Welded> {
     let nv = mesh.positions.len();
-    let limit = CLUSTER_EDGE * mean_edge_length(mesh, table);
+    let limit = CLUSTER_EDGE * table.mean_edge_length(&mesh.positions);
     // Also refuses a NaN length (no finite mean edge).
     if limit.is_nan() || limit <= 0.0 {
         return None;
@@ -66,22 +66,9 @@ pub(crate) fn weld_clusters(
     for &t in slivers {
         let tri = mesh.triangles[t as usize];
         let p = mesh.triangle_positions(t as usize);
-        // The sliver's shortest edge.
-        let (a, b, d) = (0..3)
-            .map(|k| {
-                (
-                    tri[k],
-                    tri[(k + 1) % 3],
-                    p[k].distance_squared(p[(k + 1) % 3]),
-                )
-            })
-            .fold((tri[0], tri[1], f64::INFINITY), |m, e| {
-                if e.2 < m.2 {
-                    e
-                } else {
-                    m
-                }
-            });
+        // The sliver's shortest edge, opposite its smallest angle.
+        let (k, lengths) = crate::edge_sharpener::smallest_angle_corner(&p);
+        let (a, b, d) = (tri[(k + 1) % 3], tri[(k + 2) % 3], lengths[k]);
         if d >= limit2 {
             continue;
         }
@@ -191,30 +178,6 @@ fn largest_turn(mesh: &Mesh, rep: &[u32], around: &[u32]) -> f64 {
         }
     }
     worst
-}
-
-/// Mean length of the edges of `mesh`, each once (the table pairs them; `Mesh`'s own mean
-/// hashes every edge, a third of a sharpening's time on marching cubes).
-fn mean_edge_length(mesh: &Mesh, table: &CornerTable) -> f64 {
-    let opposite = table.opposites();
-    let (mut sum, mut count) = (0.0, 0usize);
-    for (t, tri) in mesh.triangles.iter().enumerate() {
-        for k in 0..3 {
-            let c = 3 * t + k;
-            // Each interior edge from its lower corner, each boundary edge once.
-            if opposite[c] != u32::MAX && (opposite[c] as usize) < c {
-                continue;
-            }
-            let (a, b) = (tri[(k + 1) % 3], tri[(k + 2) % 3]);
-            sum += mesh.positions[a as usize].distance(mesh.positions[b as usize]);
-            count += 1;
-        }
-    }
-    if count == 0 {
-        0.0
-    } else {
-        sum / count as f64
-    }
 }
 
 /// Whether merging (per `rep`) leaves the triangles `around` (every live triangle touching
