@@ -231,6 +231,66 @@ impl CornerTable {
         Ok(table)
     }
 
+    /// Builds the table from the arrays of a checked table whose corners and vertices were
+    /// renumbered (each triangle keeping its corners' rotation), as the Edgebreaker encoder
+    /// relabels its input in traversal order. Such arrays are consistent by construction, so
+    /// only what keeps every access in bounds is checked (array lengths, vertex indices,
+    /// opposite indices): a sequential pass instead of [`CornerTable::from_raw`]'s random
+    /// reads of each opposite's triangle. Start corners are picked by `from_raw`'s rule, so
+    /// for consistent arrays the two give the same table. Inconsistent arrays give a table
+    /// whose walks are wrong but bounded, never an out-of-bounds access.
+    pub fn from_relabelled(
+        corner_vertex: Vec<u32>,
+        opposite: Vec<u32>,
+        vertex_count: usize,
+    ) -> Result<CornerTable, MeshError> {
+        let nc = corner_vertex.len();
+        if nc % 3 != 0 || opposite.len() != nc || nc >= NONE as usize {
+            return Err(MeshError::TooLarge {
+                what: "corner arrays of unequal length",
+                count: nc,
+            });
+        }
+        if vertex_count >= NONE as usize {
+            return Err(MeshError::TooLarge {
+                what: "vertex count",
+                count: vertex_count,
+            });
+        }
+        let mut vertex_corner = vec![NONE; vertex_count];
+        for (t, (tv, to)) in corner_vertex
+            .chunks_exact(3)
+            .zip(opposite.chunks_exact(3))
+            .enumerate()
+        {
+            for j in 0..3 {
+                let v = tv[j];
+                let Some(slot) = vertex_corner.get_mut(v as usize) else {
+                    return Err(MeshError::IndexOutOfRange {
+                        triangle: t as u32,
+                        index: v,
+                        vertex_count: vertex_count as u32,
+                    });
+                };
+                if to[j] != NONE && to[j] as usize >= nc {
+                    return Err(MeshError::TooLarge {
+                        what: "opposite corner index",
+                        count: to[j] as usize,
+                    });
+                }
+                // from_raw's rule: the first corner, or one whose edge behind is open.
+                if *slot == NONE || to[(j + 2) % 3] == NONE {
+                    *slot = (3 * t + j) as u32;
+                }
+            }
+        }
+        Ok(CornerTable {
+            corner_vertex,
+            opposite,
+            vertex_corner,
+        })
+    }
+
     /// Builds the table from corner vertices and opposites that are already paired (a
     /// decoder that rebuilt them itself), checking that they are consistent: indices in
     /// range, no repeated vertex in a triangle, opposites mutual and facing the same edge
@@ -924,7 +984,26 @@ mod tests {
                 nv,
                 true,
             );
-            proptest::prop_assert_eq!(raw, Ok(t));
+            proptest::prop_assert_eq!(raw, Ok(t.clone()));
+            // Arrays of a checked table: the sequential constructor picks the same starts.
+            let relabelled = CornerTable::from_relabelled(
+                t.corner_vertices().to_vec(),
+                t.opposites().to_vec(),
+                nv,
+            );
+            proptest::prop_assert_eq!(relabelled, Ok(t));
         }
+    }
+
+    #[test]
+    fn from_relabelled_refuses_what_would_index_out_of_bounds() {
+        let t = CornerTable::from_triangles(&[[0, 1, 2], [0, 2, 3]], 4).unwrap();
+        let (cv, opp) = (t.corner_vertices().to_vec(), t.opposites().to_vec());
+        assert!(CornerTable::from_relabelled(cv.clone(), opp.clone(), 3).is_err());
+        let mut bad = opp.clone();
+        bad[0] = 6;
+        assert!(CornerTable::from_relabelled(cv.clone(), bad, 4).is_err());
+        assert!(CornerTable::from_relabelled(cv[..5].to_vec(), opp[..5].to_vec(), 4).is_err());
+        assert!(CornerTable::from_relabelled(cv, opp[..3].to_vec(), 4).is_err());
     }
 }
