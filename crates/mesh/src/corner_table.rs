@@ -244,19 +244,7 @@ impl CornerTable {
         opposite: Vec<u32>,
         vertex_count: usize,
     ) -> Result<CornerTable, MeshError> {
-        let nc = corner_vertex.len();
-        if nc % 3 != 0 || opposite.len() != nc || nc >= NONE as usize {
-            return Err(MeshError::TooLarge {
-                what: "corner arrays of unequal length",
-                count: nc,
-            });
-        }
-        if vertex_count >= NONE as usize {
-            return Err(MeshError::TooLarge {
-                what: "vertex count",
-                count: vertex_count,
-            });
-        }
+        let nc = check_corner_arrays(&corner_vertex, &opposite, vertex_count)?;
         let mut vertex_corner = vec![NONE; vertex_count];
         for (t, (tv, to)) in corner_vertex
             .chunks_exact(3)
@@ -303,19 +291,7 @@ impl CornerTable {
         vertex_count: usize,
         check_fans: bool,
     ) -> Result<CornerTable, MeshError> {
-        let nc = corner_vertex.len();
-        if nc % 3 != 0 || opposite.len() != nc {
-            return Err(MeshError::TooLarge {
-                what: "corner arrays of unequal length",
-                count: nc,
-            });
-        }
-        if vertex_count >= NONE as usize {
-            return Err(MeshError::TooLarge {
-                what: "vertex count",
-                count: vertex_count,
-            });
-        }
+        let nc = check_corner_arrays(&corner_vertex, &opposite, vertex_count)?;
         // One pass over the triangles: vertex indices, repeated vertices, and each corner's
         // opposite (mutual, facing the same edge reversed); without the fan check the start
         // corners are picked on the way.
@@ -710,6 +686,30 @@ fn next_raw(c: usize) -> usize {
     } else {
         c + 1
     }
+}
+
+/// The sizes [`CornerTable::from_raw`] and [`CornerTable::from_relabelled`] accept: whole
+/// triangles, one opposite per corner, corner and vertex indices below the `NONE` marker.
+/// Returns the corner count.
+fn check_corner_arrays(
+    corner_vertex: &[u32],
+    opposite: &[u32],
+    vertex_count: usize,
+) -> Result<usize, MeshError> {
+    let nc = corner_vertex.len();
+    if nc % 3 != 0 || opposite.len() != nc || nc >= NONE as usize {
+        return Err(MeshError::TooLarge {
+            what: "corner arrays of unequal length",
+            count: nc,
+        });
+    }
+    if vertex_count >= NONE as usize {
+        return Err(MeshError::TooLarge {
+            what: "vertex count",
+            count: vertex_count,
+        });
+    }
+    Ok(nc)
 }
 
 #[inline]
