@@ -92,12 +92,7 @@ impl CornerTable {
                 count: nt,
             });
         }
-        if vertex_count >= NONE as usize {
-            return Err(MeshError::TooLarge {
-                what: "vertex count",
-                count: vertex_count,
-            });
-        }
+        check_vertex_count(vertex_count)?;
         let nc = 3 * nt;
         let mut corner_vertex = Vec::with_capacity(nc);
         // One pass over the triangles checks them, counts each vertex's corners and the edges
@@ -703,13 +698,19 @@ fn check_corner_arrays(
             count: nc,
         });
     }
+    check_vertex_count(vertex_count)?;
+    Ok(nc)
+}
+
+/// Refuses a vertex count whose indices would reach the `NONE` marker.
+fn check_vertex_count(vertex_count: usize) -> Result<(), MeshError> {
     if vertex_count >= NONE as usize {
         return Err(MeshError::TooLarge {
             what: "vertex count",
             count: vertex_count,
         });
     }
-    Ok(nc)
+    Ok(())
 }
 
 #[inline]
