@@ -397,7 +397,9 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh) -> CliResult {
                 "method": t.hint.name(),
                 "smooth_factor": t.smooth_factor,
                 "rms_error_pct": t.rms_pct,
+                "planar": t.planar,
             })).collect::<Vec<_>>(),
+            "planar_tolerance": out.planar_factor,
             "search": out.search.iter().map(|&(f, b)| json!([f, b])).collect::<Vec<_>>(),
             "angle_trials": out.angle_trials.iter().map(|t| json!({
                 "angle_bits": t.angle_bits,

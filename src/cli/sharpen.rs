@@ -76,6 +76,17 @@ pub fn run_sharpen(mesh: &Mesh, opts: &SharpenOptions) -> CliResult<Sharpened> {
     }
 }
 
+/// A swing stream's planar-region projection after sharpening (optional header field 25),
+/// applied to `sharpened`: the output of the stream's sharpening and of its filter for
+/// after sharpening (docs/swing.md section 2).
+pub fn flatten_stated_planes(header: &whet_format::Header, sharpened: &mut Mesh) -> CliResult {
+    if let Some((factor, bits)) = whet_codec::SharpenHint::planar_of(header) {
+        let opts = whet_sharpen::PlanarOptions::for_swing(bits, factor);
+        whet_sharpen::flatten_planar_regions(sharpened, &opts).map_err(Failure::input)?;
+    }
+    Ok(())
+}
+
 pub fn run(args: &SharpenArgs) -> CliResult {
     let mesh = read_mesh(&args.input, None)?;
     let opts = sharpen_options(&args.method, args.smooth_factor)?

@@ -366,10 +366,14 @@ fn decode_sharpen_follows_the_streams_hint() {
         "sharpened",
         "--json",
     ]);
-    // The encoder measured seven candidates and kept the lowest error it reports.
-    let trials = j["sharpen_trials"].as_array().unwrap();
+    // The encoder measured seven candidates and kept the lowest error; then the chosen
+    // sharpening once more with the planar-region projection, kept when it beat it.
+    let all = j["sharpen_trials"].as_array().unwrap();
+    let trials: Vec<_> = all.iter().filter(|t| t["planar"] == false).collect();
+    let planar: Vec<_> = all.iter().filter(|t| t["planar"] == true).collect();
     assert_eq!(trials.len(), 7, "{j}");
     let chosen = j["sharpen_method"].as_str().unwrap();
+    assert_eq!(planar.len(), usize::from(chosen != "none"), "{j}");
     let chosen_error = trials
         .iter()
         .find(|t| {
@@ -378,9 +382,24 @@ fn decode_sharpen_follows_the_streams_hint() {
         })
         .map(|t| t["rms_error_pct"].as_f64().unwrap())
         .unwrap();
-    assert_eq!(j["rms_error_pct"].as_f64().unwrap(), chosen_error);
+    let reported = j["rms_error_pct"].as_f64().unwrap();
+    match planar.first() {
+        Some(p) if !j["planar_tolerance"].is_null() => {
+            assert_eq!(j["planar_tolerance"].as_f64(), Some(1.0), "{j}");
+            assert_eq!(p["method"], chosen, "{j}");
+            let e = p["rms_error_pct"].as_f64().unwrap();
+            assert_eq!(reported, e, "{j}");
+            assert!(e < 0.995 * chosen_error, "{j}");
+        }
+        other => {
+            assert_eq!(reported, chosen_error, "{j}");
+            if let Some(p) = other {
+                assert!(p["rms_error_pct"].as_f64().unwrap() >= 0.995 * chosen_error);
+            }
+        }
+    }
     // A later candidate must win by the encoder's margin (0.5 %).
-    for t in trials {
+    for t in &trials {
         assert!(
             chosen_error * 0.995 <= t["rms_error_pct"].as_f64().unwrap(),
             "{j}"
@@ -462,4 +481,26 @@ fn decode_sharpen_follows_the_streams_hint() {
         );
         assert!(forced.0 == extended, "hint {code} with --method extended");
     }
+    // Header field 25 turns the planar-region projection on after the sharpening: the cube's
+    // faces are flat, so it moves vertices; `--no-surface-filter` leaves it out, as it does
+    // the filter for after sharpening.
+    for (factor, name) in [(None, "off"), (Some(100u64), "on")] {
+        let mut c = container.clone();
+        c.header = c
+            .header
+            .clone()
+            .with(whet_format::tag::SHARPEN_METHOD, 0u64);
+        c.header.remove(whet_format::tag::PLANAR_TOLERANCE);
+        if let Some(f) = factor {
+            c.header = c.header.clone().with(whet_format::tag::PLANAR_TOLERANCE, f);
+        }
+        let path = dir.join(format!("planar-{name}.whet"));
+        std::fs::write(&path, c.to_bytes().unwrap()).unwrap();
+    }
+    let (off, on) = (dir.join("planar-off.whet"), dir.join("planar-on.whet"));
+    let sharpened_off = decode(&off, &["--sharpen"], "po.off").0;
+    let sharpened_on = decode(&on, &["--sharpen"], "pn.off").0;
+    assert!(sharpened_on != sharpened_off, "field 25 moved nothing");
+    let raw = ["--sharpen", "--no-surface-filter"];
+    assert!(decode(&off, &raw, "ro.off").0 == decode(&on, &raw, "rn.off").0);
 }

@@ -86,6 +86,24 @@ impl SharpenHint {
         Some((hint, Self::smooth_factor_of(header).unwrap_or(2.0)))
     }
 
+    /// The planar-region projection a swing stream's header states for after sharpening
+    /// (field 25): its tolerance factor (the field's hundredths over 100, in angle steps)
+    /// and the stream's angle bits, for `whet_sharpen::PlanarOptions::for_swing`. `None`
+    /// without the field, for other modes, or with a value outside
+    /// [`Self::SMOOTH_FACTOR_HUNDREDTHS`] (the same 0.01 to 10 range).
+    pub fn planar_of(header: &whet_format::Header) -> Option<(f64, u32)> {
+        if header.mode != whet_format::Mode::Swing {
+            return None;
+        }
+        let factor = header
+            .get_u64(whet_format::tag::PLANAR_TOLERANCE)
+            .filter(|h| Self::SMOOTH_FACTOR_HUNDREDTHS.contains(h))?;
+        let bits = header
+            .get_u64(whet_format::tag::ANGLE_BITS)
+            .and_then(|b| u32::try_from(b).ok())?;
+        Some((factor as f64 / 100.0, bits))
+    }
+
     /// The hint a stream's header states: swing streams only, `None` without the field or
     /// with an unknown value.
     pub fn of(header: &whet_format::Header) -> Option<SharpenHint> {
@@ -101,6 +119,25 @@ impl SharpenHint {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn planar_tolerance_is_read_from_swing_headers_only_and_in_range() {
+        let swing = whet_format::Header::new(whet_format::Mode::Swing, 3, 1)
+            .with(whet_format::tag::ANGLE_BITS, 6u64);
+        assert_eq!(SharpenHint::planar_of(&swing), None);
+        let on = swing
+            .clone()
+            .with(whet_format::tag::PLANAR_TOLERANCE, 100u64);
+        assert_eq!(SharpenHint::planar_of(&on), Some((1.0, 6)));
+        for bad in [0u64, 1001] {
+            let h = swing.clone().with(whet_format::tag::PLANAR_TOLERANCE, bad);
+            assert_eq!(SharpenHint::planar_of(&h), None);
+        }
+        let exact = whet_format::Header::new(whet_format::Mode::Exact, 3, 1)
+            .with(whet_format::tag::ANGLE_BITS, 6u64)
+            .with(whet_format::tag::PLANAR_TOLERANCE, 100u64);
+        assert_eq!(SharpenHint::planar_of(&exact), None);
+    }
 
     #[test]
     fn codes_round_trip_and_unknown_codes_are_no_hint() {

@@ -164,9 +164,13 @@ pub mod tag {
     /// [`SHARPEN_METHOD`], in hundredths (swing; absent or outside 1..=1000: the decoder's
     /// default, 2).
     pub const SHARPEN_SMOOTH_FACTOR: u64 = 23;
+    /// u64 (format 1.2, optional): the planar-region projection a decoder applies after
+    /// sharpening (`whet decode --sharpen`), its tolerance in hundredths of the angle step
+    /// (swing; absent, or outside 1..=1000: none).
+    pub const PLANAR_TOLERANCE: u64 = 25;
 
     /// Every tag this crate knows, with its name and value type.
-    pub const KNOWN: [(u64, &str, ValueType); 13] = [
+    pub const KNOWN: [(u64, &str, ValueType); 14] = [
         (ENCODER, "encoder", ValueType::Bytes),
         (COMPONENT_COUNT, "component_count", ValueType::U64),
         (QUANT_BITS, "quant_bits", ValueType::U64),
@@ -192,6 +196,7 @@ pub mod tag {
             "sharpen_smooth_factor",
             ValueType::U64,
         ),
+        (PLANAR_TOLERANCE, "planar_tolerance", ValueType::U64),
     ];
 
     /// Name and type of a known tag.

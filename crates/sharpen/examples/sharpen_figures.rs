@@ -169,9 +169,10 @@ fn swing(only: Option<String>) {
                 let name = match s.sharpen_hint {
                     Some(SharpenHint::Unsharpened) => "none".to_string(),
                     h => format!(
-                        "{} {}",
+                        "{} {}{}",
                         h.map_or("extended", SharpenHint::name),
-                        s.smooth_factor
+                        s.smooth_factor,
+                        if s.planar { " + planes" } else { "" }
                     ),
                 };
                 let d = error(&s.original, &s.decode_sharpen(), samples());

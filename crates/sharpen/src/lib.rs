@@ -8,6 +8,8 @@
 //! algorithm alone, [`Method::Extended`] (the default) adds whet's extended chamfer detection.
 //! [`Method::NormalFilter`] is the normal-filtering sharpener of seed 002 (fillets, chamfers
 //! with samples, noisy creases; [`sharpen_region`] limits it to a [`VertexSelection`]).
+//! [`flatten_planar_regions`] moves the vertices inside a decoded mesh's flat faces onto
+//! their fitted planes (the swing decoder's quantization noise, which sharpening leaves).
 //! See `docs/sharpen.md` for the rules and the degenerate cases.
 //!
 //! ```
@@ -31,6 +33,7 @@ mod edge_sharpener;
 mod extended;
 mod normal_filter;
 mod options;
+mod planar;
 mod report;
 mod slivers;
 mod snap;
@@ -48,6 +51,7 @@ pub const PEAK_BYTES_PER_TRIANGLE: u64 = 200;
 
 pub use normal_filter::VertexSelection;
 pub use options::{Method, SharpenOptions};
+pub use planar::{flatten_planar_regions, PlanarOptions, PlanarReport};
 pub use report::{SharpenReport, UnmovedReason};
 pub use tags::SharpTags;
 

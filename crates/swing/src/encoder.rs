@@ -60,7 +60,15 @@ pub struct SharpenTrial {
     pub smooth_factor: f64,
     /// Measured symmetric RMS error of `whet decode --sharpen`'s output, % of the diagonal.
     pub rms_pct: f64,
+    /// With the planar-region projection after sharpening (optional header field 25, at
+    /// [`PLANAR_FACTOR`]): tried on the best sharpening only.
+    pub planar: bool,
 }
+
+/// The planar-region projection's tolerance, in angle steps, that the encoder tries after
+/// the best sharpening (`whet_sharpen::PlanarOptions::for_swing`; docs/swing.md section 2):
+/// 1 measured best of 0.3, 0.6 and 1 on the CAD fixtures of the sharpening figures.
+pub const PLANAR_FACTOR: f64 = 1.0;
 
 /// Options of [`SwingEncoder`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -231,6 +239,9 @@ pub struct SwingOutput {
     pub sharpen_hint: Option<SharpenHint>,
     /// The smooth factor that goes with [`Self::sharpen_hint`] (optional header field 23).
     pub sharpen_smooth_factor: Option<f64>,
+    /// The planar-region projection after sharpening the stream states (optional header
+    /// field 25: its tolerance in angle steps), when the encoder measured it better.
+    pub planar_factor: Option<f64>,
     /// The candidates of that choice with their measured symmetric RMS error (% of the
     /// diagonal; empty when no choice was made).
     pub sharpen_trials: Vec<SharpenTrial>,
@@ -412,6 +423,7 @@ impl SwingEncoder {
                 hint,
                 smooth_factor,
                 rms_pct: rms,
+                planar: false,
             };
             trials.push(trial);
             if best.as_ref().is_none_or(|(b, _)| rms < MARGIN * b.rms_pct) {
@@ -424,6 +436,7 @@ impl SwingEncoder {
             hint: SharpenHint::Unsharpened,
             smooth_factor: DEFAULT_SMOOTH_FACTOR,
             rms_pct: decoded,
+            planar: false,
         };
         trials.push(none);
         let (chosen_trial, stream) = match best {
@@ -443,6 +456,22 @@ impl SwingEncoder {
             None => out,
         };
         chosen.rms_pct = Some(chosen_trial.rms_pct);
+        if chosen_trial.hint != SharpenHint::Unsharpened {
+            // The planar-region projection after the chosen sharpening: the flat faces'
+            // quantization noise, which the sharpener leaves (docs/swing.md section 2).
+            let planar = restate_planar(chosen.clone(), PLANAR_FACTOR)?;
+            let opts = sharpen_options(chosen_trial.hint, chosen_trial.smooth_factor);
+            let rms = self.measure_as(prep, &planar, ErrorOf::Sharpened, &opts)?;
+            trials.push(SharpenTrial {
+                rms_pct: rms,
+                planar: true,
+                ..chosen_trial
+            });
+            if rms < MARGIN * chosen_trial.rms_pct {
+                chosen = planar;
+                chosen.rms_pct = Some(rms);
+            }
+        }
         chosen.sharpen_trials = trials;
         Ok(chosen)
     }
@@ -664,6 +693,7 @@ impl SwingEncoder {
                 sharpened_filter: info.sharpened_filter,
                 sharpen_hint: hint,
                 sharpen_smooth_factor: info.sharpen_smooth_factor,
+                planar_factor: None,
                 sharpen_trials: Vec::new(),
             });
         }
@@ -863,6 +893,13 @@ impl SwingEncoder {
                         sharpened = {
                             let mut m = s.mesh;
                             out.sharpened_filter.apply_after_sharpening(input, &mut m);
+                            if let Some(f) = out.planar_factor {
+                                let opts =
+                                    whet_sharpen::PlanarOptions::for_swing(out.angle_bits, f);
+                                // The sharpened mesh is a manifold; were it refused, the
+                                // decoder would keep it unprojected too.
+                                let _ = whet_sharpen::flatten_planar_regions(&mut m, &opts);
+                            }
                             m
                         };
                         &sharpened
@@ -1091,6 +1128,21 @@ fn sharpen_options(hint: SharpenHint, smooth_factor: f64) -> whet_sharpen::Sharp
 
 /// `out` with its stream's sharpening hint changed to `hint` (the field's value is one byte
 /// whatever the hint, so the size does not change).
+/// `out` with header field 25 stating the planar-region projection at `factor` angle steps.
+fn restate_planar(mut out: SwingOutput, factor: f64) -> Result<SwingOutput, Error> {
+    let code = SharpenHint::smooth_factor_code(factor)
+        .ok_or_else(|| Error::Internal(format!("planar factor {factor} out of range")))?;
+    let mut container = whet_format::parse(&out.bytes, &whet_codec::Limits::UNLIMITED)
+        .map_err(whet_codec::Error::from)?;
+    container.header = container
+        .header
+        .clone()
+        .with(whet_format::tag::PLANAR_TOLERANCE, code);
+    out.bytes = container.to_bytes().map_err(whet_codec::Error::from)?;
+    out.planar_factor = Some(factor);
+    Ok(out)
+}
+
 fn restate_hint(mut out: SwingOutput, hint: SharpenHint) -> Result<SwingOutput, Error> {
     let mut container = whet_format::parse(&out.bytes, &whet_codec::Limits::UNLIMITED)
         .map_err(whet_codec::Error::from)?;

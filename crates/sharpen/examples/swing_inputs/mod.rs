@@ -66,6 +66,8 @@ pub struct SwingInput {
     pub sharpen_hint: Option<whet_codec::SharpenHint>,
     /// Its smooth factor (2 when the stream names none).
     pub smooth_factor: f64,
+    /// The stream states the planar-region projection after sharpening (field 25).
+    pub planar: bool,
     /// The stream.
     pub bytes: Vec<u8>,
 }
@@ -74,8 +76,24 @@ impl SwingInput {
     /// What `whet decode --sharpen` writes for this stream (src/cli/decode.rs): the
     /// sharpening the stream names, then its filter for after sharpening on the vertices the
     /// sharpener left alone; for a stream naming none, the plain decoded mesh with its
-    /// surface filter.
+    /// surface filter; and the planar-region projection when the stream states it.
     pub fn decode_sharpen(&self) -> Mesh {
+        let mut m = self.decode_sharpen_unprojected();
+        if self.sharpen_hint == Some(whet_codec::SharpenHint::Unsharpened) {
+            return m;
+        }
+        let header = whet_format::parse(&self.bytes, &whet_format::Limits::UNLIMITED)
+            .unwrap_or_else(|e| panic!("{e}"))
+            .header;
+        if let Some((factor, bits)) = whet_codec::SharpenHint::planar_of(&header) {
+            let opts = whet_sharpen::PlanarOptions::for_swing(bits, factor);
+            whet_sharpen::flatten_planar_regions(&mut m, &opts).unwrap_or_else(|e| panic!("{e}"));
+        }
+        m
+    }
+
+    /// [`Self::decode_sharpen`] without the planar-region projection.
+    pub fn decode_sharpen_unprojected(&self) -> Mesh {
         let header = whet_format::parse(&self.bytes, &whet_format::Limits::UNLIMITED)
             .unwrap_or_else(|e| panic!("{e}"))
             .header;
@@ -104,7 +122,7 @@ pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
         .unwrap_or_else(|e| panic!("{name}: {e}"));
     let dir = whet_testkit::workspace_root().join("target/sharpen-swing");
     let _ = std::fs::create_dir_all(&dir);
-    let path = dir.join(format!("v4-{name}-{bpv}-{}.whet", angles.tag()));
+    let path = dir.join(format!("v5-{name}-{bpv}-{}.whet", angles.tag()));
     let bytes = match std::fs::read(&path) {
         Ok(b) => b,
         Err(_) => {
@@ -136,6 +154,7 @@ pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
             .map_or(0, |b| b as u32),
         sharpen_hint: whet_codec::SharpenHint::stated(&header).map(|s| s.0),
         smooth_factor: whet_codec::SharpenHint::stated(&header).map_or(2.0, |s| s.1),
+        planar: whet_codec::SharpenHint::planar_of(&header).is_some(),
         original,
         decoded,
         bytes,

@@ -273,33 +273,52 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
         let hint = out.sharpen_hint.unwrap();
         assert_ne!(hint, not, "{name}: {:?}", out.sharpen_trials);
         assert_eq!(SharpenHint::of(&header(&out.bytes)), Some(hint));
-        // The reported error is the chosen candidate's, the lowest of the seven but for the
-        // margin.
-        assert_eq!(out.sharpen_trials.len(), 7, "{name}");
+        // Seven candidates, then the chosen sharpening with the planar-region projection.
+        let (planar, trials): (Vec<&whet_swing::SharpenTrial>, Vec<_>) =
+            out.sharpen_trials.iter().partition(|t| t.planar);
+        assert_eq!(trials.len(), 7, "{name}");
+        assert_eq!(planar.len(), usize::from(hint != SharpenHint::Unsharpened));
+        let h = header(&out.bytes);
+        let stated = SharpenHint::planar_of(&h);
+        assert_eq!(stated.map(|s| s.0), out.planar_factor, "{name}");
+        // The reported error is the chosen candidate's (with the projection when it won by
+        // the margin), the lowest of the seven but for the margin.
         let chosen = out.rms_pct.unwrap();
+        let unprojected = match (out.planar_factor, planar.first()) {
+            (Some(f), Some(p)) => {
+                assert_eq!(f, whet_swing::PLANAR_FACTOR);
+                assert_eq!(p.rms_pct, chosen, "{name}");
+                let t = trials
+                    .iter()
+                    .find(|t| t.hint == hint && t.smooth_factor == p.smooth_factor)
+                    .unwrap();
+                assert!(chosen < 0.995 * t.rms_pct, "{name}");
+                t.rms_pct
+            }
+            (None, p) => {
+                if let Some(p) = p {
+                    assert!(p.rms_pct >= 0.995 * chosen, "{name}");
+                }
+                chosen
+            }
+            (Some(_), None) => panic!("{name}: projection stated without its trial"),
+        };
         assert!(
-            out.sharpen_trials
+            trials
                 .iter()
-                .any(|t| t.hint == hint && t.rms_pct == chosen),
+                .any(|t| t.hint == hint && t.rms_pct == unprojected),
             "{name}"
         );
         // A later candidate must win by the encoder's margin (0.5 %).
         assert!(
-            out.sharpen_trials
-                .iter()
-                .all(|t| chosen * 0.995 <= t.rms_pct),
+            trials.iter().all(|t| unprojected * 0.995 <= t.rms_pct),
             "{name}"
         );
         // The stream states the choice: method and factor.
-        let h = header(&out.bytes);
         let factor = SharpenHint::smooth_factor_of(&h);
         assert_eq!(factor, out.sharpen_smooth_factor, "{name}");
         if hint != SharpenHint::Unsharpened {
-            let t = out
-                .sharpen_trials
-                .iter()
-                .find(|t| t.rms_pct == chosen)
-                .unwrap();
+            let t = trials.iter().find(|t| t.rms_pct == unprojected).unwrap();
             assert_eq!(factor, Some(t.smooth_factor), "{name}");
         }
         // The stream decodes to the encoder's mesh and stays within the size target (the

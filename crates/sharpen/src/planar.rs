@@ -1,0 +1,465 @@
+//! Planar-region projection: after sharpening a swing-decoded CAD mesh, the vertices inside
+//! its flat faces still carry the swing angles' quantization noise, which EdgeSharpener
+//! leaves alone (it moves only chamfer vertices). This pass finds the regions of nearly
+//! parallel triangles, keeps those whose vertices a plane explains as well as a quadratic
+//! height field does (noise, not curvature), and moves the vertices inside them onto their
+//! least-squares plane. docs/sharpen.md, "Planar-region projection".
+
+use glam::DVec3;
+use whet_mesh::{CornerId, CornerTable, Mesh, VertexId};
+
+use crate::Error;
+
+/// Options of [`flatten_planar_regions`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct PlanarOptions {
+    /// Largest angle, in degrees, between a triangle's normal and the mean normal of the
+    /// region it joins (the region grows from the triangles whose neighbours agree best).
+    pub max_normal_angle_degrees: f64,
+    /// Largest RMS distance of a region's vertices to its plane, in mean edge lengths of
+    /// the mesh (the noise a plane may absorb); the largest distance may be three times it.
+    pub tolerance: f64,
+    /// Largest share of the plane's residual variance, relative to a quadratic height
+    /// field's, that curvature may explain: a region is planar when
+    /// `rms_plane^2 - rms_quadric^2 <= curvature_ratio * rms_quadric^2`.
+    pub curvature_ratio: f64,
+    /// Fewest triangles of a region that is projected (smaller ones cannot tell noise from
+    /// curvature).
+    pub min_triangles: usize,
+}
+
+impl PlanarOptions {
+    /// 10 degrees, tolerance 0.1 edge lengths, curvature ratio 0.25, 20 triangles.
+    pub const DEFAULT: PlanarOptions = PlanarOptions {
+        max_normal_angle_degrees: 10.0,
+        tolerance: 0.1,
+        curvature_ratio: 0.25,
+        min_triangles: 20,
+    };
+
+    /// The options with RMS tolerance `tolerance` (mean edge lengths).
+    pub const fn with_tolerance(self, tolerance: f64) -> PlanarOptions {
+        PlanarOptions { tolerance, ..self }
+    }
+
+    /// The options with curvature ratio `curvature_ratio`.
+    pub const fn with_curvature_ratio(self, curvature_ratio: f64) -> PlanarOptions {
+        PlanarOptions {
+            curvature_ratio,
+            ..self
+        }
+    }
+
+    /// The tolerance whet's swing decoder uses for a stream of `angle_bits` angle bits:
+    /// `factor` times the angle step `2 pi / 2^bits` (the size, in edge lengths, of the
+    /// displacement one quantization step makes).
+    pub fn swing_tolerance(angle_bits: u32, factor: f64) -> f64 {
+        factor * std::f64::consts::TAU / f64::from(1u32 << angle_bits.min(30))
+    }
+
+    /// The options for a swing stream of `angle_bits` angle bits whose header states the
+    /// tolerance `factor` (`whet_codec::SharpenHint::planar_of`).
+    pub fn for_swing(angle_bits: u32, factor: f64) -> PlanarOptions {
+        Self::DEFAULT.with_tolerance(Self::swing_tolerance(angle_bits, factor))
+    }
+
+    fn validate(&self) -> Result<(), Error> {
+        let ok = self.max_normal_angle_degrees > 0.0
+            && self.max_normal_angle_degrees < 90.0
+            && self.tolerance >= 0.0
+            && self.tolerance.is_finite()
+            && self.curvature_ratio >= 0.0
+            && self.curvature_ratio.is_finite();
+        if ok {
+            Ok(())
+        } else {
+            Err(Error::Parameter(format!(
+                "planar projection: angle {} (0..90), tolerance {} and curvature ratio {} \
+                 (finite, >= 0)",
+                self.max_normal_angle_degrees, self.tolerance, self.curvature_ratio
+            )))
+        }
+    }
+}
+
+impl Default for PlanarOptions {
+    fn default() -> Self {
+        Self::DEFAULT
+    }
+}
+
+/// What [`flatten_planar_regions`] did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct PlanarReport {
+    /// Regions grown (every triangle belongs to one).
+    pub regions: usize,
+    /// Regions found planar.
+    pub planar_regions: usize,
+    /// Triangles in planar regions.
+    pub planar_triangles: usize,
+    /// Vertices moved onto a plane.
+    pub moved_vertices: usize,
+}
+
+/// Moves every vertex whose triangles all lie in one planar region onto that region's
+/// least-squares plane (module docs). Boundary vertices and vertices that would move by
+/// more than half the mean edge length stay. Fails with [`Error::InvalidInput`] when `mesh`
+/// is not an oriented manifold with finite coordinates, [`Error::Parameter`] for options out
+/// of range.
+pub fn flatten_planar_regions(
+    mesh: &mut Mesh,
+    opts: &PlanarOptions,
+) -> Result<PlanarReport, Error> {
+    opts.validate()?;
+    if let Some(v) = mesh.positions.iter().position(|p| !p.is_finite()) {
+        return Err(Error::InvalidInput(
+            whet_mesh::MeshError::NonFiniteCoordinate { vertex: v as u32 },
+        ));
+    }
+    let table = CornerTable::new(mesh).map_err(Error::InvalidInput)?;
+    let p = &mesh.positions;
+    let nt = mesh.triangles.len();
+    let (normals, area): (Vec<DVec3>, Vec<f64>) = mesh
+        .triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|v| p[v as usize]);
+            let n = (b - a).cross(c - a);
+            (n.normalize_or_zero(), 0.5 * n.length())
+        })
+        .unzip();
+    let edge = table.mean_edge_length(p);
+    let table = &table;
+    let neighbours = |t: usize| {
+        (0..3).filter_map(move |k| {
+            table
+                .opposite(CornerId((3 * t + k) as u32))
+                .map(|o| o.index() / 3)
+        })
+    };
+    // Seeds: the triangles whose neighbours agree best with them first (a seed on noise
+    // would skew its region's mean normal); ties in triangle order.
+    let mut order: Vec<(f64, usize)> = (0..nt)
+        .map(|t| {
+            (
+                -neighbours(t)
+                    .map(|u| normals[t].dot(normals[u]))
+                    .sum::<f64>(),
+                t,
+            )
+        })
+        .collect();
+    order.sort_by(|a, b| a.0.total_cmp(&b.0));
+    const NONE: u32 = u32::MAX;
+    let cos_max = opts.max_normal_angle_degrees.to_radians().cos();
+    let mut region = vec![NONE; nt];
+    let mut planes: Vec<Option<(DVec3, f64)>> = Vec::new();
+    let mut report = PlanarReport::default();
+    let (mut stack, mut members, mut verts) = (Vec::new(), Vec::new(), Vec::new());
+    for &(_, seed) in &order {
+        if region[seed] != NONE {
+            continue;
+        }
+        let r = planes.len() as u32;
+        region[seed] = r;
+        let mut sum = normals[seed] * area[seed];
+        stack.clear();
+        stack.push(seed);
+        members.clear();
+        members.push(seed);
+        while let Some(t) = stack.pop() {
+            for u in neighbours(t) {
+                if region[u] == NONE && normals[u].dot(sum.normalize_or_zero()) >= cos_max {
+                    region[u] = r;
+                    sum += normals[u] * area[u];
+                    stack.push(u);
+                    members.push(u);
+                }
+            }
+        }
+        let normal = sum.normalize_or_zero();
+        let mut plane = None;
+        if members.len() >= opts.min_triangles && normal != DVec3::ZERO {
+            verts.clear();
+            verts.extend(members.iter().flat_map(|&t| mesh.triangles[t]));
+            verts.sort_unstable();
+            verts.dedup();
+            let pts: Vec<DVec3> = verts.iter().map(|&v| p[v as usize]).collect();
+            if let Some(fit) = fit_plane(&pts, normal) {
+                let tol = opts.tolerance * edge;
+                if fit.rms <= tol
+                    && fit.max <= 3.0 * tol
+                    && fit.rms * fit.rms - fit.quadric_rms * fit.quadric_rms
+                        <= opts.curvature_ratio * fit.quadric_rms * fit.quadric_rms
+                {
+                    plane = Some((normal, fit.offset));
+                    report.planar_regions += 1;
+                    report.planar_triangles += members.len();
+                }
+            }
+        }
+        planes.push(plane);
+    }
+    report.regions = planes.len();
+    let max_move = 0.5 * edge;
+    let mut moved = Vec::new();
+    'vertices: for v in 0..p.len() {
+        let vid = VertexId(v as u32);
+        if table.vertex_corner(vid).is_none() || table.is_boundary_vertex(vid) {
+            continue;
+        }
+        let mut only = NONE;
+        for c in table.vertex_corners(vid) {
+            let r = region[c.index() / 3];
+            if (only != NONE && r != only) || planes[r as usize].is_none() {
+                continue 'vertices;
+            }
+            only = r;
+        }
+        if let Some((n, d)) = planes[only as usize] {
+            let q = p[v] - n * (n.dot(p[v]) - d);
+            if q.distance(p[v]) <= max_move {
+                moved.push((v, q));
+            }
+        }
+    }
+    report.moved_vertices = moved.len();
+    for (v, q) in moved {
+        mesh.positions[v] = q;
+    }
+    Ok(report)
+}
+
+/// A plane fit of a region's vertices.
+struct PlaneFit {
+    /// `normal . x = offset` on the plane (through the vertices' centroid).
+    offset: f64,
+    /// RMS and largest distance of the vertices to the plane.
+    rms: f64,
+    max: f64,
+    /// RMS residual of the least-squares quadratic height field over the plane.
+    quadric_rms: f64,
+}
+
+/// Fits the plane with normal `normal` through the centroid of `pts`, and the quadratic
+/// height field `h = a u^2 + b uv + c v^2 + d u + e v + f` over it; `None` when the height
+/// field is undetermined (too few or collinear points).
+fn fit_plane(pts: &[DVec3], normal: DVec3) -> Option<PlaneFit> {
+    if pts.len() < 6 {
+        return None;
+    }
+    let centroid = pts.iter().copied().sum::<DVec3>() / pts.len() as f64;
+    let (eu, ev) = normal.any_orthonormal_pair();
+    let local: Vec<(f64, f64, f64)> = pts
+        .iter()
+        .map(|&x| {
+            let d = x - centroid;
+            (d.dot(eu), d.dot(ev), d.dot(normal))
+        })
+        .collect();
+    let (mut ss, mut max) = (0.0f64, 0.0f64);
+    for &(_, _, h) in &local {
+        ss += h * h;
+        max = max.max(h.abs());
+    }
+    let rms = (ss / pts.len() as f64).sqrt();
+    // Coordinates scaled to about 1 so the normal equations stay well conditioned.
+    let scale = local
+        .iter()
+        .map(|&(u, v, _)| u.abs().max(v.abs()))
+        .fold(0.0f64, f64::max);
+    if scale.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        return None;
+    }
+    let basis = |u: f64, v: f64| {
+        let (u, v) = (u / scale, v / scale);
+        [u * u, u * v, v * v, u, v, 1.0]
+    };
+    let mut m = [[0.0f64; 7]; 6];
+    for &(u, v, h) in &local {
+        let b = basis(u, v);
+        for i in 0..6 {
+            for j in 0..6 {
+                m[i][j] += b[i] * b[j];
+            }
+            m[i][6] += b[i] * h;
+        }
+    }
+    let coef = solve6(m)?;
+    let mut sq = 0.0;
+    for &(u, v, h) in &local {
+        let b = basis(u, v);
+        let f: f64 = b.iter().zip(&coef).map(|(x, c)| x * c).sum();
+        sq += (h - f) * (h - f);
+    }
+    let quadric_rms = (sq / pts.len() as f64).sqrt();
+    quadric_rms.is_finite().then_some(PlaneFit {
+        offset: normal.dot(centroid),
+        rms,
+        max,
+        quadric_rms,
+    })
+}
+
+/// Solves the 6x6 system of augmented matrix `m` by Gaussian elimination with partial
+/// pivoting; `None` when it is singular.
+fn solve6(mut m: [[f64; 7]; 6]) -> Option<[f64; 6]> {
+    let norm = m
+        .iter()
+        .flat_map(|r| r[..6].iter())
+        .fold(0.0f64, |a, x| a.max(x.abs()));
+    for col in 0..6 {
+        let pivot = (col..6).max_by(|&a, &b| m[a][col].abs().total_cmp(&m[b][col].abs()))?;
+        m.swap(col, pivot);
+        let d = m[col][col];
+        if d.abs().partial_cmp(&(1e-12 * norm)) != Some(std::cmp::Ordering::Greater) {
+            return None;
+        }
+        for r in 0..6 {
+            if r != col {
+                let f = m[r][col] / d;
+                for k in col..7 {
+                    m[r][k] -= f * m[col][k];
+                }
+            }
+        }
+    }
+    let mut x = [0.0; 6];
+    for i in 0..6 {
+        x[i] = m[i][6] / m[i][i];
+    }
+    x.iter().all(|v| v.is_finite()).then_some(x)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A `n` x `n` grid of unit cells bent along x into `z = bend * x^2`, its vertices
+    /// pushed along z by a deterministic pseudo-random `noise`.
+    fn grid(n: usize, bend: f64, noise: f64) -> Mesh {
+        let mut positions = Vec::new();
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        for j in 0..=n {
+            for i in 0..=n {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                let r = (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+                let x = i as f64;
+                positions.push(DVec3::new(x, j as f64, bend * x * x + noise * r));
+            }
+        }
+        let mut triangles = Vec::new();
+        let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+        for j in 0..n {
+            for i in 0..n {
+                triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+                triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+            }
+        }
+        Mesh::new(positions, triangles)
+    }
+
+    fn max_abs_z_interior(m: &Mesh, n: usize) -> f64 {
+        let mut worst = 0.0f64;
+        for j in 1..n {
+            for i in 1..n {
+                worst = worst.max(m.positions[j * (n + 1) + i].z.abs());
+            }
+        }
+        worst
+    }
+
+    #[test]
+    fn a_noisy_plane_is_flattened_inside_and_its_boundary_kept() {
+        let n = 12;
+        let mut m = grid(n, 0.0, 0.06);
+        let before = m.clone();
+        let opts = PlanarOptions::DEFAULT.with_tolerance(0.1);
+        let report = flatten_planar_regions(&mut m, &opts).unwrap();
+        assert_eq!(report.planar_regions, 1, "{report:?}");
+        assert_eq!(report.moved_vertices, (n - 1) * (n - 1));
+        // The noise was up to 0.03; the fitted plane is within its mean of z = 0.
+        assert!(max_abs_z_interior(&before, n) > 0.02);
+        assert!(
+            max_abs_z_interior(&m, n) < 0.01,
+            "{}",
+            max_abs_z_interior(&m, n)
+        );
+        // Projection is along the normal only (nearly z): x and y stay within rounding.
+        for (a, b) in m.positions.iter().zip(&before.positions) {
+            assert!((a.x - b.x).abs() < 1e-3 && (a.y - b.y).abs() < 1e-3);
+        }
+        // Boundary vertices are untouched, bit for bit.
+        for i in 0..=n {
+            assert_eq!(m.positions[i], before.positions[i]);
+        }
+    }
+
+    #[test]
+    fn a_gently_curved_region_is_not_flattened() {
+        // z = 0.004 x^2 over 12 cells: the normals turn by 5.5 degrees (one region), the
+        // sagitta (0.14 over 12 units, 0.05 RMS about the plane) stays within a tolerance
+        // of 0.1, but a quadratic explains it: not planar.
+        let n = 12;
+        let mut m = grid(n, 0.004, 0.0);
+        let before = m.clone();
+        let report = flatten_planar_regions(&mut m, &PlanarOptions::DEFAULT).unwrap();
+        assert_eq!(report.regions, 1, "{report:?}");
+        assert_eq!(report.planar_regions, 0, "{report:?}");
+        assert_eq!(m, before);
+    }
+
+    #[test]
+    fn an_exact_plane_stays_on_itself() {
+        let n = 8;
+        let mut m = grid(n, 0.0, 0.0);
+        let before = m.clone();
+        let report = flatten_planar_regions(&mut m, &PlanarOptions::DEFAULT).unwrap();
+        assert_eq!(report.planar_regions, 1);
+        for (a, b) in m.positions.iter().zip(&before.positions) {
+            assert!(a.distance(*b) < 1e-12);
+        }
+    }
+
+    #[test]
+    fn bad_options_and_inputs_are_errors() {
+        let mut m = grid(4, 0.0, 0.0);
+        for bad in [
+            PlanarOptions::DEFAULT.with_tolerance(f64::NAN),
+            PlanarOptions::DEFAULT.with_tolerance(-1.0),
+            PlanarOptions::DEFAULT.with_curvature_ratio(-0.5),
+            PlanarOptions {
+                max_normal_angle_degrees: 95.0,
+                ..PlanarOptions::DEFAULT
+            },
+        ] {
+            assert!(matches!(
+                flatten_planar_regions(&mut m, &bad),
+                Err(Error::Parameter(_))
+            ));
+        }
+        m.positions[3].x = f64::INFINITY;
+        assert!(matches!(
+            flatten_planar_regions(&mut m, &PlanarOptions::DEFAULT),
+            Err(Error::InvalidInput(_))
+        ));
+        let mut nonmanifold = grid(2, 0.0, 0.0);
+        let t = nonmanifold.triangles[0];
+        nonmanifold.triangles.push(t);
+        assert!(matches!(
+            flatten_planar_regions(&mut nonmanifold, &PlanarOptions::DEFAULT),
+            Err(Error::InvalidInput(_))
+        ));
+    }
+
+    #[test]
+    fn swing_tolerance_is_the_angle_step() {
+        let t = PlanarOptions::swing_tolerance(6, 1.0);
+        assert!((t - std::f64::consts::TAU / 64.0).abs() < 1e-15);
+        assert!(PlanarOptions::swing_tolerance(99, 1.0) > 0.0);
+    }
+}
