@@ -140,40 +140,56 @@ pub fn flatten_planar_regions(
         })
     };
     // Seeds: the triangles whose neighbours agree best with them first (a seed on noise
-    // would skew its region's mean normal); ties in triangle order.
-    let mut order: Vec<(f64, usize)> = (0..nt)
+    // would skew its region's mean normal). The agreement, a sum of up to three cosines, is
+    // bucketed to 1/1000 (a counting sort: ties, and near-ties, in triangle order).
+    const BUCKETS: usize = 6001;
+    let bucket: Vec<u16> = (0..nt)
         .map(|t| {
-            (
-                -neighbours(t)
-                    .map(|u| normals[t].dot(normals[u]))
-                    .sum::<f64>(),
-                t,
-            )
+            let s: f64 = neighbours(t).map(|u| normals[t].dot(normals[u])).sum();
+            ((3.0 - s) * 1000.0)
+                .round()
+                .clamp(0.0, (BUCKETS - 1) as f64) as u16
         })
         .collect();
-    order.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut start = vec![0u32; BUCKETS + 1];
+    for &b in &bucket {
+        start[b as usize + 1] += 1;
+    }
+    for k in 0..BUCKETS {
+        start[k + 1] += start[k];
+    }
+    let mut order = vec![0u32; nt];
+    for (t, &b) in bucket.iter().enumerate() {
+        order[start[b as usize] as usize] = t as u32;
+        start[b as usize] += 1;
+    }
     const NONE: u32 = u32::MAX;
     let cos_max = opts.max_normal_angle_degrees.to_radians().cos();
     let mut region = vec![NONE; nt];
     let mut planes: Vec<Option<(DVec3, f64)>> = Vec::new();
     let mut report = PlanarReport::default();
-    let (mut stack, mut members, mut verts) = (Vec::new(), Vec::new(), Vec::new());
-    for &(_, seed) in &order {
+    let (mut stack, mut members, mut pts) = (Vec::new(), Vec::new(), Vec::new());
+    // The last region each vertex was gathered for.
+    let mut gathered = vec![NONE; p.len()];
+    for seed in order.into_iter().map(|t| t as usize) {
         if region[seed] != NONE {
             continue;
         }
         let r = planes.len() as u32;
         region[seed] = r;
         let mut sum = normals[seed] * area[seed];
+        // The running mean normal, renormalised once per triangle added.
+        let mut mean = normals[seed];
         stack.clear();
         stack.push(seed);
         members.clear();
         members.push(seed);
         while let Some(t) = stack.pop() {
             for u in neighbours(t) {
-                if region[u] == NONE && normals[u].dot(sum.normalize_or_zero()) >= cos_max {
+                if region[u] == NONE && normals[u].dot(mean) >= cos_max {
                     region[u] = r;
                     sum += normals[u] * area[u];
+                    mean = sum.normalize_or_zero();
                     stack.push(u);
                     members.push(u);
                 }
@@ -182,11 +198,15 @@ pub fn flatten_planar_regions(
         let normal = sum.normalize_or_zero();
         let mut plane = None;
         if members.len() >= opts.min_triangles && normal != DVec3::ZERO {
-            verts.clear();
-            verts.extend(members.iter().flat_map(|&t| mesh.triangles[t]));
-            verts.sort_unstable();
-            verts.dedup();
-            let pts: Vec<DVec3> = verts.iter().map(|&v| p[v as usize]).collect();
+            pts.clear();
+            for &t in &members {
+                for v in mesh.triangles[t] {
+                    if gathered[v as usize] != r {
+                        gathered[v as usize] = r;
+                        pts.push(p[v as usize]);
+                    }
+                }
+            }
             if let Some(fit) = fit_plane(&pts, normal) {
                 let tol = opts.tolerance * edge;
                 if fit.rms <= tol
