@@ -67,8 +67,10 @@ pub struct SharpenTrial {
 
 /// The planar-region projection's tolerance, in angle steps, that the encoder tries after
 /// the best sharpening (`whet_sharpen::PlanarOptions::for_swing`; docs/swing.md section 2):
-/// 1 measured best of 0.3, 0.6 and 1 on the CAD fixtures of the sharpening figures.
-pub const PLANAR_FACTOR: f64 = 1.0;
+/// 2: of 0.6, 1, 1.5, 2 and 3 on the 48 swing rows of the sharpening figures (`planar_sweep`
+/// in whet-sharpen), 2 and 3 gained the most, and below 1 the 6-bit rows gained less
+/// (docs/results.md).
+pub const PLANAR_FACTOR: f64 = 2.0;
 
 /// Options of [`SwingEncoder`].
 #[derive(Clone, Copy, Debug, PartialEq)]
