@@ -133,7 +133,7 @@ pub fn run(args: &DecodeArgs) -> CliResult {
                 whet_codec::SurfaceFilter::after_sharpening_of(h)
                     .apply_after_sharpening(&mesh, &mut s.mesh);
                 // Then the flat faces onto their planes, when the stream says so.
-                super::sharpen::flatten_stated_planes(h, &mut s.mesh)?;
+                super::sharpen::flatten_stated_planes(h, &mut s.mesh);
             }
         }
         match args.bend {

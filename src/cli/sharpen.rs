@@ -77,14 +77,17 @@ pub fn run_sharpen(mesh: &Mesh, opts: &SharpenOptions) -> CliResult<Sharpened> {
 }
 
 /// A swing stream's planar-region projection after sharpening (optional header field 25),
-/// applied to `sharpened`: the output of the stream's sharpening and of its filter for
-/// after sharpening (docs/swing.md section 2).
-pub fn flatten_stated_planes(header: &whet_format::Header, sharpened: &mut Mesh) -> CliResult {
+/// applied to `sharpened`: the output of the sharpening and of the stream's filter for after
+/// sharpening (docs/swing.md section 2). A mesh the projection refuses (it needs an oriented
+/// manifold, which sharpening gives) is kept unprojected with a warning, as the encoder's
+/// measurement keeps it: the field is an optional refinement, not part of the decoded mesh.
+pub fn flatten_stated_planes(header: &whet_format::Header, sharpened: &mut Mesh) {
     if let Some((factor, bits)) = whet_codec::SharpenHint::planar_of(header) {
         let opts = whet_sharpen::PlanarOptions::for_swing(bits, factor);
-        whet_sharpen::flatten_planar_regions(sharpened, &opts).map_err(Failure::input)?;
+        if let Err(e) = whet_sharpen::flatten_planar_regions(sharpened, &opts) {
+            eprintln!("whet: the planar-region projection was skipped: {e}");
+        }
     }
-    Ok(())
 }
 
 pub fn run(args: &SharpenArgs) -> CliResult {

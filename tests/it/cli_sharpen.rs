@@ -481,15 +481,33 @@ fn decode_sharpen_follows_the_streams_hint() {
         );
         assert!(forced.0 == extended, "hint {code} with --method extended");
     }
-    // Header field 25 turns the planar-region projection on after the sharpening: the cube's
-    // faces are flat, so it moves vertices; `--no-surface-filter` leaves it out, as it does
-    // the filter for after sharpening.
-    for (factor, name) in [(None, "off"), (Some(100u64), "on")] {
-        let mut c = container.clone();
-        c.header = c
-            .header
-            .clone()
-            .with(whet_format::tag::SHARPEN_METHOD, 0u64);
+    // Header field 25 turns the planar-region projection on after the sharpening. At 6 bpv
+    // the cube's faces are regions of hundreds of triangles carrying the 6-bit angles' noise:
+    // the encoder measures the projection better and states it (two angle steps).
+    let fine = dir.join("fine.whet");
+    let j = whet_json(&[
+        "encode",
+        s(&mc),
+        "-o",
+        s(&fine),
+        "--bpv",
+        "6",
+        "--angle-bits",
+        "6",
+        "--optimize-for",
+        "sharpened",
+        "--json",
+    ]);
+    assert_eq!(j["planar_tolerance"].as_f64(), Some(2.0), "{j}");
+    let fine_container = whet_format::parse(
+        &std::fs::read(&fine).unwrap(),
+        &whet_format::Limits::DEFAULT,
+    )
+    .unwrap();
+    // The same stream without the field, and with it: the projection moves vertices;
+    // `--no-surface-filter` leaves it out, as it does the filter for after sharpening.
+    for (factor, name) in [(None, "off"), (Some(200u64), "on")] {
+        let mut c = fine_container.clone();
         c.header.remove(whet_format::tag::PLANAR_TOLERANCE);
         if let Some(f) = factor {
             c.header = c.header.clone().with(whet_format::tag::PLANAR_TOLERANCE, f);

@@ -4,7 +4,7 @@
 //! steps) and curvature ratio, both measured with Metro against the original.
 //!
 //! ```text
-//! cargo run --release -p whet-sharpen --example planar_sweep -- [factor 1.0] [curvature ratio 0.25]
+//! cargo run --release -p whet-sharpen --example planar_sweep -- [factor 2] [curvature ratio 0.1]
 //! ```
 
 mod support;
@@ -20,7 +20,7 @@ fn main() {
             a.parse().unwrap_or_else(|e| panic!("{a}: {e}"))
         })
     };
-    let (factor, ratio) = (arg(1, 1.0), arg(2, 0.25));
+    let (factor, ratio) = (arg(1, 2.0), arg(2, 0.1));
     let metro_opts = MetroOptions::DEFAULT.with_samples(300_000);
     println!("| stream | input RMS % | decode --sharpen RMS % (gain) | with the projection (gain) | moved / vertices |");
     println!("|---|---|---|---|---|");

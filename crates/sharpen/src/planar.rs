@@ -30,11 +30,11 @@ pub struct PlanarOptions {
 }
 
 impl PlanarOptions {
-    /// 10 degrees, tolerance 0.1 edge lengths, curvature ratio 0.25, 20 triangles.
+    /// 10 degrees, tolerance 0.1 edge lengths, curvature ratio 0.1, 20 triangles.
     pub const DEFAULT: PlanarOptions = PlanarOptions {
         max_normal_angle_degrees: 10.0,
         tolerance: 0.1,
-        curvature_ratio: 0.25,
+        curvature_ratio: 0.1,
         min_triangles: 20,
     };
 
@@ -214,7 +214,7 @@ pub fn flatten_planar_regions(
                     && fit.rms * fit.rms - fit.quadric_rms * fit.quadric_rms
                         <= opts.curvature_ratio * fit.quadric_rms * fit.quadric_rms
                 {
-                    plane = Some((normal, fit.offset));
+                    plane = Some((fit.normal, fit.offset));
                     report.planar_regions += 1;
                     report.planar_triangles += members.len();
                 }
@@ -254,18 +254,21 @@ pub fn flatten_planar_regions(
 
 /// A plane fit of a region's vertices.
 struct PlaneFit {
-    /// `normal . x = offset` on the plane (through the vertices' centroid).
+    /// `normal . x = offset` on the least-squares plane.
+    normal: DVec3,
     offset: f64,
-    /// RMS and largest distance of the vertices to the plane.
+    /// RMS and largest residual of the vertices' heights over that plane.
     rms: f64,
     max: f64,
-    /// RMS residual of the least-squares quadratic height field over the plane.
+    /// RMS residual of the least-squares quadratic height field.
     quadric_rms: f64,
 }
 
-/// Fits the plane with normal `normal` through the centroid of `pts`, and the quadratic
-/// height field `h = a u^2 + b uv + c v^2 + d u + e v + f` over it; `None` when the height
-/// field is undetermined (too few or collinear points).
+/// Fits, as height fields over the plane through the centroid of `pts` with normal `normal`
+/// (the region's mean normal), the least-squares plane `h = d u + e v + f` and the quadratic
+/// `h = a u^2 + b uv + c v^2 + d u + e v + f`; `None` when either is undetermined (too few
+/// or collinear points). The mean normal alone would not do: a sum of area-weighted normals
+/// depends only on the region's border, whose noise would tilt the plane.
 fn fit_plane(pts: &[DVec3], normal: DVec3) -> Option<PlaneFit> {
     if pts.len() < 6 {
         return None;
@@ -279,12 +282,6 @@ fn fit_plane(pts: &[DVec3], normal: DVec3) -> Option<PlaneFit> {
             (d.dot(eu), d.dot(ev), d.dot(normal))
         })
         .collect();
-    let (mut ss, mut max) = (0.0f64, 0.0f64);
-    for &(_, _, h) in &local {
-        ss += h * h;
-        max = max.max(h.abs());
-    }
-    let rms = (ss / pts.len() as f64).sqrt();
     // Coordinates scaled to about 1 so the normal equations stay well conditioned.
     let scale = local
         .iter()
@@ -308,19 +305,41 @@ fn fit_plane(pts: &[DVec3], normal: DVec3) -> Option<PlaneFit> {
         }
     }
     let coef = solve6(m)?;
-    let mut sq = 0.0;
+    // The plane: the same system with the quadratic terms pinned to zero.
+    let mut m_plane = m;
+    for i in 0..3 {
+        for (j, x) in m_plane[i].iter_mut().enumerate() {
+            *x = if i == j { 1.0 } else { 0.0 };
+        }
+        for row in m_plane.iter_mut().skip(3) {
+            row[i] = 0.0;
+        }
+    }
+    let lin = solve6(m_plane)?;
+    let (mut sq, mut sq_plane, mut max) = (0.0f64, 0.0f64, 0.0f64);
     for &(u, v, h) in &local {
         let b = basis(u, v);
         let f: f64 = b.iter().zip(&coef).map(|(x, c)| x * c).sum();
         sq += (h - f) * (h - f);
+        let r = h - (lin[3] * b[3] + lin[4] * b[4] + lin[5]);
+        sq_plane += r * r;
+        max = max.max(r.abs());
     }
-    let quadric_rms = (sq / pts.len() as f64).sqrt();
-    quadric_rms.is_finite().then_some(PlaneFit {
-        offset: normal.dot(centroid),
-        rms,
-        max,
-        quadric_rms,
-    })
+    let n = pts.len() as f64;
+    let (rms, quadric_rms) = ((sq_plane / n).sqrt(), (sq / n).sqrt());
+    // h = d u + e v + f in unscaled coordinates: tangents eu + (d / scale) normal and
+    // ev + (e / scale) normal, whose cross product is the plane's normal.
+    let plane_normal = (normal - eu * (lin[3] / scale) - ev * (lin[4] / scale)).normalize_or_zero();
+    let on_plane = centroid + normal * lin[5];
+    (quadric_rms.is_finite() && rms.is_finite() && plane_normal != DVec3::ZERO).then_some(
+        PlaneFit {
+            normal: plane_normal,
+            offset: plane_normal.dot(on_plane),
+            rms,
+            max,
+            quadric_rms,
+        },
+    )
 }
 
 /// Solves the 6x6 system of augmented matrix `m` by Gaussian elimination with partial
@@ -416,6 +435,26 @@ mod tests {
         // Boundary vertices are untouched, bit for bit.
         for i in 0..=n {
             assert_eq!(m.positions[i], before.positions[i]);
+        }
+    }
+
+    #[test]
+    fn a_tilted_noisy_plane_goes_onto_its_least_squares_plane() {
+        // z = 0.05 x + noise: the projection lands within the noise's mean of the true plane
+        // (the border's noise would tilt a plane taken from the mean normal alone).
+        let n = 14;
+        let mut m = grid(n, 0.0, 0.06);
+        for p in &mut m.positions {
+            p.z += 0.05 * p.x;
+        }
+        let report = flatten_planar_regions(&mut m, &PlanarOptions::DEFAULT).unwrap();
+        assert_eq!(report.moved_vertices, (n - 1) * (n - 1), "{report:?}");
+        let unit = DVec3::new(-0.05, 0.0, 1.0).normalize();
+        for j in 1..n {
+            for i in 1..n {
+                let p = m.positions[j * (n + 1) + i];
+                assert!(p.dot(unit).abs() < 0.01, "{p}: {}", p.dot(unit));
+            }
         }
     }
 

@@ -899,7 +899,7 @@ impl SwingEncoder {
                                 let opts =
                                     whet_sharpen::PlanarOptions::for_swing(out.angle_bits, f);
                                 // The sharpened mesh is a manifold; were it refused, the
-                                // decoder would keep it unprojected too.
+                                // decoder keeps it unprojected too (with a warning).
                                 let _ = whet_sharpen::flatten_planar_regions(&mut m, &opts);
                             }
                             m
@@ -1128,9 +1128,9 @@ fn sharpen_options(hint: SharpenHint, smooth_factor: f64) -> whet_sharpen::Sharp
         .with_smooth_factor(smooth_factor)
 }
 
-/// `out` with its stream's sharpening hint changed to `hint` (the field's value is one byte
-/// whatever the hint, so the size does not change).
-/// `out` with header field 25 stating the planar-region projection at `factor` angle steps.
+/// `out` with header field 25 stating the planar-region projection at `factor` angle steps
+/// (rounded to the field's hundredths, which is what a decoder reads). The field's three
+/// bytes come after the size search, within its tolerance.
 fn restate_planar(mut out: SwingOutput, factor: f64) -> Result<SwingOutput, Error> {
     let code = SharpenHint::smooth_factor_code(factor)
         .ok_or_else(|| Error::Internal(format!("planar factor {factor} out of range")))?;
@@ -1141,10 +1141,12 @@ fn restate_planar(mut out: SwingOutput, factor: f64) -> Result<SwingOutput, Erro
         .clone()
         .with(whet_format::tag::PLANAR_TOLERANCE, code);
     out.bytes = container.to_bytes().map_err(whet_codec::Error::from)?;
-    out.planar_factor = Some(factor);
+    out.planar_factor = Some(code as f64 / 100.0);
     Ok(out)
 }
 
+/// `out` with its stream's sharpening hint changed to `hint` (the field's value is one byte
+/// whatever the hint, so the size does not change).
 fn restate_hint(mut out: SwingOutput, hint: SharpenHint) -> Result<SwingOutput, Error> {
     let mut container = whet_format::parse(&out.bytes, &whet_codec::Limits::UNLIMITED)
         .map_err(whet_codec::Error::from)?;
