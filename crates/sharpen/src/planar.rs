@@ -121,12 +121,9 @@ pub fn flatten_planar_regions(
     let table = CornerTable::new(mesh).map_err(Error::InvalidInput)?;
     let p = &mesh.positions;
     let nt = mesh.triangles.len();
-    let (normals, area): (Vec<DVec3>, Vec<f64>) = mesh
-        .triangles
-        .iter()
+    let (normals, area): (Vec<DVec3>, Vec<f64>) = (0..nt)
         .map(|t| {
-            let [a, b, c] = t.map(|v| p[v as usize]);
-            let n = (b - a).cross(c - a);
+            let n = mesh.face_cross(t);
             (n.normalize_or_zero(), 0.5 * n.length())
         })
         .unzip();

@@ -1134,13 +1134,7 @@ fn sharpen_options(hint: SharpenHint, smooth_factor: f64) -> whet_sharpen::Sharp
 fn restate_planar(mut out: SwingOutput, factor: f64) -> Result<SwingOutput, Error> {
     let code = SharpenHint::smooth_factor_code(factor)
         .ok_or_else(|| Error::Internal(format!("planar factor {factor} out of range")))?;
-    let mut container = whet_format::parse(&out.bytes, &whet_codec::Limits::UNLIMITED)
-        .map_err(whet_codec::Error::from)?;
-    container.header = container
-        .header
-        .clone()
-        .with(whet_format::tag::PLANAR_TOLERANCE, code);
-    out.bytes = container.to_bytes().map_err(whet_codec::Error::from)?;
+    out.bytes = with_header_field(&out.bytes, whet_format::tag::PLANAR_TOLERANCE, code)?;
     out.planar_factor = Some(code as f64 / 100.0);
     Ok(out)
 }
@@ -1148,15 +1142,18 @@ fn restate_planar(mut out: SwingOutput, factor: f64) -> Result<SwingOutput, Erro
 /// `out` with its stream's sharpening hint changed to `hint` (the field's value is one byte
 /// whatever the hint, so the size does not change).
 fn restate_hint(mut out: SwingOutput, hint: SharpenHint) -> Result<SwingOutput, Error> {
-    let mut container = whet_format::parse(&out.bytes, &whet_codec::Limits::UNLIMITED)
-        .map_err(whet_codec::Error::from)?;
-    container.header = container
-        .header
-        .clone()
-        .with(whet_format::tag::SHARPEN_METHOD, hint.code());
-    out.bytes = container.to_bytes().map_err(whet_codec::Error::from)?;
+    out.bytes = with_header_field(&out.bytes, whet_format::tag::SHARPEN_METHOD, hint.code())?;
     out.sharpen_hint = Some(hint);
     Ok(out)
+}
+
+/// The encoder's own stream `bytes` with header field `tag` set to `value` (the payload is
+/// copied unchanged; the container's checksums are recomputed).
+fn with_header_field(bytes: &[u8], tag: u64, value: u64) -> Result<Vec<u8>, Error> {
+    let mut container = whet_format::parse(bytes, &whet_codec::Limits::UNLIMITED)
+        .map_err(whet_codec::Error::from)?;
+    container.header = container.header.clone().with(tag, value);
+    Ok(container.to_bytes().map_err(whet_codec::Error::from)?)
 }
 
 #[cfg(test)]
