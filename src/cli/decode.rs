@@ -33,6 +33,11 @@ pub struct DecodeArgs {
     /// extended.
     #[arg(long)]
     method: Option<String>,
+    /// EdgeSharpener's curved-wall factor (`whet sharpen --curved-walls`; 0: off). Without
+    /// it, the one a swing stream names with its method (see --method); otherwise the
+    /// method's own (2 for extended, off for papers).
+    #[arg(long)]
+    curved_walls: Option<f64>,
     /// Subdiv streams: subdivision levels, overriding the header (0 gives the control mesh).
     #[arg(long)]
     levels: Option<u32>,
@@ -91,10 +96,16 @@ pub fn run(args: &DecodeArgs) -> CliResult {
         // The stream's choice (`SharpenHint::stated`); an explicit --method replaces it,
         // factor included.
         let stated = header.as_ref().and_then(whet_codec::SharpenHint::stated);
-        let (method, stream_factor) = match (&args.method, stated) {
-            (Some(m), _) => (m.as_str(), None),
-            (None, Some((h, f))) => (h.name(), Some(f)),
-            (None, None) => ("extended", None),
+        let (method, stream_factor, stream_walls) = match (&args.method, stated) {
+            (Some(m), _) => (m.as_str(), None, None),
+            (None, Some((h, f))) => (
+                h.name(),
+                Some(f),
+                header
+                    .as_ref()
+                    .and_then(whet_codec::SharpenHint::curved_walls_of),
+            ),
+            (None, None) => ("extended", None, None),
         };
         if method == whet_codec::SharpenHint::Unsharpened.name() {
             // No candidate beat the decoded mesh (or `--method none`): what `whet decode`
@@ -124,7 +135,11 @@ pub fn run(args: &DecodeArgs) -> CliResult {
             };
         }
         let smooth_factor = args.smooth_factor.or(stream_factor).unwrap_or(2.0);
-        let opts = super::sharpen::sharpen_options(method, smooth_factor)?;
+        let mut opts = super::sharpen::sharpen_options(method, smooth_factor)?;
+        if let Some(w) = args.curved_walls.or(stream_walls) {
+            opts = opts.with_curved_wall_factor(w);
+            opts.validate().map_err(super::Failure::input)?;
+        }
         let mut s = super::sharpen::run_sharpen(&mesh, &opts)?;
         if !args.no_surface_filter {
             // A swing stream's filter for after sharpening: the smooth parts the sharpener

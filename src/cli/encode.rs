@@ -393,9 +393,11 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh) -> CliResult {
             },
             "sharpen_method": out.sharpen_hint.map(|h| h.name()),
             "sharpen_smooth_factor": out.sharpen_hint.and(out.sharpen_smooth_factor),
+            "sharpen_curved_walls": out.sharpen_hint.and(out.sharpen_curved_walls),
             "sharpen_trials": out.sharpen_trials.iter().map(|t| json!({
                 "method": t.hint.name(),
                 "smooth_factor": t.smooth_factor,
+                "curved_walls": t.curved_walls,
                 "rms_error_pct": t.rms_pct,
                 "planar": t.planar,
             })).collect::<Vec<_>>(),

@@ -177,10 +177,14 @@ fn sharpened(
     mesh: &Mesh,
     method: whet_sharpen::Method,
     smooth_factor: f64,
+    curved_walls: Option<f64>,
 ) -> Result<whet_sharpen::Sharpened, String> {
-    let opts = whet_sharpen::SharpenOptions::DEFAULT
+    let mut opts = whet_sharpen::SharpenOptions::DEFAULT
         .with_method(method)
         .with_smooth_factor(smooth_factor);
+    if let Some(w) = curved_walls {
+        opts = opts.with_curved_wall_factor(w);
+    }
     let run = |m: &Mesh| whet_sharpen::sharpen(m, &opts);
     match run(mesh) {
         Ok(s) => Ok(s),
@@ -215,7 +219,10 @@ fn sharpened_from_stream(mesh: &Mesh, bytes: &[u8]) -> Result<(Mesh, Vec<[u32; 2
         Some(whet_codec::SharpenHint::Papers) => whet_sharpen::Method::Papers,
         _ => whet_sharpen::Method::Extended,
     };
-    let mut s = sharpened(mesh, method, smooth_factor)?;
+    let curved_walls = header
+        .as_ref()
+        .and_then(whet_codec::SharpenHint::curved_walls_of);
+    let mut s = sharpened(mesh, method, smooth_factor, curved_walls)?;
     if let Some(h) = &header {
         whet_codec::SurfaceFilter::after_sharpening_of(h).apply_after_sharpening(mesh, &mut s.mesh);
         super::sharpen::flatten_stated_planes(h, &mut s.mesh);

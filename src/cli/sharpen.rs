@@ -28,6 +28,12 @@ pub struct SharpenArgs {
     /// otherwise stay at their index, used by no triangle.
     #[arg(long)]
     no_weld: bool,
+    /// extended and papers: where two rings of triangles lie outside every smooth region, an
+    /// edge turning by under this factor times the smooth threshold counts as smooth, so a
+    /// face curved at the sampling's scale (a small hole's wall) gets its chamfers found.
+    /// 0 is off; 1 to 4 otherwise. Default: 2 for extended, off for papers.
+    #[arg(long)]
+    curved_walls: Option<f64>,
     /// normal-filter: neighbourhood radius in mean edge lengths (a little more than the widest
     /// feature to sharpen).
     #[arg(long, default_value_t = SharpenOptions::DEFAULT.rho)]
@@ -97,6 +103,10 @@ pub fn run(args: &SharpenArgs) -> CliResult {
         .with_eta(args.eta)
         .with_lambda(args.lambda)
         .with_weld_clusters(!args.no_weld);
+    let opts = match args.curved_walls {
+        Some(w) => opts.with_curved_wall_factor(w),
+        None => opts,
+    };
     opts.validate().map_err(Failure::input)?;
     let out = match &args.select {
         None => run_sharpen(&mesh, &opts)?,

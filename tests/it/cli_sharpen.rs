@@ -2,7 +2,7 @@
 //! marching-cubes cube must bring it closer to the true cube.
 
 use crate::{s, whet, whet_json};
-use whet_testkit::scratch_dir;
+use whet_testkit::{scratch_dir, shared_fixture};
 
 fn rms_pct(truth: &std::path::Path, test: &std::path::Path) -> (f64, f64) {
     let j = whet_json(&["metro", s(truth), s(test), "--samples", "100000", "--json"]);
@@ -366,19 +366,27 @@ fn decode_sharpen_follows_the_streams_hint() {
         "sharpened",
         "--json",
     ]);
-    // The encoder measured seven candidates and kept the lowest error; then the chosen
-    // sharpening once more with the planar-region projection, kept when it beat it.
+    // The encoder measured ten candidates (the papers' method twice, without and with
+    // curved walls) and kept the lowest error; then the chosen sharpening once more with the
+    // planar-region projection, kept when it beat it.
     let all = j["sharpen_trials"].as_array().unwrap();
     let trials: Vec<_> = all.iter().filter(|t| t["planar"] == false).collect();
     let planar: Vec<_> = all.iter().filter(|t| t["planar"] == true).collect();
-    assert_eq!(trials.len(), 7, "{j}");
+    assert_eq!(trials.len(), 10, "{j}");
     let chosen = j["sharpen_method"].as_str().unwrap();
     assert_eq!(planar.len(), usize::from(chosen != "none"), "{j}");
+    // The stream states curved walls only where they differ from the method's own (on for
+    // extended, off for papers).
+    let chosen_walls = j["sharpen_curved_walls"]
+        .as_f64()
+        .unwrap_or(if chosen == "extended" { 2.0 } else { 0.0 });
     let chosen_error = trials
         .iter()
         .find(|t| {
             t["method"] == chosen
-                && (chosen == "none" || t["smooth_factor"] == j["sharpen_smooth_factor"])
+                && (chosen == "none"
+                    || (t["smooth_factor"] == j["sharpen_smooth_factor"]
+                        && t["curved_walls"].as_f64() == Some(chosen_walls)))
         })
         .map(|t| t["rms_error_pct"].as_f64().unwrap())
         .unwrap();
@@ -427,6 +435,8 @@ fn decode_sharpen_follows_the_streams_hint() {
     assert_ne!(papers, extended);
     for (code, expected) in [(0u64, &extended), (1, &papers), (2, &plain)] {
         let mut c = container.clone();
+        // Each method with its own curved walls (the encoder may have stated others).
+        c.header.remove(whet_format::tag::SHARPEN_CURVED_WALLS);
         c.header = c
             .header
             .clone()
@@ -521,4 +531,73 @@ fn decode_sharpen_follows_the_streams_hint() {
     assert!(sharpened_on != sharpened_off, "field 25 moved nothing");
     let raw = ["--sharpen", "--no-surface-filter"];
     assert!(decode(&off, &raw, "ro.off").0 == decode(&on, &raw, "rn.off").0);
+}
+
+#[test]
+fn decode_sharpen_reads_the_streams_curved_walls() {
+    // partLp retiled at its own vertex count: its through-holes, 2.3 edges in radius, are
+    // where curved walls change the papers' method (docs/results.md, "Curved walls").
+    let dir = scratch_dir("cli-decode-curved-walls");
+    let stream = dir.join("p.whet");
+    let fixture = shared_fixture("partLp.off");
+    let args = ["encode", s(&fixture), "-o", s(&stream), "--bpv", "3.3"];
+    let o = whet(&[&args[..], &["--angle-bits", "6"]].concat());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let container = whet_format::parse(
+        &std::fs::read(&stream).unwrap(),
+        &whet_format::Limits::DEFAULT,
+    )
+    .unwrap();
+    let decode = |input: &std::path::Path, extra: &[&str], name: &str| {
+        let out = dir.join(name);
+        let o = whet(&[&["decode", s(input), "-o", s(&out)][..], extra].concat());
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        std::fs::read(&out).unwrap()
+    };
+    let stating = |method: u64, walls: u64, name: &str| {
+        let mut c = container.clone();
+        c.header = c
+            .header
+            .clone()
+            .with(whet_format::tag::SHARPEN_METHOD, method)
+            .with(whet_format::tag::SHARPEN_SMOOTH_FACTOR, 150u64)
+            .with(whet_format::tag::SHARPEN_CURVED_WALLS, walls);
+        let path = dir.join(name);
+        std::fs::write(&path, c.to_bytes().unwrap()).unwrap();
+        path
+    };
+    let papers = ["--sharpen", "--method", "papers", "--smooth-factor", "1.5"];
+    let without = decode(&stream, &papers, "papers.off");
+    let with = decode(
+        &stream,
+        &[&papers[..], &["--curved-walls", "2"]].concat(),
+        "pw.off",
+    );
+    assert!(with != without, "curved walls changed nothing on partLp");
+    // Papers at 1.5 with walls at 2, as the stream states them ...
+    let hinted = stating(1, 200, "papers-walls.whet");
+    assert!(decode(&hinted, &["--sharpen"], "h.off") == with);
+    // ... and `--curved-walls` overriding the stream's factor.
+    let off = decode(&hinted, &["--sharpen", "--curved-walls", "0"], "h0.off");
+    assert!(off == without);
+    // Field 27 at 0 turns the extended method's own walls off.
+    let extended = [
+        "--sharpen",
+        "--method",
+        "extended",
+        "--smooth-factor",
+        "1.5",
+    ];
+    let expected = decode(
+        &stream,
+        &[&extended[..], &["--curved-walls", "0"]].concat(),
+        "e0.off",
+    );
+    assert!(
+        decode(
+            &stating(0, 0, "extended-off.whet"),
+            &["--sharpen"],
+            "he.off"
+        ) == expected
+    );
 }

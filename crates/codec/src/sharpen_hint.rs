@@ -86,6 +86,33 @@ impl SharpenHint {
         Some((hint, Self::smooth_factor_of(header).unwrap_or(2.0)))
     }
 
+    /// The curved-wall factor a swing stream's header states for its sharpening (field 27, in
+    /// hundredths; `whet_sharpen::SharpenOptions::curved_wall_factor`): `Some(0.0)` for off
+    /// (value 0), the factor for a value in [`Self::CURVED_WALL_HUNDREDTHS`]; `None` (the
+    /// method's own) without the field, with another value, for other modes, or without a
+    /// hint this whet knows (the factor goes with its method, as field 23 does).
+    pub fn curved_walls_of(header: &whet_format::Header) -> Option<f64> {
+        Self::of(header)?;
+        header
+            .get_u64(whet_format::tag::SHARPEN_CURVED_WALLS)
+            .filter(|&h| h == 0 || Self::CURVED_WALL_HUNDREDTHS.contains(&h))
+            .map(|h| h as f64 / 100.0)
+    }
+
+    /// The curved-wall factors field 27 can state, in hundredths (1 to 4, the range
+    /// `SharpenOptions::validate` accepts besides 0).
+    pub const CURVED_WALL_HUNDREDTHS: std::ops::RangeInclusive<u64> = 100..=400;
+
+    /// Field 27's value for `factor` (0 for off; otherwise rounded to hundredths), `None`
+    /// outside the range.
+    pub fn curved_walls_code(factor: f64) -> Option<u64> {
+        if factor == 0.0 {
+            return Some(0);
+        }
+        let h = (factor * 100.0).round();
+        (100.0..=400.0).contains(&h).then_some(h as u64)
+    }
+
     /// The planar-region projection a swing stream's header states for after sharpening
     /// (field 25): its tolerance factor (the field's hundredths over 100, in angle steps)
     /// and the stream's angle bits, for `whet_sharpen::PlanarOptions::for_swing`. `None`
@@ -137,6 +164,38 @@ mod tests {
             .with(whet_format::tag::ANGLE_BITS, 6u64)
             .with(whet_format::tag::PLANAR_TOLERANCE, 100u64);
         assert_eq!(SharpenHint::planar_of(&exact), None);
+    }
+
+    #[test]
+    fn curved_walls_go_with_a_known_method_and_stay_in_range() {
+        let swing = whet_format::Header::new(whet_format::Mode::Swing, 3, 1);
+        let walls = swing
+            .clone()
+            .with(whet_format::tag::SHARPEN_CURVED_WALLS, 150u64);
+        // Without field 21 the factor has no method to go with.
+        assert_eq!(SharpenHint::curved_walls_of(&walls), None);
+        let papers = walls.with(whet_format::tag::SHARPEN_METHOD, 1u64);
+        assert_eq!(SharpenHint::curved_walls_of(&papers), Some(1.5));
+        let off = papers
+            .clone()
+            .with(whet_format::tag::SHARPEN_CURVED_WALLS, 0u64);
+        assert_eq!(SharpenHint::curved_walls_of(&off), Some(0.0));
+        for bad in [1u64, 99, 401, u64::MAX] {
+            let h = swing
+                .clone()
+                .with(whet_format::tag::SHARPEN_METHOD, 0u64)
+                .with(whet_format::tag::SHARPEN_CURVED_WALLS, bad);
+            assert_eq!(SharpenHint::curved_walls_of(&h), None, "{bad}");
+        }
+        let exact = whet_format::Header::new(whet_format::Mode::Exact, 3, 1)
+            .with(whet_format::tag::SHARPEN_METHOD, 1u64)
+            .with(whet_format::tag::SHARPEN_CURVED_WALLS, 150u64);
+        assert_eq!(SharpenHint::curved_walls_of(&exact), None);
+        assert_eq!(SharpenHint::curved_walls_code(1.5), Some(150));
+        assert_eq!(SharpenHint::curved_walls_code(0.0), Some(0));
+        assert_eq!(SharpenHint::curved_walls_code(0.5), None);
+        assert_eq!(SharpenHint::curved_walls_code(4.004), Some(400));
+        assert_eq!(SharpenHint::curved_walls_code(4.2), None);
     }
 
     #[test]

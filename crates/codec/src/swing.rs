@@ -933,6 +933,9 @@ pub struct SwingStreamInfo<'a> {
     /// Its smooth factor (optional header field 23, written when `Some` and the hint is;
     /// [`SharpenHint::smooth_factor_code`]).
     pub sharpen_smooth_factor: Option<f64>,
+    /// Its curved-wall factor (optional header field 27, written when `Some` and the hint
+    /// is; [`SharpenHint::curved_walls_code`]).
+    pub sharpen_curved_walls: Option<f64>,
 }
 
 /// Writes the swing stream of a retiled mesh, after checking that Edgebreaker reproduces the
@@ -1387,6 +1390,12 @@ fn write_stream(
         {
             header = header.with(tag::SHARPEN_SMOOTH_FACTOR, code);
         }
+        if let Some(code) = info
+            .sharpen_curved_walls
+            .and_then(crate::SharpenHint::curved_walls_code)
+        {
+            header = header.with(tag::SHARPEN_CURVED_WALLS, code);
+        }
     }
     header.set_bbox(min, max);
     let container = Container::new(header)
@@ -1830,6 +1839,7 @@ mod tests {
             sharpened_filter: SurfaceFilter::NONE,
             sharpen_hint: None,
             sharpen_smooth_factor: None,
+            sharpen_curved_walls: None,
         }
     }
 

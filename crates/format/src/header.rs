@@ -168,9 +168,13 @@ pub mod tag {
     /// sharpening (`whet decode --sharpen`), its tolerance in hundredths of the angle step
     /// (swing; absent, or outside 1..=1000: none).
     pub const PLANAR_TOLERANCE: u64 = 25;
+    /// u64 (format 1.2, optional): the EdgeSharpener curved-wall factor that goes with
+    /// [`SHARPEN_METHOD`], in hundredths, 0 for off (swing; absent, or another value: the
+    /// method's own).
+    pub const SHARPEN_CURVED_WALLS: u64 = 27;
 
     /// Every tag this crate knows, with its name and value type.
-    pub const KNOWN: [(u64, &str, ValueType); 14] = [
+    pub const KNOWN: [(u64, &str, ValueType); 15] = [
         (ENCODER, "encoder", ValueType::Bytes),
         (COMPONENT_COUNT, "component_count", ValueType::U64),
         (QUANT_BITS, "quant_bits", ValueType::U64),
@@ -197,6 +201,7 @@ pub mod tag {
             ValueType::U64,
         ),
         (PLANAR_TOLERANCE, "planar_tolerance", ValueType::U64),
+        (SHARPEN_CURVED_WALLS, "sharpen_curved_walls", ValueType::U64),
     ];
 
     /// Name and type of a known tag.

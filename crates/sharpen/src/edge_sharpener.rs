@@ -145,6 +145,8 @@ pub(crate) struct Scratch {
     /// Extended method: input slivers (by triangle) with a long edge that is a chamfer edge
     /// the sliver keeps from splitting (`crate::weld`).
     pub blocked: Vec<u32>,
+    /// Curved walls: a mark per vertex (on a red triangle), then per triangle (deep).
+    pub wall_marks: Vec<u8>,
 }
 
 fn reset<T: Clone>(v: &mut Vec<T>, n: usize, x: T) {
@@ -200,6 +202,7 @@ impl EdgeSharpener {
         let mut report = SharpenReport {
             method: self.options.method,
             smooth_factor: self.options.smooth_factor,
+            curved_wall_factor: self.options.curved_walls(),
             input_vertices: mesh.positions.len(),
             input_triangles: mesh.triangles.len(),
             ..SharpenReport::default()
@@ -305,6 +308,8 @@ pub(crate) struct Run<'a> {
     /// Longest input edge.
     pub max_edge: f64,
     pub limits: SnapLimits,
+    /// The smooth threshold, radians (`smooth_factor` times the mean normal angle).
+    pub smooth_threshold: f64,
     /// Reference normals of the triangles touched when the subdivision was laid out, by
     /// their index in `Scratch::touched`, computed when first asked for (see
     /// `reference_normal`: a fallback that most meshes never reach).
@@ -359,6 +364,7 @@ impl<'a> Run<'a> {
             positions: Vec::new(),
             max_edge: 0.0,
             limits: SnapLimits::new(0.0),
+            smooth_threshold: 0.0,
             ref_normals: Vec::new(),
             snap_cache: Vec::new(),
             corner_cache: Vec::new(),
@@ -478,6 +484,7 @@ impl<'a> Run<'a> {
         self.report.mean_angle_degrees = mean.to_degrees();
         self.report.smooth_threshold_degrees = threshold.to_degrees();
         self.limits = SnapLimits::new(threshold);
+        self.smooth_threshold = threshold;
         let thr = threshold as f32;
         let mut smooth = 0;
         for (c, (&a, &o)) in s.angles.iter().zip(opposite).enumerate() {
@@ -491,9 +498,9 @@ impl<'a> Run<'a> {
         self.report.smooth_edges = smooth;
     }
 
-    /// Filters 1-4 and 3bis.
-    #[inline(never)] // one call per run; kept out of line so profiles show it
-    fn filters(&mut self) {
+    /// Filters 1-3: red (core) vertices, the triangles around them, and the growth through
+    /// brown edges.
+    fn paint_red(&mut self) {
         let mesh = self.mesh;
         let table = self.table;
         let nt = mesh.triangles.len();
@@ -541,6 +548,81 @@ impl<'a> Run<'a> {
             });
         }
         s.stack = stack;
+    }
+
+    /// Curved walls (`SharpenOptions::curved_wall_factor`, docs/sharpen.md): after filter 3,
+    /// an edge between two *deep* gray triangles (not red, and no vertex shared with a red
+    /// triangle) turns brown when its angle is under the factor times the smooth threshold.
+    /// A face curved at the sampling's scale (a hole's cylinder a few edges across turns by
+    /// 20-30 degrees per edge, over a threshold of 16) has no core vertex, so filters 1-3 leave
+    /// it gray, and with it the chamfer between it and a flat face is never found: the
+    /// chamfer needs red vertices on both sides. A chamfer strip is never deep (its vertices
+    /// are on red faces' triangles), so its edges keep their colour; a wall deep enough to
+    /// hold a core vertex needs two rings of gray around it. Returns the number of edges
+    /// turned brown.
+    fn promote_curved_walls(&mut self) -> usize {
+        let mesh = self.mesh;
+        let opposite = self.table.opposites();
+        let s = &mut *self.s;
+        let wall_threshold = (self.opts.curved_walls() * self.smooth_threshold) as f32;
+        let threshold = self.smooth_threshold as f32;
+        // One byte per vertex (on a red triangle), then one per triangle (deep), in one
+        // scratch array kept between runs.
+        let nv = mesh.positions.len();
+        let mut marks = std::mem::take(&mut s.wall_marks);
+        reset(&mut marks, nv + mesh.triangles.len(), 0u8);
+        let (near_red, deep) = marks.split_at_mut(nv);
+        for (tri, &tf) in mesh.triangles.iter().zip(&s.tflags) {
+            if tf & T_RED != 0 {
+                for &v in tri {
+                    near_red[v as usize] = 1;
+                }
+            }
+        }
+        for ((d, tri), &tf) in deep.iter_mut().zip(&mesh.triangles).zip(&s.tflags) {
+            *d = u8::from(tf & T_RED == 0 && tri.iter().all(|&v| near_red[v as usize] == 0));
+        }
+        let mut promoted = 0;
+        for (c, (&a, &o)) in s.angles.iter().zip(opposite).enumerate() {
+            // Only the lower corner of an interior edge holds its angle (-1 elsewhere).
+            if a >= threshold
+                && a < wall_threshold
+                && o != NONE
+                && deep[c / 3] != 0
+                && deep[o as usize / 3] != 0
+            {
+                s.cflags[c] |= C_BROWN;
+                s.cflags[o as usize] |= C_BROWN;
+                promoted += 1;
+            }
+        }
+        s.wall_marks = marks;
+        self.report.smooth_edges += promoted;
+        self.report.curved_wall_edges = promoted;
+        promoted
+    }
+
+    /// Filters 1-4 and 3bis, with the curved walls (`SharpenOptions::curved_wall_factor`)
+    /// between filter 3 and the rest.
+    #[inline(never)] // one call per run; kept out of line so profiles show it
+    fn filters(&mut self) {
+        self.paint_red();
+        if self.opts.curved_walls() > 0.0 && self.promote_curved_walls() > 0 {
+            // Filters 1-3 again with the new brown edges (the red set only grows: every
+            // core vertex stays core, and the growth crosses more edges).
+            for f in self.s.vflags.iter_mut() {
+                *f &= !(V_NOT_SMOOTH | V_CORE);
+            }
+            for f in self.s.tflags.iter_mut() {
+                *f &= !T_RED;
+            }
+            self.paint_red();
+        }
+        let mesh = self.mesh;
+        let table = self.table;
+        let nt = mesh.triangles.len();
+        let opposite = table.opposites();
+        let s = &mut *self.s;
         if self.opts.method == Method::Extended {
             label_regions(s, table, nt);
         }

@@ -106,6 +106,10 @@ pub struct SharpenReport {
     /// cluster's slivers kept a chamfer edge from splitting (docs/sharpen.md, "What we extend",
     /// step 10). They keep their index, used by no triangle.
     pub welded_vertices: usize,
+    /// The options' curved-wall factor (0: off).
+    pub curved_wall_factor: f64,
+    /// Edges the curved walls made smooth (included in `smooth_edges`).
+    pub curved_wall_edges: usize,
     /// Subdivided triangles the sliver pass restored to their input triangles (docs/sharpen.md,
     /// "The sliver pass").
     pub restored_triangles: usize,
@@ -171,7 +175,8 @@ impl SharpenReport {
     /// filter's `rho`, `eta`, `lambda`, `feature_faces`, `feature_vertices`,
     /// `absolute_feature_vertices`, `presmooth_iterations`, `filtered_normals`,
     /// `rectified_normals`, `update_iterations`, `flips_avoided`, `swaps`, `collapses`,
-    /// `detection_ms`, `filtering_ms` and `updating_ms` (zeros for the other methods).
+    /// `detection_ms`, `filtering_ms` and `updating_ms` (zeros for the other methods), then
+    /// `curved_wall_factor` and `curved_wall_edges`.
     pub fn to_json(&self) -> String {
         let mut s = String::with_capacity(768);
         // Writing to a String cannot fail.
@@ -221,7 +226,8 @@ impl SharpenReport {
             "\"rho\":{},\"eta\":{},\"lambda\":{},\"feature_faces\":{},\"feature_vertices\":{},\
              \"absolute_feature_vertices\":{},\"presmooth_iterations\":{},\"filtered_normals\":{},\
              \"rectified_normals\":{},\"update_iterations\":{},\"flips_avoided\":{},\"swaps\":{},\
-             \"collapses\":{},\"detection_ms\":{},\"filtering_ms\":{},\"updating_ms\":{}}}",
+             \"collapses\":{},\"detection_ms\":{},\"filtering_ms\":{},\"updating_ms\":{},\
+             \"curved_wall_factor\":{},\"curved_wall_edges\":{}}}",
             json_num(self.rho),
             json_num(self.eta),
             json_num(self.lambda),
@@ -238,6 +244,8 @@ impl SharpenReport {
             json_num(self.detection_time.as_secs_f64() * 1e3),
             json_num(self.filtering_time.as_secs_f64() * 1e3),
             json_num(self.updating_time.as_secs_f64() * 1e3),
+            json_num(self.curved_wall_factor),
+            self.curved_wall_edges,
         );
         s
     }
@@ -280,6 +288,8 @@ mod tests {
             "collapses",
             "detection_ms",
             "updating_ms",
+            "curved_wall_factor",
+            "curved_wall_edges",
         ] {
             assert_eq!(j.matches(&format!("\"{key}\":")).count(), 1, "{key} in {j}");
         }

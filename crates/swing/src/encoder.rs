@@ -58,6 +58,9 @@ pub struct SharpenTrial {
     pub hint: SharpenHint,
     /// EdgeSharpener's smooth factor (irrelevant for [`SharpenHint::Unsharpened`]).
     pub smooth_factor: f64,
+    /// EdgeSharpener's curved-wall factor (`SharpenOptions::curved_walls`, the method's own
+    /// unless the candidate sets one; 0: off).
+    pub curved_walls: f64,
     /// Measured symmetric RMS error of `whet decode --sharpen`'s output, % of the diagonal.
     pub rms_pct: f64,
     /// With the planar-region projection after sharpening (optional header field 25, at
@@ -241,6 +244,9 @@ pub struct SwingOutput {
     pub sharpen_hint: Option<SharpenHint>,
     /// The smooth factor that goes with [`Self::sharpen_hint`] (optional header field 23).
     pub sharpen_smooth_factor: Option<f64>,
+    /// The curved-wall factor that goes with [`Self::sharpen_hint`] when it is not the
+    /// method's own (optional header field 27; `None`: the method's own).
+    pub sharpen_curved_walls: Option<f64>,
     /// The planar-region projection after sharpening the stream states (optional header
     /// field 25: its tolerance in angle steps), when the encoder measured it better.
     pub planar_factor: Option<f64>,
@@ -377,13 +383,20 @@ impl SwingEncoder {
         // by more than the sampling noise of a measurement (about 0.3 % at 300 000
         // samples).
         const MARGIN: f64 = 0.995;
-        const CANDIDATES: [(SharpenHint, f64); 6] = [
-            (SharpenHint::Extended, DEFAULT_SMOOTH_FACTOR),
-            (SharpenHint::Papers, DEFAULT_SMOOTH_FACTOR),
-            (SharpenHint::Extended, 1.5),
-            (SharpenHint::Papers, 1.5),
-            (SharpenHint::Extended, 1.0),
-            (SharpenHint::Papers, 1.0),
+        // (method, smooth factor, curved-wall factor; `None`: the method's own, which is on
+        // for the extended method and off for the papers'). The papers' method with curved
+        // walls comes last, so that it is chosen only where it beats the others by the margin.
+        const W: Option<f64> = Some(PAPERS_CURVED_WALL_FACTOR);
+        const CANDIDATES: [(SharpenHint, f64, Option<f64>); 9] = [
+            (SharpenHint::Extended, DEFAULT_SMOOTH_FACTOR, None),
+            (SharpenHint::Papers, DEFAULT_SMOOTH_FACTOR, None),
+            (SharpenHint::Extended, 1.5, None),
+            (SharpenHint::Papers, 1.5, None),
+            (SharpenHint::Extended, 1.0, None),
+            (SharpenHint::Papers, 1.0, None),
+            (SharpenHint::Papers, DEFAULT_SMOOTH_FACTOR, W),
+            (SharpenHint::Papers, 1.5, W),
+            (SharpenHint::Papers, 1.0, W),
         ];
         let fraction = out.edge_length_fraction;
         // The candidates are retiled at `out`'s angle bits (the automatic choice's, when on).
@@ -392,7 +405,10 @@ impl SwingEncoder {
                 .with_angle_bits(out.angle_bits)
                 .with_auto_angle_bits(false),
         );
-        let others: Vec<_> = CANDIDATES[1..].iter().map(|&(h, f)| (Some(h), f)).collect();
+        let others: Vec<_> = CANDIDATES[1..]
+            .iter()
+            .map(|&(h, f, w)| (Some(h), f, w))
+            .collect();
         let mut streams = match at_bits.encode_at_for(prep, fraction, &others) {
             // The same retiling (the retiler is deterministic); only the hint and the filter
             // for after sharpening differ.
@@ -405,8 +421,8 @@ impl SwingEncoder {
         .into_iter();
         let mut trials = Vec::new();
         let mut best: Option<(SharpenTrial, Option<SwingOutput>)> = None;
-        for (i, (hint, smooth_factor)) in CANDIDATES.into_iter().enumerate() {
-            let opts = sharpen_options(hint, smooth_factor);
+        for (i, (hint, smooth_factor, curved_walls)) in CANDIDATES.into_iter().enumerate() {
+            let opts = sharpen_options(hint, smooth_factor, curved_walls);
             let (rms, stream) = if i == 0 {
                 // `out` was encoded for this one.
                 let rms = match out.rms_pct {
@@ -424,6 +440,7 @@ impl SwingEncoder {
             let trial = SharpenTrial {
                 hint,
                 smooth_factor,
+                curved_walls: opts.curved_walls(),
                 rms_pct: rms,
                 planar: false,
             };
@@ -437,6 +454,7 @@ impl SwingEncoder {
         let none = SharpenTrial {
             hint: SharpenHint::Unsharpened,
             smooth_factor: DEFAULT_SMOOTH_FACTOR,
+            curved_walls: 0.0,
             rms_pct: decoded,
             planar: false,
         };
@@ -462,7 +480,11 @@ impl SwingEncoder {
             // The planar-region projection after the chosen sharpening: the flat faces'
             // quantization noise, which the sharpener leaves (docs/swing.md section 2).
             let planar = restate_planar(chosen.clone(), PLANAR_FACTOR)?;
-            let opts = sharpen_options(chosen_trial.hint, chosen_trial.smooth_factor);
+            let opts = sharpen_options(
+                chosen_trial.hint,
+                chosen_trial.smooth_factor,
+                Some(chosen_trial.curved_walls),
+            );
             let rms = self.measure_as(prep, &planar, ErrorOf::Sharpened, &opts)?;
             trials.push(SharpenTrial {
                 rms_pct: rms,
@@ -633,32 +655,33 @@ impl SwingEncoder {
     /// measured the others), so that the size searches count its four or five bytes.
     fn encode_at(&self, prep: &Prepared, fraction: f64) -> Result<SwingOutput, Error> {
         let hint = (self.opts.error_of == ErrorOf::Sharpened).then_some(SharpenHint::Extended);
-        let mut outs = self.encode_at_for(prep, fraction, &[(hint, DEFAULT_SMOOTH_FACTOR)])?;
+        let mut outs =
+            self.encode_at_for(prep, fraction, &[(hint, DEFAULT_SMOOTH_FACTOR, None)])?;
         outs.pop()
             .ok_or_else(|| Error::Internal("a retiling gave no stream".into()))
     }
 
-    /// [`Self::encode_at`] once per candidate `(hint, smooth factor)`, from one retiling:
+    /// [`Self::encode_at`] once per candidate `(hint, smooth factor, curved-wall factor)`, from one retiling:
     /// each stream states its candidate and carries the filter for after sharpening fitted
     /// for that sharpening (extended at factor 2 without a hint).
     fn encode_at_for(
         &self,
         prep: &Prepared,
         fraction: f64,
-        candidates: &[(Option<SharpenHint>, f64)],
+        candidates: &[(Option<SharpenHint>, f64, Option<f64>)],
     ) -> Result<Vec<SwingOutput>, Error> {
         let o = &self.opts;
         let l = fraction * prep.diagonal;
         let params = SwingParams::new(l, o.angle_bits, &prep.mesh.bounding_box(), o.quant_bits)?;
         let sharpen: Vec<_> = candidates
             .iter()
-            .map(|&(h, f)| sharpen_options(h.unwrap_or(SharpenHint::Extended), f))
+            .map(|&(h, f, w)| sharpen_options(h.unwrap_or(SharpenHint::Extended), f, w))
             .collect();
         let retiled = retile_fitted(&prep.mesh, &params, &o.tuning, o.surface_filter, &sharpen)?;
         let mut outs = Vec::with_capacity(candidates.len());
         // The same decoded mesh for every candidate (they differ in header fields only).
         let mut coverage = None;
-        for (&(hint, smooth_factor), &sharpened_filter) in
+        for (&(hint, smooth_factor, curved_walls), &sharpened_filter) in
             candidates.iter().zip(&retiled.sharpened_filters)
         {
             let info = SwingStreamInfo {
@@ -671,6 +694,7 @@ impl SwingEncoder {
                 // Always written with a hint, so that the size searches count its bytes (the
                 // default's 200 hundredths take two, as 150 does; 100 takes one).
                 sharpen_smooth_factor: hint.map(|_| smooth_factor),
+                sharpen_curved_walls: hint.and(curved_walls),
             };
             let enc: SwingEncoded = encode_retiled(&retiled.mesh, &params, &info)?;
             let coverage_gap = *coverage.get_or_insert_with(|| {
@@ -695,6 +719,7 @@ impl SwingEncoder {
                 sharpened_filter: info.sharpened_filter,
                 sharpen_hint: hint,
                 sharpen_smooth_factor: info.sharpen_smooth_factor,
+                sharpen_curved_walls: info.sharpen_curved_walls,
                 planar_factor: None,
                 sharpen_trials: Vec::new(),
             });
@@ -1116,16 +1141,28 @@ pub fn encode(mesh: &Mesh, opts: &SwingOptions) -> Result<SwingOutput, Error> {
 /// 23 is sharpened with.
 const DEFAULT_SMOOTH_FACTOR: f64 = 2.0;
 
-/// The sharpener options a hint and smooth factor stand for (extended for "none": its
-/// filter for after sharpening is never applied).
-fn sharpen_options(hint: SharpenHint, smooth_factor: f64) -> whet_sharpen::SharpenOptions {
+/// The curved-wall factor of the papers' method's candidates with curved walls (the
+/// extended method has them on by default, at the same factor; docs/swing.md section 2).
+pub const PAPERS_CURVED_WALL_FACTOR: f64 = whet_sharpen::DEFAULT_CURVED_WALL_FACTOR;
+
+/// The sharpener options a hint, smooth factor and curved-wall factor stand for (extended
+/// for "none": its filter for after sharpening is never applied).
+fn sharpen_options(
+    hint: SharpenHint,
+    smooth_factor: f64,
+    curved_walls: Option<f64>,
+) -> whet_sharpen::SharpenOptions {
     let method = match hint {
         SharpenHint::Papers => whet_sharpen::Method::Papers,
         _ => whet_sharpen::Method::Extended,
     };
-    whet_sharpen::SharpenOptions::DEFAULT
+    let opts = whet_sharpen::SharpenOptions::DEFAULT
         .with_method(method)
-        .with_smooth_factor(smooth_factor)
+        .with_smooth_factor(smooth_factor);
+    match curved_walls {
+        Some(w) => opts.with_curved_wall_factor(w),
+        None => opts,
+    }
 }
 
 /// `out` with header field 25 stating the planar-region projection at `factor` angle steps

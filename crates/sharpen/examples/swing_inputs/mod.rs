@@ -66,6 +66,8 @@ pub struct SwingInput {
     pub sharpen_hint: Option<whet_codec::SharpenHint>,
     /// Its smooth factor (2 when the stream names none).
     pub smooth_factor: f64,
+    /// Its curved-wall factor (field 27; `None`: the method's own).
+    pub curved_walls: Option<f64>,
     /// The stream states the planar-region projection after sharpening (field 25).
     pub planar: bool,
     /// The stream.
@@ -109,6 +111,10 @@ impl SwingInput {
         let opts = whet_sharpen::SharpenOptions::DEFAULT
             .with_method(method)
             .with_smooth_factor(factor);
+        let opts = match self.curved_walls {
+            Some(w) => opts.with_curved_wall_factor(w),
+            None => opts,
+        };
         let mut s = whet_sharpen::sharpen(&self.decoded, &opts).unwrap_or_else(|e| panic!("{e}"));
         whet_codec::SurfaceFilter::after_sharpening_of(&header)
             .apply_after_sharpening(&self.decoded, &mut s.mesh);
@@ -122,7 +128,7 @@ pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
         .unwrap_or_else(|e| panic!("{name}: {e}"));
     let dir = whet_testkit::workspace_root().join("target/sharpen-swing");
     let _ = std::fs::create_dir_all(&dir);
-    let path = dir.join(format!("v5-{name}-{bpv}-{}.whet", angles.tag()));
+    let path = dir.join(format!("v6-{name}-{bpv}-{}.whet", angles.tag()));
     let bytes = match std::fs::read(&path) {
         Ok(b) => b,
         Err(_) => {
@@ -154,6 +160,7 @@ pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
             .map_or(0, |b| b as u32),
         sharpen_hint: whet_codec::SharpenHint::stated(&header).map(|s| s.0),
         smooth_factor: whet_codec::SharpenHint::stated(&header).map_or(2.0, |s| s.1),
+        curved_walls: whet_codec::SharpenHint::curved_walls_of(&header),
         planar: whet_codec::SharpenHint::planar_of(&header).is_some(),
         original,
         decoded,

@@ -62,6 +62,9 @@ fn refuses_bad_options() {
         SharpenOptions::DEFAULT.with_smooth_factor(f64::NAN),
         SharpenOptions::DEFAULT.with_min_angle_degrees(-1.0),
         SharpenOptions::DEFAULT.with_min_angle_degrees(45.0),
+        SharpenOptions::DEFAULT.with_curved_wall_factor(0.5),
+        SharpenOptions::DEFAULT.with_curved_wall_factor(4.5),
+        SharpenOptions::DEFAULT.with_curved_wall_factor(f64::NAN),
     ] {
         assert!(
             matches!(sharpen(&m, &opts), Err(Error::Parameter(_))),
@@ -77,6 +80,12 @@ fn refuses_bad_options() {
     assert_eq!(SharpenOptions::default(), SharpenOptions::DEFAULT);
     assert_eq!(SharpenOptions::DEFAULT.method, Method::Extended);
     assert_eq!(SharpenOptions::DEFAULT.smooth_factor, 2.0);
+    assert_eq!(SharpenOptions::DEFAULT.curved_wall_factor, None);
+    assert_eq!(SharpenOptions::DEFAULT.curved_walls(), 2.0);
+    assert_eq!(SharpenOptions::PAPERS.curved_walls(), 0.0);
+    let off = SharpenOptions::DEFAULT.with_curved_wall_factor(0.0);
+    assert_eq!(off.curved_walls(), 0.0);
+    assert!(off.validate().is_ok());
 }
 
 #[test]

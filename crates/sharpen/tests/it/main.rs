@@ -25,3 +25,4 @@ mod ridge;
 mod robustness;
 mod rotations;
 mod swing;
+mod walls;

@@ -207,12 +207,12 @@ fn automatic_angle_bits_climb_on_flat_parts_and_stay_low_on_smooth_ones() {
     assert!((out.bits_per_original_vertex() / 3.0 - 1.0).abs() <= 0.05);
     let decoded = whet_codec::decode(&out.bytes, &whet_codec::DecodeOptions::DEFAULT).unwrap();
     assert_eq!(decoded, out.retiled);
-    // The sharpening choice retiled its candidates at the chosen bits (six methods and
-    // factors, each the same retiling, and none), then tried the chosen one with the
-    // planar-region projection.
+    // The sharpening choice retiled its candidates at the chosen bits (nine methods, factors
+    // and curved walls, each the same retiling, and none), then tried the chosen one with
+    // the planar-region projection.
     let unprojected = out.sharpen_trials.iter().filter(|t| !t.planar).count();
-    assert_eq!(unprojected, 7, "{:?}", out.sharpen_trials);
-    assert!(out.sharpen_trials.len() <= 8, "{:?}", out.sharpen_trials);
+    assert_eq!(unprojected, 10, "{:?}", out.sharpen_trials);
+    assert!(out.sharpen_trials.len() <= 11, "{:?}", out.sharpen_trials);
 
     // spot, smooth: every bit is paid for on curved patches (measured: 5-6 bits best).
     let out = encode(
@@ -276,16 +276,16 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
         let hint = out.sharpen_hint.unwrap();
         assert_ne!(hint, not, "{name}: {:?}", out.sharpen_trials);
         assert_eq!(SharpenHint::of(&header(&out.bytes)), Some(hint));
-        // Seven candidates, then the chosen sharpening with the planar-region projection.
+        // Ten candidates, then the chosen sharpening with the planar-region projection.
         let (planar, trials): (Vec<&whet_swing::SharpenTrial>, Vec<_>) =
             out.sharpen_trials.iter().partition(|t| t.planar);
-        assert_eq!(trials.len(), 7, "{name}");
+        assert_eq!(trials.len(), 10, "{name}");
         assert_eq!(planar.len(), usize::from(hint != SharpenHint::Unsharpened));
         let h = header(&out.bytes);
         let stated = SharpenHint::planar_of(&h);
         assert_eq!(stated.map(|s| s.0), out.planar_factor, "{name}");
         // The reported error is the chosen candidate's (with the projection when it won by
-        // the margin), the lowest of the seven but for the margin.
+        // the margin), the lowest of the ten but for the margin.
         let chosen = out.rms_pct.unwrap();
         let unprojected = match (out.planar_factor, planar.first()) {
             (Some(f), Some(p)) => {
@@ -293,7 +293,11 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
                 assert_eq!(p.rms_pct, chosen, "{name}");
                 let t = trials
                     .iter()
-                    .find(|t| t.hint == hint && t.smooth_factor == p.smooth_factor)
+                    .find(|t| {
+                        t.hint == hint
+                            && t.smooth_factor == p.smooth_factor
+                            && t.curved_walls == p.curved_walls
+                    })
                     .unwrap();
                 assert!(chosen < 0.995 * t.rms_pct, "{name}");
                 t.rms_pct
@@ -317,12 +321,21 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
             trials.iter().all(|t| unprojected * 0.995 <= t.rms_pct),
             "{name}"
         );
-        // The stream states the choice: method and factor.
+        // The stream states the choice: method and factor, and curved walls where they
+        // differ from the method's own (on for extended, off for papers).
         let factor = SharpenHint::smooth_factor_of(&h);
         assert_eq!(factor, out.sharpen_smooth_factor, "{name}");
+        let walls = SharpenHint::curved_walls_of(&h);
+        assert_eq!(walls, out.sharpen_curved_walls, "{name}");
         if hint != SharpenHint::Unsharpened {
             let t = trials.iter().find(|t| t.rms_pct == unprojected).unwrap();
             assert_eq!(factor, Some(t.smooth_factor), "{name}");
+            let own = if hint == SharpenHint::Extended {
+                2.0
+            } else {
+                0.0
+            };
+            assert_eq!(walls.unwrap_or(own), t.curved_walls, "{name}");
         }
         // The stream decodes to the encoder's mesh and stays within the size target (the
         // size searches count the hint's two bytes, so the rate may land on another L).

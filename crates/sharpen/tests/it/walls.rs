@@ -1,0 +1,117 @@
+//! Curved walls (`SharpenOptions::curved_wall_factor`, docs/sharpen.md): a flat plate meets a
+//! cylinder a few samples in radius across a chamfer, the shape of a small hole's rim.
+
+use whet_mesh::{DVec3, Mesh};
+use whet_sharpen::{sharpen, Method, SharpenOptions};
+
+/// Radius of the cylinder, in grid steps: it turns by about 16 degrees per step, over a
+/// smooth threshold of twice the mean angle (9.4 degrees with the noise below, 0.05 steps;
+/// at 0.06 the noise alone makes enough of its edges smooth to find the chamfer).
+const RADIUS: f64 = 3.5;
+/// Where the cylinder leaves the plate, and at what angle below it.
+const TILT: f64 = std::f64::consts::FRAC_PI_4;
+
+/// The true surface at `x` (the crease at `x = 0`): the plate `z = 0` for `x <= 0`, beyond
+/// it the cylinder of axis `y` leaving the plate at 45 degrees and bending down, by arc
+/// length.
+fn surface(x: f64) -> (f64, f64) {
+    if x <= 0.0 {
+        (x, 0.0)
+    } else {
+        let a = TILT + x / RADIUS;
+        (
+            RADIUS * (a.sin() - TILT.sin()),
+            RADIUS * (a.cos() - TILT.cos()),
+        )
+    }
+}
+
+/// A grid over the parameter `x` (20 steps on the plate, 8 on the cylinder, offset by half a
+/// step so that one column of cells straddles the crease: the chamfer) and `y` (12 steps),
+/// each cell cut by one diagonal. Every vertex is on the true surface but for a
+/// deterministic offset along the surface normal of up to `noise` steps, as quantization
+/// leaves on a decoded mesh: it sets the mean normal angle, hence the smooth threshold.
+fn plate_and_cylinder(noise: f64) -> Mesh {
+    let (nx, ny) = (29usize, 13usize);
+    let mut positions = Vec::with_capacity(nx * ny);
+    let mut state = 0x9E37_79B9_7F4A_7C15u64;
+    for j in 0..ny {
+        for i in 0..nx {
+            let t = i as f64 - 20.5;
+            let (x, z) = surface(t);
+            // splitmix64, mapped to [-1, 1)
+            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut h = state;
+            h = (h ^ (h >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            h = (h ^ (h >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            h ^= h >> 31;
+            let u = (h >> 11) as f64 / (1u64 << 52) as f64 - 1.0;
+            let normal = if t <= 0.0 {
+                DVec3::Z
+            } else {
+                let a = TILT + t / RADIUS;
+                DVec3::new(a.sin(), 0.0, a.cos())
+            };
+            positions.push(DVec3::new(x, j as f64, z) + noise * u * normal);
+        }
+    }
+    let mut triangles = Vec::new();
+    let at = |i: usize, j: usize| (j * nx + i) as u32;
+    for j in 0..ny - 1 {
+        for i in 0..nx - 1 {
+            triangles.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+            triangles.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+        }
+    }
+    Mesh::new(positions, triangles)
+}
+
+/// Distance of `p` to the crease line (`x = z = 0`).
+fn off_crease(p: DVec3) -> f64 {
+    (p.x * p.x + p.z * p.z).sqrt()
+}
+
+#[test]
+fn a_tight_cylinder_beside_a_plate_gets_its_chamfer_split_with_curved_walls_only() {
+    let mesh = plate_and_cylinder(0.05);
+    for method in crate::EDGE_SHARPENER {
+        let opts = SharpenOptions::DEFAULT.with_method(method);
+        // Without curved walls the cylinder has no core vertex: no red region on its side,
+        // so no chamfer edge across the crease.
+        let plain = sharpen(&mesh, &opts.with_curved_wall_factor(0.0)).unwrap();
+        assert_eq!(plain.report.curved_wall_edges, 0, "{method}");
+        let crease_vertices = |m: &Mesh| {
+            m.positions[mesh.positions.len()..]
+                .iter()
+                .filter(|p| off_crease(**p) < 0.25)
+                .count()
+        };
+        assert_eq!(crease_vertices(&plain.mesh), 0, "{method}");
+        let walls = sharpen(&mesh, &opts.with_curved_wall_factor(2.0)).unwrap();
+        let r = &walls.report;
+        assert!(r.curved_wall_edges > 0, "{method}: {r:?}");
+        assert_eq!(r.curved_wall_factor, 2.0);
+        // The extended method has them by default (at 2); the papers' method has not.
+        let default = sharpen(&mesh, &opts).unwrap();
+        match method {
+            Method::Extended => assert_eq!(default.mesh, walls.mesh),
+            _ => assert_eq!(default.mesh, plain.mesh),
+        }
+        // The interior rows of the chamfer (11 cells, one new vertex on each cell's
+        // crossing edge) get vertices near the crease: between the plate and the
+        // cylinder's tangent plane one step from it, within a quarter step.
+        let near = crease_vertices(&walls.mesh);
+        assert!(
+            near >= 9,
+            "{method}: {near} new vertices near the crease, {r:?}"
+        );
+        // Nothing moved on the cylinder far from the crease, nor on the plate.
+        for (v, (a, b)) in mesh.positions.iter().zip(&walls.mesh.positions).enumerate() {
+            assert_eq!(a, b, "{method}: input vertex {v} moved");
+        }
+        // The output is an oriented manifold with the input's boundary.
+        let c = crate::support::check(&mesh, &mesh, &walls);
+        assert!(c.manifold, "{method}: {c:?}");
+        assert_eq!(c.new_boundary_edges, 0, "{method}: {c:?}");
+    }
+}
