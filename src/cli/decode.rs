@@ -38,6 +38,10 @@ pub struct DecodeArgs {
     /// method's own (2 for extended, off for papers).
     #[arg(long)]
     curved_walls: Option<f64>,
+    /// EdgeSharpener passes (`whet sharpen --passes`). Without it, the number a swing stream
+    /// names with its method (see --method); otherwise 1.
+    #[arg(long)]
+    passes: Option<u32>,
     /// Subdiv streams: subdivision levels, overriding the header (0 gives the control mesh).
     #[arg(long)]
     levels: Option<u32>,
@@ -96,16 +100,18 @@ pub fn run(args: &DecodeArgs) -> CliResult {
         // The stream's choice (`SharpenHint::stated`); an explicit --method replaces it,
         // factor included.
         let stated = header.as_ref().and_then(whet_codec::SharpenHint::stated);
-        let (method, stream_factor, stream_walls) = match (&args.method, stated) {
-            (Some(m), _) => (m.as_str(), None, None),
-            (None, Some((h, f))) => (
-                h.name(),
-                Some(f),
-                header
-                    .as_ref()
-                    .and_then(whet_codec::SharpenHint::curved_walls_of),
-            ),
-            (None, None) => ("extended", None, None),
+        let (method, stream_factor, stream_walls, stream_passes) = match (&args.method, stated) {
+            (Some(m), _) => (m.as_str(), None, None, None),
+            (None, Some((h, f))) => {
+                let h2 = header.as_ref();
+                (
+                    h.name(),
+                    Some(f),
+                    h2.and_then(whet_codec::SharpenHint::curved_walls_of),
+                    h2.and_then(whet_codec::SharpenHint::passes_of),
+                )
+            }
+            (None, None) => ("extended", None, None, None),
         };
         if method == whet_codec::SharpenHint::Unsharpened.name() {
             // No candidate beat the decoded mesh (or `--method none`): what `whet decode`
@@ -135,11 +141,12 @@ pub fn run(args: &DecodeArgs) -> CliResult {
             };
         }
         let smooth_factor = args.smooth_factor.or(stream_factor).unwrap_or(2.0);
-        let mut opts = super::sharpen::sharpen_options(method, smooth_factor)?;
+        let mut opts = super::sharpen::sharpen_options(method, smooth_factor)?
+            .with_passes(args.passes.or(stream_passes).unwrap_or(1));
         if let Some(w) = args.curved_walls.or(stream_walls) {
             opts = opts.with_curved_wall_factor(w);
-            opts.validate().map_err(super::Failure::input)?;
         }
+        opts.validate().map_err(super::Failure::input)?;
         let mut s = super::sharpen::run_sharpen(&mesh, &opts)?;
         if !args.no_surface_filter {
             // A swing stream's filter for after sharpening: the smooth parts the sharpener

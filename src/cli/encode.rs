@@ -394,14 +394,18 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh) -> CliResult {
             "sharpen_method": out.sharpen_hint.map(|h| h.name()),
             "sharpen_smooth_factor": out.sharpen_hint.and(out.sharpen_smooth_factor),
             "sharpen_curved_walls": out.sharpen_hint.and(out.sharpen_curved_walls),
+            "sharpen_passes": out.sharpen_hint.map(|_| out.sharpen_passes.unwrap_or(1)),
             "sharpen_trials": out.sharpen_trials.iter().map(|t| json!({
                 "method": t.hint.name(),
                 "smooth_factor": t.smooth_factor,
                 "curved_walls": t.curved_walls,
+                "passes": t.passes,
                 "rms_error_pct": t.rms_pct,
+                "max_error_pct": t.max_pct,
                 "planar": t.planar,
             })).collect::<Vec<_>>(),
             "planar_tolerance": out.planar_factor,
+            "sharpen_input_max_error_pct": out.sharpen_input_max_pct,
             "search": out.search.iter().map(|&(f, b)| json!([f, b])).collect::<Vec<_>>(),
             "angle_trials": out.angle_trials.iter().map(|t| json!({
                 "angle_bits": t.angle_bits,

@@ -178,10 +178,12 @@ fn sharpened(
     method: whet_sharpen::Method,
     smooth_factor: f64,
     curved_walls: Option<f64>,
+    passes: u32,
 ) -> Result<whet_sharpen::Sharpened, String> {
     let mut opts = whet_sharpen::SharpenOptions::DEFAULT
         .with_method(method)
-        .with_smooth_factor(smooth_factor);
+        .with_smooth_factor(smooth_factor)
+        .with_passes(passes);
     if let Some(w) = curved_walls {
         opts = opts.with_curved_wall_factor(w);
     }
@@ -222,7 +224,11 @@ fn sharpened_from_stream(mesh: &Mesh, bytes: &[u8]) -> Result<(Mesh, Vec<[u32; 2
     let curved_walls = header
         .as_ref()
         .and_then(whet_codec::SharpenHint::curved_walls_of);
-    let mut s = sharpened(mesh, method, smooth_factor, curved_walls)?;
+    let passes = header
+        .as_ref()
+        .and_then(whet_codec::SharpenHint::passes_of)
+        .unwrap_or(1);
+    let mut s = sharpened(mesh, method, smooth_factor, curved_walls, passes)?;
     if let Some(h) = &header {
         whet_codec::SurfaceFilter::after_sharpening_of(h).apply_after_sharpening(mesh, &mut s.mesh);
         super::sharpen::flatten_stated_planes(h, &mut s.mesh);

@@ -34,6 +34,10 @@ pub struct SharpenArgs {
     /// 0 is off; 1 to 4 otherwise. Default: 2 for extended, off for papers.
     #[arg(long)]
     curved_walls: Option<f64>,
+    /// extended and papers: run the sharpener this many times (1 to 4), each pass on the
+    /// previous one's output; a pass's splits can leave chamfers the next finds.
+    #[arg(long, default_value_t = 1)]
+    passes: u32,
     /// normal-filter: neighbourhood radius in mean edge lengths (a little more than the widest
     /// feature to sharpen).
     #[arg(long, default_value_t = SharpenOptions::DEFAULT.rho)]
@@ -102,7 +106,8 @@ pub fn run(args: &SharpenArgs) -> CliResult {
         .with_rho(args.rho)
         .with_eta(args.eta)
         .with_lambda(args.lambda)
-        .with_weld_clusters(!args.no_weld);
+        .with_weld_clusters(!args.no_weld)
+        .with_passes(args.passes);
     let opts = match args.curved_walls {
         Some(w) => opts.with_curved_wall_factor(w),
         None => opts,

@@ -366,13 +366,14 @@ fn decode_sharpen_follows_the_streams_hint() {
         "sharpened",
         "--json",
     ]);
-    // The encoder measured ten candidates (the papers' method twice, without and with
-    // curved walls) and kept the lowest error; then the chosen sharpening once more with the
-    // planar-region projection, kept when it beat it.
+    // The encoder measured nineteen candidates (the papers' method without and with curved
+    // walls, every sharpening in one pass and in two, and none) and kept the lowest error;
+    // then the chosen sharpening once more with the planar-region projection, kept when it
+    // beat it.
     let all = j["sharpen_trials"].as_array().unwrap();
     let trials: Vec<_> = all.iter().filter(|t| t["planar"] == false).collect();
     let planar: Vec<_> = all.iter().filter(|t| t["planar"] == true).collect();
-    assert_eq!(trials.len(), 10, "{j}");
+    assert_eq!(trials.len(), 19, "{j}");
     let chosen = j["sharpen_method"].as_str().unwrap();
     assert_eq!(planar.len(), usize::from(chosen != "none"), "{j}");
     // The stream states curved walls only where they differ from the method's own (on for
@@ -386,7 +387,8 @@ fn decode_sharpen_follows_the_streams_hint() {
             t["method"] == chosen
                 && (chosen == "none"
                     || (t["smooth_factor"] == j["sharpen_smooth_factor"]
-                        && t["curved_walls"].as_f64() == Some(chosen_walls)))
+                        && t["curved_walls"].as_f64() == Some(chosen_walls)
+                        && t["passes"] == j["sharpen_passes"]))
         })
         .map(|t| t["rms_error_pct"].as_f64().unwrap())
         .unwrap();
@@ -406,12 +408,16 @@ fn decode_sharpen_follows_the_streams_hint() {
             }
         }
     }
-    // A later candidate must win by the encoder's margin (0.5 %).
+    // A later candidate must win by the encoder's margin (0.5 %), among those whose max
+    // error stays within the sharpened mesh's (the others cannot be chosen).
+    let input_max = j["sharpen_input_max_error_pct"].as_f64().unwrap();
     for t in &trials {
-        assert!(
-            chosen_error * 0.995 <= t["rms_error_pct"].as_f64().unwrap(),
-            "{j}"
-        );
+        if t["max_error_pct"].as_f64().unwrap() <= input_max {
+            assert!(
+                chosen_error * 0.995 <= t["rms_error_pct"].as_f64().unwrap(),
+                "{j}"
+            );
+        }
     }
     // The same stream stating each hint in turn.
     let bytes = std::fs::read(&stream).unwrap();
@@ -435,8 +441,10 @@ fn decode_sharpen_follows_the_streams_hint() {
     assert_ne!(papers, extended);
     for (code, expected) in [(0u64, &extended), (1, &papers), (2, &plain)] {
         let mut c = container.clone();
-        // Each method with its own curved walls (the encoder may have stated others).
+        // Each method with its own curved walls and one pass (the encoder may have stated
+        // others).
         c.header.remove(whet_format::tag::SHARPEN_CURVED_WALLS);
+        c.header.remove(whet_format::tag::SHARPEN_PASSES);
         c.header = c
             .header
             .clone()
@@ -534,7 +542,7 @@ fn decode_sharpen_follows_the_streams_hint() {
 }
 
 #[test]
-fn decode_sharpen_reads_the_streams_curved_walls() {
+fn decode_sharpen_reads_the_streams_curved_walls_and_passes() {
     // partLp retiled at its own vertex count: its through-holes, 2.3 edges in radius, are
     // where curved walls change the papers' method (docs/results.md, "Curved walls").
     let dir = scratch_dir("cli-decode-curved-walls");
@@ -600,4 +608,25 @@ fn decode_sharpen_reads_the_streams_curved_walls() {
             "he.off"
         ) == expected
     );
+    // Field 29 states the passes: papers at 1.5 in two passes, and `--passes` overriding it.
+    let mut c = container.clone();
+    c.header = c
+        .header
+        .clone()
+        .with(whet_format::tag::SHARPEN_METHOD, 1u64)
+        .with(whet_format::tag::SHARPEN_SMOOTH_FACTOR, 150u64)
+        .with(whet_format::tag::SHARPEN_PASSES, 2u64);
+    let two = dir.join("two-passes.whet");
+    std::fs::write(&two, c.to_bytes().unwrap()).unwrap();
+    let explicit = decode(
+        &stream,
+        &[&papers[..], &["--passes", "2"]].concat(),
+        "p2.off",
+    );
+    assert!(
+        explicit != without,
+        "a second pass changed nothing on partLp"
+    );
+    assert!(decode(&two, &["--sharpen"], "h2.off") == explicit);
+    assert!(decode(&two, &["--sharpen", "--passes", "1"], "h21.off") == without);
 }

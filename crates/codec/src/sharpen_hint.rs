@@ -113,6 +113,20 @@ impl SharpenHint {
         (100.0..=400.0).contains(&h).then_some(h as u64)
     }
 
+    /// The EdgeSharpener passes a swing stream's header states with its sharpening (field
+    /// 29; `whet_sharpen::SharpenOptions::passes`): `None` (one) without the field, with a
+    /// value outside [`Self::PASSES`], for other modes, or without a hint this whet knows.
+    pub fn passes_of(header: &whet_format::Header) -> Option<u32> {
+        Self::of(header)?;
+        header
+            .get_u64(whet_format::tag::SHARPEN_PASSES)
+            .filter(|p| Self::PASSES.contains(p))
+            .map(|p| p as u32)
+    }
+
+    /// The pass counts field 29 can state (`whet_sharpen::MAX_PASSES` is 4).
+    pub const PASSES: std::ops::RangeInclusive<u64> = 1..=4;
+
     /// The planar-region projection a swing stream's header states for after sharpening
     /// (field 25): its tolerance factor (the field's hundredths over 100, in angle steps)
     /// and the stream's angle bits, for `whet_sharpen::PlanarOptions::for_swing`. `None`
@@ -196,6 +210,23 @@ mod tests {
         assert_eq!(SharpenHint::curved_walls_code(0.5), None);
         assert_eq!(SharpenHint::curved_walls_code(4.004), Some(400));
         assert_eq!(SharpenHint::curved_walls_code(4.2), None);
+    }
+
+    #[test]
+    fn passes_go_with_a_known_method_and_stay_in_range() {
+        let swing = whet_format::Header::new(whet_format::Mode::Swing, 3, 1);
+        let two = swing.clone().with(whet_format::tag::SHARPEN_PASSES, 2u64);
+        assert_eq!(SharpenHint::passes_of(&two), None);
+        let papers = two.with(whet_format::tag::SHARPEN_METHOD, 1u64);
+        assert_eq!(SharpenHint::passes_of(&papers), Some(2));
+        for bad in [0u64, 5, u64::MAX] {
+            let h = papers.clone().with(whet_format::tag::SHARPEN_PASSES, bad);
+            assert_eq!(SharpenHint::passes_of(&h), None, "{bad}");
+        }
+        let exact = whet_format::Header::new(whet_format::Mode::Exact, 3, 1)
+            .with(whet_format::tag::SHARPEN_METHOD, 1u64)
+            .with(whet_format::tag::SHARPEN_PASSES, 2u64);
+        assert_eq!(SharpenHint::passes_of(&exact), None);
     }
 
     #[test]

@@ -936,6 +936,9 @@ pub struct SwingStreamInfo<'a> {
     /// Its curved-wall factor (optional header field 27, written when `Some` and the hint
     /// is; [`SharpenHint::curved_walls_code`]).
     pub sharpen_curved_walls: Option<f64>,
+    /// Its EdgeSharpener passes (optional header field 29, written when `Some` and the hint
+    /// is).
+    pub sharpen_passes: Option<u32>,
 }
 
 /// Writes the swing stream of a retiled mesh, after checking that Edgebreaker reproduces the
@@ -1396,6 +1399,9 @@ fn write_stream(
         {
             header = header.with(tag::SHARPEN_CURVED_WALLS, code);
         }
+        if let Some(p) = info.sharpen_passes {
+            header = header.with(tag::SHARPEN_PASSES, u64::from(p));
+        }
     }
     header.set_bbox(min, max);
     let container = Container::new(header)
@@ -1840,6 +1846,7 @@ mod tests {
             sharpen_hint: None,
             sharpen_smooth_factor: None,
             sharpen_curved_walls: None,
+            sharpen_passes: None,
         }
     }
 

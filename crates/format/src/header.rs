@@ -172,9 +172,12 @@ pub mod tag {
     /// [`SHARPEN_METHOD`], in hundredths, 0 for off (swing; absent, or another value: the
     /// method's own).
     pub const SHARPEN_CURVED_WALLS: u64 = 27;
+    /// u64 (format 1.2, optional): how many EdgeSharpener passes go with
+    /// [`SHARPEN_METHOD`] (swing; absent, or outside 1..=4: one).
+    pub const SHARPEN_PASSES: u64 = 29;
 
     /// Every tag this crate knows, with its name and value type.
-    pub const KNOWN: [(u64, &str, ValueType); 15] = [
+    pub const KNOWN: [(u64, &str, ValueType); 16] = [
         (ENCODER, "encoder", ValueType::Bytes),
         (COMPONENT_COUNT, "component_count", ValueType::U64),
         (QUANT_BITS, "quant_bits", ValueType::U64),
@@ -202,6 +205,7 @@ pub mod tag {
         ),
         (PLANAR_TOLERANCE, "planar_tolerance", ValueType::U64),
         (SHARPEN_CURVED_WALLS, "sharpen_curved_walls", ValueType::U64),
+        (SHARPEN_PASSES, "sharpen_passes", ValueType::U64),
     ];
 
     /// Name and type of a known tag.

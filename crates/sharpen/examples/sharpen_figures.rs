@@ -169,12 +169,17 @@ fn swing(only: Option<String>) {
                 let name = match s.sharpen_hint {
                     Some(SharpenHint::Unsharpened) => "none".to_string(),
                     h => format!(
-                        "{} {}{}{}",
+                        "{} {}{}{}{}",
                         h.map_or("extended", SharpenHint::name),
                         s.smooth_factor,
                         match s.curved_walls {
                             Some(w) => format!(" walls {w}"),
                             None => String::new(),
+                        },
+                        if s.passes > 1 {
+                            format!(" x{}", s.passes)
+                        } else {
+                            String::new()
                         },
                         if s.planar { " + planes" } else { "" }
                     ),

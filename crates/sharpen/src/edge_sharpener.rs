@@ -194,6 +194,25 @@ impl EdgeSharpener {
         }
         let start = Instant::now();
         self.options.validate()?;
+        let mut out = self.sharpen_once(mesh)?;
+        out.report.passes = 1;
+        while out.report.passes < self.options.passes as usize && changed(&out.report) {
+            // Another pass on the output (`SharpenOptions::passes`): the chamfers a pass
+            // leaves (where its splits made new strips) are found by the next.
+            let next = self.sharpen_once(&out.mesh)?;
+            let last = next.report.clone();
+            if !changed(&last) {
+                break;
+            }
+            out = compose_passes(out, next);
+        }
+        out.report.time = start.elapsed();
+        Ok(out)
+    }
+
+    /// One pass of [`Self::sharpen`] (options validated).
+    fn sharpen_once(&mut self, mesh: &Mesh) -> Result<Sharpened, Error> {
+        let start = Instant::now();
         if let Some(v) = mesh.positions.iter().position(|p| !p.is_finite()) {
             return Err(Error::InvalidInput(MeshError::NonFiniteCoordinate {
                 vertex: v as u32,
@@ -289,6 +308,64 @@ impl EdgeSharpener {
             tags,
             report,
         })
+    }
+}
+
+/// A pass changed the mesh: it added, moved, welded or removed something.
+fn changed(r: &SharpenReport) -> bool {
+    r.inserted_vertices > 0
+        || r.moved_input_vertices > 0
+        || r.welded_vertices > 0
+        || r.collapsed_triangles > 0
+}
+
+/// `first` followed by `next`, a pass over `first.mesh`: `next`'s mesh, parents traced back
+/// to `first`'s input, the tags of both (input vertices keep their indices from pass to
+/// pass, so a vertex tagged by either stays tagged), and the counts added up (the smooth
+/// threshold and the input counts are the first pass's).
+fn compose_passes(first: Sharpened, next: Sharpened) -> Sharpened {
+    let parents = next
+        .parents
+        .iter()
+        .map(|p| first.parents.get(p.index()).copied().unwrap_or(*p))
+        .collect();
+    let mut flags = vec![false; next.mesh.positions.len()];
+    for v in first.tags.vertices.iter().chain(&next.tags.vertices) {
+        if let Some(f) = flags.get_mut(v.index()) {
+            *f = true;
+        }
+    }
+    let tags = SharpTags::from_vertex_flags(&next.mesh, &flags);
+    let (a, b) = (&first.report, &next.report);
+    let mut unmoved = a.unmoved_by_reason;
+    for (u, n) in unmoved.iter_mut().zip(b.unmoved_by_reason) {
+        *u += n;
+    }
+    let report = SharpenReport {
+        output_vertices: b.output_vertices,
+        output_triangles: b.output_triangles,
+        chamfer_edges: a.chamfer_edges + b.chamfer_edges,
+        corner_triangles: a.corner_triangles + b.corner_triangles,
+        chamfer_vertices: a.chamfer_vertices + b.chamfer_vertices,
+        inserted_vertices: a.inserted_vertices + b.inserted_vertices,
+        new_vertices: a.new_vertices + b.new_vertices,
+        snapped_vertices: a.snapped_vertices + b.snapped_vertices,
+        unmoved_by_reason: unmoved,
+        moved_input_vertices: a.moved_input_vertices + b.moved_input_vertices,
+        collapsed_triangles: a.collapsed_triangles + b.collapsed_triangles,
+        welded_vertices: a.welded_vertices + b.welded_vertices,
+        restored_triangles: a.restored_triangles + b.restored_triangles,
+        curved_wall_edges: a.curved_wall_edges + b.curved_wall_edges,
+        tagged_vertices: tags.vertices.len(),
+        sharp_edges: tags.edges.len(),
+        passes: a.passes + 1,
+        ..a.clone()
+    };
+    Sharpened {
+        mesh: next.mesh,
+        parents,
+        tags,
+        report,
     }
 }
 

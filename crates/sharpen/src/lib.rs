@@ -50,7 +50,7 @@ pub use edge_sharpener::EdgeSharpener;
 pub const PEAK_BYTES_PER_TRIANGLE: u64 = 200;
 
 pub use normal_filter::VertexSelection;
-pub use options::{Method, SharpenOptions, DEFAULT_CURVED_WALL_FACTOR};
+pub use options::{Method, SharpenOptions, DEFAULT_CURVED_WALL_FACTOR, MAX_PASSES};
 pub use planar::{flatten_planar_regions, PlanarOptions, PlanarReport};
 pub use report::{SharpenReport, UnmovedReason};
 pub use tags::SharpTags;

@@ -64,6 +64,10 @@ impl std::str::FromStr for Method {
 /// walls; marching-cubes samplings and the organic fixtures come out the same either way.
 pub const DEFAULT_CURVED_WALL_FACTOR: f64 = 2.0;
 
+/// The most passes [`SharpenOptions::passes`] allows: a third pass gains about 1 % where a
+/// second gains 5-40 % (docs/results.md, "Passes").
+pub const MAX_PASSES: u32 = 4;
+
 /// Options of [`crate::sharpen`] and [`crate::EdgeSharpener`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
@@ -100,6 +104,10 @@ pub struct SharpenOptions {
     /// method; off for the papers', as in the papers); `Some(0.0)`: off; otherwise finite, in
     /// `[1, 4]`. See [`Self::curved_walls`].
     pub curved_wall_factor: Option<f64>,
+    /// How many times EdgeSharpener runs, each pass on the previous one's output (1 to 4;
+    /// default 1, the papers' single pass). A pass's splits can leave chamfers the next one
+    /// finds (docs/sharpen.md, "Passes"); passes stop early once one changes nothing.
+    pub passes: u32,
 }
 
 impl SharpenOptions {
@@ -114,6 +122,7 @@ impl SharpenOptions {
         lambda: 0.0,
         weld_clusters: true,
         curved_wall_factor: None,
+        passes: 1,
     };
 
     /// The papers' algorithm with their constants (`--method papers`).
@@ -167,6 +176,12 @@ impl SharpenOptions {
         self
     }
 
+    /// Sets the number of passes.
+    pub const fn with_passes(mut self, passes: u32) -> Self {
+        self.passes = passes;
+        self
+    }
+
     /// The curved-wall factor a run uses: the one set, or the method's own (0: off).
     pub fn curved_walls(&self) -> f64 {
         self.curved_wall_factor.unwrap_or(match self.method {
@@ -199,6 +214,12 @@ impl SharpenOptions {
         if !(w == 0.0 || (1.0..=4.0).contains(&w)) {
             return Err(crate::Error::Parameter(format!(
                 "curved_wall_factor must be 0 (off) or between 1 and 4, got {w}"
+            )));
+        }
+        if !(1..=MAX_PASSES).contains(&self.passes) {
+            return Err(crate::Error::Parameter(format!(
+                "passes must be between 1 and {MAX_PASSES}, got {}",
+                self.passes
             )));
         }
         for (name, x) in [("eta", self.eta), ("lambda", self.lambda)] {

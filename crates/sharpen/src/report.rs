@@ -110,6 +110,10 @@ pub struct SharpenReport {
     pub curved_wall_factor: f64,
     /// Edges the curved walls made smooth (included in `smooth_edges`).
     pub curved_wall_edges: usize,
+    /// Passes that ran (`SharpenOptions::passes`; fewer when one changed nothing). The
+    /// counts of the later passes are added to the first's; the smooth threshold, the mean
+    /// angle and `smooth_edges` are the first pass's.
+    pub passes: usize,
     /// Subdivided triangles the sliver pass restored to their input triangles (docs/sharpen.md,
     /// "The sliver pass").
     pub restored_triangles: usize,
@@ -176,7 +180,7 @@ impl SharpenReport {
     /// `absolute_feature_vertices`, `presmooth_iterations`, `filtered_normals`,
     /// `rectified_normals`, `update_iterations`, `flips_avoided`, `swaps`, `collapses`,
     /// `detection_ms`, `filtering_ms` and `updating_ms` (zeros for the other methods), then
-    /// `curved_wall_factor` and `curved_wall_edges`.
+    /// `curved_wall_factor`, `curved_wall_edges` and `passes`.
     pub fn to_json(&self) -> String {
         let mut s = String::with_capacity(768);
         // Writing to a String cannot fail.
@@ -227,7 +231,7 @@ impl SharpenReport {
              \"absolute_feature_vertices\":{},\"presmooth_iterations\":{},\"filtered_normals\":{},\
              \"rectified_normals\":{},\"update_iterations\":{},\"flips_avoided\":{},\"swaps\":{},\
              \"collapses\":{},\"detection_ms\":{},\"filtering_ms\":{},\"updating_ms\":{},\
-             \"curved_wall_factor\":{},\"curved_wall_edges\":{}}}",
+             \"curved_wall_factor\":{},\"curved_wall_edges\":{},\"passes\":{}}}",
             json_num(self.rho),
             json_num(self.eta),
             json_num(self.lambda),
@@ -246,6 +250,7 @@ impl SharpenReport {
             json_num(self.updating_time.as_secs_f64() * 1e3),
             json_num(self.curved_wall_factor),
             self.curved_wall_edges,
+            self.passes,
         );
         s
     }
@@ -290,6 +295,7 @@ mod tests {
             "updating_ms",
             "curved_wall_factor",
             "curved_wall_edges",
+            "passes",
         ] {
             assert_eq!(j.matches(&format!("\"{key}\":")).count(), 1, "{key} in {j}");
         }

@@ -61,8 +61,15 @@ pub struct SharpenTrial {
     /// EdgeSharpener's curved-wall factor (`SharpenOptions::curved_walls`, the method's own
     /// unless the candidate sets one; 0: off).
     pub curved_walls: f64,
+    /// EdgeSharpener passes (`SharpenOptions::passes`; irrelevant for
+    /// [`SharpenHint::Unsharpened`]).
+    pub passes: u32,
     /// Measured symmetric RMS error of `whet decode --sharpen`'s output, % of the diagonal.
     pub rms_pct: f64,
+    /// Its measured symmetric max error, % of the diagonal: a sharpening whose max is over
+    /// that of the mesh it sharpens (the decoded mesh without its surface filter) is not
+    /// chosen.
+    pub max_pct: f64,
     /// With the planar-region projection after sharpening (optional header field 25, at
     /// [`PLANAR_FACTOR`]): tried on the best sharpening only.
     pub planar: bool,
@@ -247,12 +254,19 @@ pub struct SwingOutput {
     /// The curved-wall factor that goes with [`Self::sharpen_hint`] when it is not the
     /// method's own (optional header field 27; `None`: the method's own).
     pub sharpen_curved_walls: Option<f64>,
+    /// The EdgeSharpener passes that go with [`Self::sharpen_hint`] when more than one
+    /// (optional header field 29).
+    pub sharpen_passes: Option<u32>,
     /// The planar-region projection after sharpening the stream states (optional header
     /// field 25: its tolerance in angle steps), when the encoder measured it better.
     pub planar_factor: Option<f64>,
     /// The candidates of that choice with their measured symmetric RMS error (% of the
     /// diagonal; empty when no choice was made).
     pub sharpen_trials: Vec<SharpenTrial>,
+    /// The symmetric max error (% of the diagonal) of the mesh those candidates sharpen (the
+    /// decoded mesh without its surface filter): no sharpening whose max is over it is
+    /// chosen. `None` when no choice was made.
+    pub sharpen_input_max_pct: Option<f64>,
     /// How far the original's surface strays from the retiling, in units of `L`: the
     /// largest distance of a sample of the original's vertices, outside the components
     /// coded as pillows, to the retiled mesh (see `MAX_COVERAGE_GAP`); infinite when a
@@ -385,9 +399,11 @@ impl SwingEncoder {
         const MARGIN: f64 = 0.995;
         // (method, smooth factor, curved-wall factor; `None`: the method's own, which is on
         // for the extended method and off for the papers'). The papers' method with curved
-        // walls comes last, so that it is chosen only where it beats the others by the margin.
+        // walls comes after the others, and every sharpening in two passes after all of them
+        // in one, so that each extension is chosen only where it beats what comes before it
+        // by the margin.
         const W: Option<f64> = Some(PAPERS_CURVED_WALL_FACTOR);
-        const CANDIDATES: [(SharpenHint, f64, Option<f64>); 9] = [
+        const SHARPENINGS: [(SharpenHint, f64, Option<f64>); 9] = [
             (SharpenHint::Extended, DEFAULT_SMOOTH_FACTOR, None),
             (SharpenHint::Papers, DEFAULT_SMOOTH_FACTOR, None),
             (SharpenHint::Extended, 1.5, None),
@@ -398,6 +414,17 @@ impl SwingEncoder {
             (SharpenHint::Papers, 1.5, W),
             (SharpenHint::Papers, 1.0, W),
         ];
+        let candidates: Vec<Candidate> = [1, TWO_PASSES]
+            .into_iter()
+            .flat_map(|passes| {
+                SHARPENINGS.map(|(hint, smooth_factor, curved_walls)| Candidate {
+                    hint: Some(hint),
+                    smooth_factor,
+                    curved_walls,
+                    passes,
+                })
+            })
+            .collect();
         let fraction = out.edge_length_fraction;
         // The candidates are retiled at `out`'s angle bits (the automatic choice's, when on).
         let at_bits = SwingEncoder::new(
@@ -405,11 +432,7 @@ impl SwingEncoder {
                 .with_angle_bits(out.angle_bits)
                 .with_auto_angle_bits(false),
         );
-        let others: Vec<_> = CANDIDATES[1..]
-            .iter()
-            .map(|&(h, f, w)| (Some(h), f, w))
-            .collect();
-        let mut streams = match at_bits.encode_at_for(prep, fraction, &others) {
+        let mut streams = match at_bits.encode_at_for(prep, fraction, &candidates[1..]) {
             // The same retiling (the retiler is deterministic); only the hint and the filter
             // for after sharpening differ.
             Ok(s) if s.first().is_some_and(|p| p.retiled == out.retiled) => s,
@@ -421,19 +444,21 @@ impl SwingEncoder {
         .into_iter();
         let mut trials = Vec::new();
         let mut best: Option<(SharpenTrial, Option<SwingOutput>)> = None;
-        for (i, (hint, smooth_factor, curved_walls)) in CANDIDATES.into_iter().enumerate() {
-            let opts = sharpen_options(hint, smooth_factor, curved_walls);
-            let (rms, stream) = if i == 0 {
+        // Sharpening must not make the worst place worse than the mesh it sharpens (the issue's
+        // "no case gets worse"): the RMS decides among the candidates whose max stays within
+        // that mesh's.
+        let input_max = self.unfiltered_figures(prep, &out)?.1;
+        for (i, c) in candidates.iter().enumerate() {
+            let (hint, smooth_factor) = (c.hint.unwrap_or(SharpenHint::Extended), c.smooth_factor);
+            let opts = c.sharpen_options();
+            let ((rms, max), stream) = if i == 0 {
                 // `out` was encoded for this one.
-                let rms = match out.rms_pct {
-                    Some(r) => r,
-                    None => self.measure_as(prep, &out, ErrorOf::Sharpened, &opts)?,
-                };
-                (rms, None)
+                let f = self.measure_figures(prep, &out, ErrorOf::Sharpened, &opts)?;
+                (f, None)
             } else {
                 let Some(p) = streams.next() else { break };
                 (
-                    self.measure_as(prep, &p, ErrorOf::Sharpened, &opts)?,
+                    self.measure_figures(prep, &p, ErrorOf::Sharpened, &opts)?,
                     Some(p),
                 )
             };
@@ -441,21 +466,25 @@ impl SwingEncoder {
                 hint,
                 smooth_factor,
                 curved_walls: opts.curved_walls(),
+                passes: opts.passes,
                 rms_pct: rms,
+                max_pct: max,
                 planar: false,
             };
             trials.push(trial);
-            if best.as_ref().is_none_or(|(b, _)| rms < MARGIN * b.rms_pct) {
+            if max <= input_max && best.as_ref().is_none_or(|(b, _)| rms < MARGIN * b.rms_pct) {
                 best = Some((trial, stream));
             }
         }
         let opts = whet_sharpen::SharpenOptions::DEFAULT;
-        let decoded = self.measure_as(prep, &out, ErrorOf::Decoded, &opts)?;
+        let (decoded, decoded_max) = self.measure_figures(prep, &out, ErrorOf::Decoded, &opts)?;
         let none = SharpenTrial {
             hint: SharpenHint::Unsharpened,
             smooth_factor: DEFAULT_SMOOTH_FACTOR,
             curved_walls: 0.0,
+            passes: 1,
             rms_pct: decoded,
+            max_pct: decoded_max,
             planar: false,
         };
         trials.push(none);
@@ -480,23 +509,27 @@ impl SwingEncoder {
             // The planar-region projection after the chosen sharpening: the flat faces'
             // quantization noise, which the sharpener leaves (docs/swing.md section 2).
             let planar = restate_planar(chosen.clone(), PLANAR_FACTOR)?;
-            let opts = sharpen_options(
-                chosen_trial.hint,
-                chosen_trial.smooth_factor,
-                Some(chosen_trial.curved_walls),
-            );
-            let rms = self.measure_as(prep, &planar, ErrorOf::Sharpened, &opts)?;
+            let opts = Candidate {
+                hint: Some(chosen_trial.hint),
+                smooth_factor: chosen_trial.smooth_factor,
+                curved_walls: Some(chosen_trial.curved_walls),
+                passes: chosen_trial.passes,
+            }
+            .sharpen_options();
+            let (rms, max) = self.measure_figures(prep, &planar, ErrorOf::Sharpened, &opts)?;
             trials.push(SharpenTrial {
                 rms_pct: rms,
+                max_pct: max,
                 planar: true,
                 ..chosen_trial
             });
-            if rms < MARGIN * chosen_trial.rms_pct {
+            if rms < MARGIN * chosen_trial.rms_pct && max <= input_max.max(chosen_trial.max_pct) {
                 chosen = planar;
                 chosen.rms_pct = Some(rms);
             }
         }
         chosen.sharpen_trials = trials;
+        chosen.sharpen_input_max_pct = Some(input_max);
         Ok(chosen)
     }
 
@@ -655,46 +688,47 @@ impl SwingEncoder {
     /// measured the others), so that the size searches count its four or five bytes.
     fn encode_at(&self, prep: &Prepared, fraction: f64) -> Result<SwingOutput, Error> {
         let hint = (self.opts.error_of == ErrorOf::Sharpened).then_some(SharpenHint::Extended);
-        let mut outs =
-            self.encode_at_for(prep, fraction, &[(hint, DEFAULT_SMOOTH_FACTOR, None)])?;
+        let only = Candidate {
+            hint,
+            smooth_factor: DEFAULT_SMOOTH_FACTOR,
+            curved_walls: None,
+            passes: 1,
+        };
+        let mut outs = self.encode_at_for(prep, fraction, &[only])?;
         outs.pop()
             .ok_or_else(|| Error::Internal("a retiling gave no stream".into()))
     }
 
-    /// [`Self::encode_at`] once per candidate `(hint, smooth factor, curved-wall factor)`, from one retiling:
+    /// [`Self::encode_at`] once per candidate sharpening, from one retiling:
     /// each stream states its candidate and carries the filter for after sharpening fitted
     /// for that sharpening (extended at factor 2 without a hint).
     fn encode_at_for(
         &self,
         prep: &Prepared,
         fraction: f64,
-        candidates: &[(Option<SharpenHint>, f64, Option<f64>)],
+        candidates: &[Candidate],
     ) -> Result<Vec<SwingOutput>, Error> {
         let o = &self.opts;
         let l = fraction * prep.diagonal;
         let params = SwingParams::new(l, o.angle_bits, &prep.mesh.bounding_box(), o.quant_bits)?;
-        let sharpen: Vec<_> = candidates
-            .iter()
-            .map(|&(h, f, w)| sharpen_options(h.unwrap_or(SharpenHint::Extended), f, w))
-            .collect();
+        let sharpen: Vec<_> = candidates.iter().map(Candidate::sharpen_options).collect();
         let retiled = retile_fitted(&prep.mesh, &params, &o.tuning, o.surface_filter, &sharpen)?;
         let mut outs = Vec::with_capacity(candidates.len());
         // The same decoded mesh for every candidate (they differ in header fields only).
         let mut coverage = None;
-        for (&(hint, smooth_factor, curved_walls), &sharpened_filter) in
-            candidates.iter().zip(&retiled.sharpened_filters)
-        {
+        for (c, &sharpened_filter) in candidates.iter().zip(&retiled.sharpened_filters) {
             let info = SwingStreamInfo {
                 version: o.version,
                 repair: &prep.repair,
                 dropped_unused_vertices: prep.dropped,
                 filter: retiled.filter,
                 sharpened_filter,
-                sharpen_hint: hint,
+                sharpen_hint: c.hint,
                 // Always written with a hint, so that the size searches count its bytes (the
                 // default's 200 hundredths take two, as 150 does; 100 takes one).
-                sharpen_smooth_factor: hint.map(|_| smooth_factor),
-                sharpen_curved_walls: hint.and(curved_walls),
+                sharpen_smooth_factor: c.hint.map(|_| c.smooth_factor),
+                sharpen_curved_walls: c.hint.and(c.curved_walls),
+                sharpen_passes: c.hint.and((c.passes > 1).then_some(c.passes)),
             };
             let enc: SwingEncoded = encode_retiled(&retiled.mesh, &params, &info)?;
             let coverage_gap = *coverage.get_or_insert_with(|| {
@@ -717,11 +751,13 @@ impl SwingEncoder {
                 angle_trials: Vec::new(),
                 surface_filter: info.filter,
                 sharpened_filter: info.sharpened_filter,
-                sharpen_hint: hint,
+                sharpen_hint: c.hint,
                 sharpen_smooth_factor: info.sharpen_smooth_factor,
                 sharpen_curved_walls: info.sharpen_curved_walls,
+                sharpen_passes: info.sharpen_passes,
                 planar_factor: None,
                 sharpen_trials: Vec::new(),
+                sharpen_input_max_pct: None,
             });
         }
         Ok(outs)
@@ -899,22 +935,36 @@ impl SwingEncoder {
         error_of: ErrorOf,
         sharpen: &whet_sharpen::SharpenOptions,
     ) -> Result<f64, Error> {
-        let (sharpened, unfiltered);
+        Ok(self.measure_figures(prep, out, error_of, sharpen)?.0)
+    }
+
+    /// The symmetric RMS and max errors of `out`'s decoded mesh without its surface filter
+    /// (what `whet decode --sharpen` sharpens), in % of the diagonal.
+    fn unfiltered_figures(&self, prep: &Prepared, out: &SwingOutput) -> Result<(f64, f64), Error> {
+        let r = metro(
+            &prep.mesh,
+            &*unfiltered(out)?,
+            &MetroOptions::DEFAULT.with_samples(self.opts.metro_samples),
+        )?;
+        Ok((r.symmetric.rms_pct, r.symmetric.max_pct))
+    }
+
+    /// [`Self::measure_as`] with the max error too: `(rms, max)` in % of the diagonal.
+    fn measure_figures(
+        &self,
+        prep: &Prepared,
+        out: &SwingOutput,
+        error_of: ErrorOf,
+        sharpen: &whet_sharpen::SharpenOptions,
+    ) -> Result<(f64, f64), Error> {
+        let (sharpened, input);
         let mesh = match error_of {
             ErrorOf::Decoded => &out.retiled,
             ErrorOf::Sharpened => {
                 // `whet decode --sharpen`: the mesh without its surface filter, sharpened.
                 // (then the stream's filter for after sharpening, as `whet decode --sharpen`)
-                let input = if out.surface_filter.is_none() {
-                    &out.retiled
-                } else {
-                    // Its own stream: trusted, so without the hostile-input limits.
-                    let opts = whet_codec::DecodeOptions::DEFAULT
-                        .with_surface_filter(false)
-                        .with_limits(whet_codec::Limits::UNLIMITED);
-                    unfiltered = whet_codec::decode(&out.bytes, &opts)?;
-                    &unfiltered
-                };
+                input = unfiltered(out)?;
+                let input = &*input;
                 match whet_sharpen::sharpen(input, sharpen) {
                     Ok(s) => {
                         sharpened = {
@@ -943,7 +993,7 @@ impl SwingEncoder {
             mesh,
             &MetroOptions::DEFAULT.with_samples(self.opts.metro_samples),
         )?;
-        Ok(r.symmetric.rms_pct)
+        Ok((r.symmetric.rms_pct, r.symmetric.max_pct))
     }
 
     /// The cheapest stream found whose RMS error is at most `target` % of the diagonal.
@@ -1145,23 +1195,51 @@ const DEFAULT_SMOOTH_FACTOR: f64 = 2.0;
 /// extended method has them on by default, at the same factor; docs/swing.md section 2).
 pub const PAPERS_CURVED_WALL_FACTOR: f64 = whet_sharpen::DEFAULT_CURVED_WALL_FACTOR;
 
-/// The sharpener options a hint, smooth factor and curved-wall factor stand for (extended
-/// for "none": its filter for after sharpening is never applied).
-fn sharpen_options(
-    hint: SharpenHint,
+/// `out`'s decoded mesh without its surface filter (what `whet decode --sharpen` sharpens).
+fn unfiltered(out: &SwingOutput) -> Result<std::borrow::Cow<'_, Mesh>, Error> {
+    if out.surface_filter.is_none() {
+        return Ok(std::borrow::Cow::Borrowed(&out.retiled));
+    }
+    // Its own stream: trusted, so without the hostile-input limits.
+    let opts = whet_codec::DecodeOptions::DEFAULT
+        .with_surface_filter(false)
+        .with_limits(whet_codec::Limits::UNLIMITED);
+    Ok(std::borrow::Cow::Owned(whet_codec::decode(
+        &out.bytes, &opts,
+    )?))
+}
+
+/// The EdgeSharpener passes of the candidates in more than one pass: a third pass gains
+/// about 1 % where the second gains up to 40 % (docs/results.md, "Passes").
+pub const TWO_PASSES: u32 = 2;
+
+/// A sharpening the encoder can state: the hint (field 21; `None`: no hint, the stream of a
+/// plain encode), smooth factor (23), curved-wall factor (27; `None`: the method's own) and
+/// passes (29).
+#[derive(Clone, Copy, Debug)]
+struct Candidate {
+    hint: Option<SharpenHint>,
     smooth_factor: f64,
     curved_walls: Option<f64>,
-) -> whet_sharpen::SharpenOptions {
-    let method = match hint {
-        SharpenHint::Papers => whet_sharpen::Method::Papers,
-        _ => whet_sharpen::Method::Extended,
-    };
-    let opts = whet_sharpen::SharpenOptions::DEFAULT
-        .with_method(method)
-        .with_smooth_factor(smooth_factor);
-    match curved_walls {
-        Some(w) => opts.with_curved_wall_factor(w),
-        None => opts,
+    passes: u32,
+}
+
+impl Candidate {
+    /// The sharpener options it stands for (extended for "none" and no hint: its filter
+    /// for after sharpening is never applied).
+    fn sharpen_options(&self) -> whet_sharpen::SharpenOptions {
+        let method = match self.hint {
+            Some(SharpenHint::Papers) => whet_sharpen::Method::Papers,
+            _ => whet_sharpen::Method::Extended,
+        };
+        let opts = whet_sharpen::SharpenOptions::DEFAULT
+            .with_method(method)
+            .with_smooth_factor(self.smooth_factor)
+            .with_passes(self.passes);
+        match self.curved_walls {
+            Some(w) => opts.with_curved_wall_factor(w),
+            None => opts,
+        }
     }
 }
 

@@ -68,6 +68,8 @@ pub struct SwingInput {
     pub smooth_factor: f64,
     /// Its curved-wall factor (field 27; `None`: the method's own).
     pub curved_walls: Option<f64>,
+    /// Its EdgeSharpener passes (field 29; 1 without it).
+    pub passes: u32,
     /// The stream states the planar-region projection after sharpening (field 25).
     pub planar: bool,
     /// The stream.
@@ -110,7 +112,8 @@ impl SwingInput {
         let factor = self.smooth_factor;
         let opts = whet_sharpen::SharpenOptions::DEFAULT
             .with_method(method)
-            .with_smooth_factor(factor);
+            .with_smooth_factor(factor)
+            .with_passes(self.passes);
         let opts = match self.curved_walls {
             Some(w) => opts.with_curved_wall_factor(w),
             None => opts,
@@ -128,7 +131,7 @@ pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
         .unwrap_or_else(|e| panic!("{name}: {e}"));
     let dir = whet_testkit::workspace_root().join("target/sharpen-swing");
     let _ = std::fs::create_dir_all(&dir);
-    let path = dir.join(format!("v6-{name}-{bpv}-{}.whet", angles.tag()));
+    let path = dir.join(format!("v8-{name}-{bpv}-{}.whet", angles.tag()));
     let bytes = match std::fs::read(&path) {
         Ok(b) => b,
         Err(_) => {
@@ -161,6 +164,7 @@ pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
         sharpen_hint: whet_codec::SharpenHint::stated(&header).map(|s| s.0),
         smooth_factor: whet_codec::SharpenHint::stated(&header).map_or(2.0, |s| s.1),
         curved_walls: whet_codec::SharpenHint::curved_walls_of(&header),
+        passes: whet_codec::SharpenHint::passes_of(&header).unwrap_or(1),
         planar: whet_codec::SharpenHint::planar_of(&header).is_some(),
         original,
         decoded,

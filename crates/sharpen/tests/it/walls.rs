@@ -1,5 +1,6 @@
 //! Curved walls (`SharpenOptions::curved_wall_factor`, docs/sharpen.md): a flat plate meets a
-//! cylinder a few samples in radius across a chamfer, the shape of a small hole's rim.
+//! cylinder a few samples in radius across a chamfer, the shape of a small hole's rim; and
+//! passes (`SharpenOptions::passes`): the sharpener run again on its own output.
 
 use whet_mesh::{DVec3, Mesh};
 use whet_sharpen::{sharpen, Method, SharpenOptions};
@@ -113,5 +114,75 @@ fn a_tight_cylinder_beside_a_plate_gets_its_chamfer_split_with_curved_walls_only
         let c = crate::support::check(&mesh, &mesh, &walls);
         assert!(c.manifold, "{method}: {c:?}");
         assert_eq!(c.new_boundary_edges, 0, "{method}: {c:?}");
+    }
+}
+
+/// `SharpenOptions::passes`: a second pass runs on the first one's output, and the result
+/// is that of sharpening twice, with parents traced back to the input and the tags of both.
+#[test]
+fn two_passes_are_the_sharpener_run_on_its_own_output() {
+    use whet_synth::{marching_cubes, Shape, ShapeKind, ShapeParams};
+    let rotation = glam::DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.44);
+    let shape = Shape::new(
+        ShapeKind::Fandisk,
+        &ShapeParams::default().with_rotation(rotation),
+    )
+    .unwrap();
+    let mesh = marching_cubes(&shape, 24).unwrap();
+    for method in crate::EDGE_SHARPENER {
+        let once_opts = SharpenOptions::DEFAULT.with_method(method);
+        let once = sharpen(&mesh, &once_opts).unwrap();
+        let again = sharpen(&once.mesh, &once_opts).unwrap();
+        assert!(
+            again.report.new_vertices > 0,
+            "{method}: nothing for a second pass"
+        );
+        let twice = sharpen(&mesh, &once_opts.with_passes(2)).unwrap();
+        let r = &twice.report;
+        assert_eq!(r.passes, 2, "{method}");
+        assert_eq!(twice.mesh, again.mesh, "{method}");
+        assert_eq!(
+            r.new_vertices,
+            once.report.new_vertices + again.report.new_vertices
+        );
+        assert_eq!(r.input_vertices, mesh.positions.len());
+        assert_eq!(
+            r.smooth_threshold_degrees,
+            once.report.smooth_threshold_degrees
+        );
+        // Parents: each output triangle's parent in the second pass, then in the first.
+        assert_eq!(twice.parents.len(), twice.mesh.triangles.len());
+        for (p2, p) in again.parents.iter().zip(&twice.parents) {
+            assert_eq!(*p, once.parents[p2.index()], "{method}");
+            assert!(p.index() < mesh.triangles.len());
+        }
+        // Tags: every vertex either pass tagged, and the edges between them.
+        for v in once.tags.vertices.iter().chain(&again.tags.vertices) {
+            assert!(
+                twice.tags.vertices.binary_search(v).is_ok(),
+                "{method}: {v:?}"
+            );
+        }
+        assert_eq!(r.tagged_vertices, twice.tags.vertices.len());
+        // Input vertices other than chamfer vertices stay put through both passes.
+        let moved = mesh
+            .positions
+            .iter()
+            .zip(&twice.mesh.positions)
+            .filter(|(a, b)| a != b)
+            .count();
+        assert!(
+            moved <= r.moved_input_vertices + r.welded_vertices,
+            "{method}"
+        );
+        // Four passes stop where a pass changes nothing; more are refused.
+        let four = sharpen(&mesh, &once_opts.with_passes(4)).unwrap();
+        assert!((2..=4).contains(&four.report.passes), "{method}");
+        for bad in [0, 5] {
+            assert!(
+                sharpen(&mesh, &once_opts.with_passes(bad)).is_err(),
+                "{bad}"
+            );
+        }
     }
 }
