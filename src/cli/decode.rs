@@ -36,11 +36,11 @@ pub struct DecodeArgs {
     /// EdgeSharpener's curved-wall factor (`whet sharpen --curved-walls`; 0: off). Without
     /// it, the one a swing stream names with its method (see --method); otherwise the
     /// method's own (2 for extended, off for papers).
-    #[arg(long)]
+    #[arg(long, requires = "sharpen")]
     curved_walls: Option<f64>,
     /// EdgeSharpener passes (`whet sharpen --passes`). Without it, the number a swing stream
     /// names with its method (see --method); otherwise 1.
-    #[arg(long)]
+    #[arg(long, requires = "sharpen")]
     passes: Option<u32>,
     /// Subdiv streams: subdivision levels, overriding the header (0 gives the control mesh).
     #[arg(long)]
@@ -113,6 +113,11 @@ pub fn run(args: &DecodeArgs) -> CliResult {
             }
             (None, None) => ("extended", None, None, None),
         };
+        // The explicit values are checked even where no sharpening runs.
+        let explicit = whet_sharpen::SharpenOptions::DEFAULT
+            .with_passes(args.passes.unwrap_or(1))
+            .with_curved_wall_factor(args.curved_walls.unwrap_or(0.0));
+        explicit.validate().map_err(super::Failure::input)?;
         if method == whet_codec::SharpenHint::Unsharpened.name() {
             // No candidate beat the decoded mesh (or `--method none`): what `whet decode`
             // gives without --sharpen (the stream's own surface filter included).
@@ -142,7 +147,10 @@ pub fn run(args: &DecodeArgs) -> CliResult {
         }
         let smooth_factor = args.smooth_factor.or(stream_factor).unwrap_or(2.0);
         let mut opts = super::sharpen::sharpen_options(method, smooth_factor)?
-            .with_passes(args.passes.or(stream_passes).unwrap_or(1));
+            .with_passes(args.passes.or(stream_passes).unwrap_or(1))
+            // Passes after the first run on grown meshes: each is held to the budget the
+            // first was checked against.
+            .with_pass_budget_triangles(args.max_memory / whet_sharpen::PEAK_BYTES_PER_TRIANGLE);
         if let Some(w) = args.curved_walls.or(stream_walls) {
             opts = opts.with_curved_wall_factor(w);
         }

@@ -190,21 +190,37 @@ impl EdgeSharpener {
     /// Sharpens `mesh`; see [`crate::sharpen`].
     pub fn sharpen(&mut self, mesh: &Mesh) -> Result<Sharpened, Error> {
         if self.options.method == Method::NormalFilter {
-            return crate::normal_filter::run(mesh, &self.options, None);
+            // One pass, whatever `passes` says (the option is EdgeSharpener's).
+            let mut out = crate::normal_filter::run(mesh, &self.options, None)?;
+            out.report.passes = 1;
+            return Ok(out);
         }
         let start = Instant::now();
         self.options.validate()?;
         let mut out = self.sharpen_once(mesh)?;
         out.report.passes = 1;
-        while out.report.passes < self.options.passes as usize && changed(&out.report) {
+        // A pass that gives its input back would do so again.
+        let mut unchanged = out.mesh == *mesh;
+        while out.report.passes < self.options.passes as usize && !unchanged {
             // Another pass on the output (`SharpenOptions::passes`): the chamfers a pass
-            // leaves (where its splits made new strips) are found by the next.
-            let next = self.sharpen_once(&out.mesh)?;
-            let last = next.report.clone();
-            if !changed(&last) {
+            // leaves (where its splits made new strips) are found by the next. It stops where
+            // a pass changed nothing (the next would change nothing either), where the mesh
+            // has outgrown the budget, and where a later pass fails: the earlier output is a
+            // valid result, and the decoder and the encoder's measurement both keep it.
+            if self
+                .options
+                .pass_budget_triangles
+                .is_some_and(|b| out.mesh.triangles.len() as u64 > b)
+            {
                 break;
             }
-            out = compose_passes(out, next);
+            let Ok(next) = self.sharpen_once(&out.mesh) else {
+                break;
+            };
+            unchanged = next.mesh == out.mesh;
+            if !unchanged {
+                out = compose_passes(out, next);
+            }
         }
         out.report.time = start.elapsed();
         Ok(out)
@@ -311,28 +327,27 @@ impl EdgeSharpener {
     }
 }
 
-/// A pass changed the mesh: it added, moved, welded or removed something.
-fn changed(r: &SharpenReport) -> bool {
-    r.inserted_vertices > 0
-        || r.moved_input_vertices > 0
-        || r.welded_vertices > 0
-        || r.collapsed_triangles > 0
-}
-
 /// `first` followed by `next`, a pass over `first.mesh`: `next`'s mesh, parents traced back
 /// to `first`'s input, the tags of both (input vertices keep their indices from pass to
-/// pass, so a vertex tagged by either stays tagged), and the counts added up (the smooth
-/// threshold and the input counts are the first pass's).
+/// pass, so a vertex tagged by either stays tagged, unless the later pass welded it away),
+/// and the counts of events added up (the smooth threshold, the mean angle, `smooth_edges`,
+/// `curved_wall_edges` and the input counts are the first pass's).
 fn compose_passes(first: Sharpened, next: Sharpened) -> Sharpened {
+    // `next`'s parents index `first.mesh`'s triangles, which `first.parents` covers.
+    debug_assert!(next.parents.iter().all(|p| p.index() < first.parents.len()));
     let parents = next
         .parents
         .iter()
         .map(|p| first.parents.get(p.index()).copied().unwrap_or(*p))
         .collect();
+    let mut used = vec![false; next.mesh.positions.len()];
+    for &v in next.mesh.triangles.iter().flatten() {
+        used[v as usize] = true;
+    }
     let mut flags = vec![false; next.mesh.positions.len()];
     for v in first.tags.vertices.iter().chain(&next.tags.vertices) {
         if let Some(f) = flags.get_mut(v.index()) {
-            *f = true;
+            *f = used[v.index()];
         }
     }
     let tags = SharpTags::from_vertex_flags(&next.mesh, &flags);
@@ -355,7 +370,6 @@ fn compose_passes(first: Sharpened, next: Sharpened) -> Sharpened {
         collapsed_triangles: a.collapsed_triangles + b.collapsed_triangles,
         welded_vertices: a.welded_vertices + b.welded_vertices,
         restored_triangles: a.restored_triangles + b.restored_triangles,
-        curved_wall_edges: a.curved_wall_edges + b.curved_wall_edges,
         tagged_vertices: tags.vertices.len(),
         sharp_edges: tags.edges.len(),
         passes: a.passes + 1,

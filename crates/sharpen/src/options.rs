@@ -108,6 +108,9 @@ pub struct SharpenOptions {
     /// default 1, the papers' single pass). A pass's splits can leave chamfers the next one
     /// finds (docs/sharpen.md, "Passes"); passes stop early once one changes nothing.
     pub passes: u32,
+    /// Passes after the first run only while the mesh has at most this many triangles (a
+    /// memory budget: `whet decode --max-memory`); `None`: no limit.
+    pub pass_budget_triangles: Option<u64>,
 }
 
 impl SharpenOptions {
@@ -123,6 +126,7 @@ impl SharpenOptions {
         weld_clusters: true,
         curved_wall_factor: None,
         passes: 1,
+        pass_budget_triangles: None,
     };
 
     /// The papers' algorithm with their constants (`--method papers`).
@@ -179,6 +183,12 @@ impl SharpenOptions {
     /// Sets the number of passes.
     pub const fn with_passes(mut self, passes: u32) -> Self {
         self.passes = passes;
+        self
+    }
+
+    /// Sets the triangle budget of the passes after the first.
+    pub const fn with_pass_budget_triangles(mut self, triangles: u64) -> Self {
+        self.pass_budget_triangles = Some(triangles);
         self
     }
 

@@ -110,9 +110,11 @@ pub struct SharpenReport {
     pub curved_wall_factor: f64,
     /// Edges the curved walls made smooth (included in `smooth_edges`).
     pub curved_wall_edges: usize,
-    /// Passes that ran (`SharpenOptions::passes`; fewer when one changed nothing). The
-    /// counts of the later passes are added to the first's; the smooth threshold, the mean
-    /// angle and `smooth_edges` are the first pass's.
+    /// Passes that ran (`SharpenOptions::passes`; fewer when one changed nothing, the mesh
+    /// outgrew `pass_budget_triangles` or a later pass failed). The counts of events of the
+    /// later passes (chamfer edges, new vertices, collapses, ...) are added to the first's;
+    /// the smooth threshold, the mean angle, `smooth_edges` and `curved_wall_edges` are the
+    /// first pass's.
     pub passes: usize,
     /// Subdivided triangles the sliver pass restored to their input triangles (docs/sharpen.md,
     /// "The sliver pass").

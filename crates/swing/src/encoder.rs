@@ -448,17 +448,21 @@ impl SwingEncoder {
         // "no case gets worse"): the RMS decides among the candidates whose max stays within
         // that mesh's.
         let input_max = self.unfiltered_figures(prep, &out)?.1;
+        // Candidates whose output is the same mesh (curved walls that turn no edge smooth, a
+        // second pass that changes nothing) are measured once.
+        let mut measured = Vec::new();
         for (i, c) in candidates.iter().enumerate() {
             let (hint, smooth_factor) = (c.hint.unwrap_or(SharpenHint::Extended), c.smooth_factor);
             let opts = c.sharpen_options();
             let ((rms, max), stream) = if i == 0 {
                 // `out` was encoded for this one.
-                let f = self.measure_figures(prep, &out, ErrorOf::Sharpened, &opts)?;
+                let f =
+                    self.measure_figures(prep, &out, ErrorOf::Sharpened, &opts, &mut measured)?;
                 (f, None)
             } else {
                 let Some(p) = streams.next() else { break };
                 (
-                    self.measure_figures(prep, &p, ErrorOf::Sharpened, &opts)?,
+                    self.measure_figures(prep, &p, ErrorOf::Sharpened, &opts, &mut measured)?,
                     Some(p),
                 )
             };
@@ -477,7 +481,8 @@ impl SwingEncoder {
             }
         }
         let opts = whet_sharpen::SharpenOptions::DEFAULT;
-        let (decoded, decoded_max) = self.measure_figures(prep, &out, ErrorOf::Decoded, &opts)?;
+        let (decoded, decoded_max) =
+            self.measure_figures(prep, &out, ErrorOf::Decoded, &opts, &mut Vec::new())?;
         let none = SharpenTrial {
             hint: SharpenHint::Unsharpened,
             smooth_factor: DEFAULT_SMOOTH_FACTOR,
@@ -516,7 +521,8 @@ impl SwingEncoder {
                 passes: chosen_trial.passes,
             }
             .sharpen_options();
-            let (rms, max) = self.measure_figures(prep, &planar, ErrorOf::Sharpened, &opts)?;
+            let (rms, max) =
+                self.measure_figures(prep, &planar, ErrorOf::Sharpened, &opts, &mut Vec::new())?;
             trials.push(SharpenTrial {
                 rms_pct: rms,
                 max_pct: max,
@@ -717,6 +723,15 @@ impl SwingEncoder {
         // The same decoded mesh for every candidate (they differ in header fields only).
         let mut coverage = None;
         for (c, &sharpened_filter) in candidates.iter().zip(&retiled.sharpened_filters) {
+            // What the stream cannot state, a decoder would not reproduce.
+            let walls_ok = c
+                .curved_walls
+                .is_none_or(|w| SharpenHint::curved_walls_code(w).is_some());
+            if !walls_ok || !SharpenHint::PASSES.contains(&u64::from(c.passes)) {
+                return Err(Error::Internal(format!(
+                    "a sharpening candidate the stream cannot state: {c:?}"
+                )));
+            }
             let info = SwingStreamInfo {
                 version: o.version,
                 repair: &prep.repair,
@@ -935,7 +950,9 @@ impl SwingEncoder {
         error_of: ErrorOf,
         sharpen: &whet_sharpen::SharpenOptions,
     ) -> Result<f64, Error> {
-        Ok(self.measure_figures(prep, out, error_of, sharpen)?.0)
+        Ok(self
+            .measure_figures(prep, out, error_of, sharpen, &mut Vec::new())?
+            .0)
     }
 
     /// The symmetric RMS and max errors of `out`'s decoded mesh without its surface filter
@@ -950,12 +967,15 @@ impl SwingEncoder {
     }
 
     /// [`Self::measure_as`] with the max error too: `(rms, max)` in % of the diagonal.
+    /// `measured` holds the figures of meshes measured before, by [`mesh_key`]: a mesh found
+    /// there is not measured again.
     fn measure_figures(
         &self,
         prep: &Prepared,
         out: &SwingOutput,
         error_of: ErrorOf,
         sharpen: &whet_sharpen::SharpenOptions,
+        measured: &mut Vec<(u64, (f64, f64))>,
     ) -> Result<(f64, f64), Error> {
         let (sharpened, input);
         let mesh = match error_of {
@@ -988,12 +1008,18 @@ impl SwingEncoder {
                 }
             }
         };
+        let key = mesh_key(mesh);
+        if let Some((_, f)) = measured.iter().find(|(k, _)| *k == key) {
+            return Ok(*f);
+        }
         let r = metro(
             &prep.mesh,
             mesh,
             &MetroOptions::DEFAULT.with_samples(self.opts.metro_samples),
         )?;
-        Ok((r.symmetric.rms_pct, r.symmetric.max_pct))
+        let f = (r.symmetric.rms_pct, r.symmetric.max_pct);
+        measured.push((key, f));
+        Ok(f)
     }
 
     /// The cheapest stream found whose RMS error is at most `target` % of the diagonal.
@@ -1194,6 +1220,19 @@ const DEFAULT_SMOOTH_FACTOR: f64 = 2.0;
 /// The curved-wall factor of the papers' method's candidates with curved walls (the
 /// extended method has them on by default, at the same factor; docs/swing.md section 2).
 pub const PAPERS_CURVED_WALL_FACTOR: f64 = whet_sharpen::DEFAULT_CURVED_WALL_FACTOR;
+
+/// A 64-bit hash of a mesh's positions (bit for bit) and triangles: equal meshes have equal
+/// keys, and two different meshes one with probability about 2^-64.
+fn mesh_key(mesh: &Mesh) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    mesh.positions.len().hash(&mut h);
+    for p in &mesh.positions {
+        p.to_array().map(f64::to_bits).hash(&mut h);
+    }
+    mesh.triangles.hash(&mut h);
+    h.finish()
+}
 
 /// `out`'s decoded mesh without its surface filter (what `whet decode --sharpen` sharpens).
 fn unfiltered(out: &SwingOutput) -> Result<std::borrow::Cow<'_, Mesh>, Error> {

@@ -491,9 +491,23 @@ pub(crate) fn retile_fitted(
         // One set of fields serves both fits (fit_surface_filter computes the same).
         let fields = whet_codec::FilterFields::new(&kept);
         let filter = crate::fit_displacements(&kept, &fields.normal, &fields.smoothed, closest);
+        // Candidates that sharpen to the same mesh (the papers' method with curved walls
+        // that turn no edge smooth, a second pass that changes nothing) share one fit.
+        let mut fitted: Vec<(Option<whet_mesh::Mesh>, SurfaceFilter)> = Vec::new();
         let after = sharpen
             .iter()
-            .map(|o| fit_after_sharpening(&kept, &fields, o, closest))
+            .map(|o| {
+                let sharp = whet_sharpen::sharpen(&kept, o).ok().map(|s| s.mesh);
+                if let Some((_, f)) = fitted.iter().find(|(m, _)| *m == sharp) {
+                    return *f;
+                }
+                let f = match &sharp {
+                    Some(s) => fit_after_sharpening(&kept, &fields, s, closest),
+                    None => SurfaceFilter::NONE,
+                };
+                fitted.push((sharp, f));
+                f
+            })
             .collect();
         (filter, after)
     } else {
@@ -532,24 +546,20 @@ pub(crate) fn retile_fitted(
     })
 }
 
-/// The factors of the filter for after sharpening: `kept` (the unfiltered decoded mesh)
-/// sharpened with `sharpen` (whet-sharpen's defaults, or a stream's choice), the filter's fields of `kept` on the vertices
-/// the sharpener left alone, fitted to the original (docs/swing.md section 2). On a smooth
-/// part the sharpener changes little and the fit finds the decoded filter again; on a CAD
-/// part it fits the flat faces between the restored creases. No filter when the sharpener
-/// refuses the mesh.
+/// The factors of the filter for after sharpening: `sharp`, `kept` (the unfiltered decoded
+/// mesh) sharpened (with whet-sharpen's defaults, or a stream's choice), the filter's fields
+/// of `kept` on the vertices the sharpener left alone, fitted to the original (docs/swing.md
+/// section 2). On a smooth part the sharpener changes little and the fit finds the decoded
+/// filter again; on a CAD part it fits the flat faces between the restored creases. (No
+/// filter when the sharpener refuses the mesh: the caller's.)
 fn fit_after_sharpening(
     kept: &whet_mesh::Mesh,
     fields: &whet_codec::FilterFields,
-    sharpen: &whet_sharpen::SharpenOptions,
+    sharp: &whet_mesh::Mesh,
     closest: impl FnMut(DVec3) -> Option<DVec3>,
 ) -> SurfaceFilter {
-    let Ok(sharp) = whet_sharpen::sharpen(kept, sharpen) else {
-        return SurfaceFilter::NONE;
-    };
-    let sharp = sharp.mesh;
-    let moved = fields.after_sharpening(kept, &sharp);
-    crate::fit_displacements(&sharp, &moved.normal, &moved.smoothed, closest)
+    let moved = fields.after_sharpening(kept, sharp);
+    crate::fit_displacements(sharp, &moved.normal, &moved.smoothed, closest)
 }
 
 impl Retiler<'_, '_> {

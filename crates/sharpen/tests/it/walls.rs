@@ -175,14 +175,51 @@ fn two_passes_are_the_sharpener_run_on_its_own_output() {
             moved <= r.moved_input_vertices + r.welded_vertices,
             "{method}"
         );
-        // Four passes stop where a pass changes nothing; more are refused.
+        // Four passes are the sharpener run on its own output until a run gives its input
+        // back (or four ran); more are refused.
+        let mut manual = vec![once.mesh.clone()];
+        while manual.len() < 4 {
+            let m = sharpen(manual.last().unwrap(), &once_opts).unwrap().mesh;
+            if m == *manual.last().unwrap() {
+                break;
+            }
+            manual.push(m);
+        }
         let four = sharpen(&mesh, &once_opts.with_passes(4)).unwrap();
-        assert!((2..=4).contains(&four.report.passes), "{method}");
+        assert_eq!(four.report.passes, manual.len(), "{method}");
+        assert_eq!(four.mesh, *manual.last().unwrap(), "{method}");
         for bad in [0, 5] {
             assert!(
                 sharpen(&mesh, &once_opts.with_passes(bad)).is_err(),
                 "{bad}"
             );
         }
+        // A budget under the first output's size stops after the first pass.
+        let budget = once_opts
+            .with_passes(4)
+            .with_pass_budget_triangles(mesh.triangles.len() as u64);
+        let capped = sharpen(&mesh, &budget).unwrap();
+        assert_eq!(
+            (capped.report.passes, &capped.mesh),
+            (1, &once.mesh),
+            "{method}"
+        );
+    }
+}
+
+/// A mesh the sharpener gives back unchanged takes one pass, however many are asked for.
+#[test]
+fn passes_stop_where_a_pass_changes_nothing() {
+    use whet_synth::{Shape, ShapeKind, ShapeParams};
+    // The exact cube: its creases lie on vertices, nothing is chamfered.
+    let cube = Shape::new(ShapeKind::Cube, &ShapeParams::default())
+        .unwrap()
+        .truth_mesh();
+    for method in crate::EDGE_SHARPENER {
+        let opts = SharpenOptions::DEFAULT.with_method(method).with_passes(4);
+        let out = sharpen(&cube, &opts).unwrap();
+        assert_eq!(out.report.passes, 1, "{method}");
+        assert_eq!(out.mesh, cube, "{method}");
+        assert_eq!(out.report.new_vertices, 0, "{method}");
     }
 }
