@@ -34,8 +34,7 @@ pub struct DecodeArgs {
     #[arg(long)]
     method: Option<String>,
     /// EdgeSharpener's curved-wall factor (`whet sharpen --curved-walls`; 0: off). Without
-    /// it, the one a swing stream names with its method (see --method); otherwise the
-    /// method's own (2 for extended, off for papers).
+    /// it, the one a swing stream names with its method (see --method); otherwise off.
     #[arg(long, requires = "sharpen")]
     curved_walls: Option<f64>,
     /// EdgeSharpener passes (`whet sharpen --passes`). Without it, the number a swing stream

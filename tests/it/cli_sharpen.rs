@@ -366,21 +366,18 @@ fn decode_sharpen_follows_the_streams_hint() {
         "sharpened",
         "--json",
     ]);
-    // The encoder measured nineteen candidates (the papers' method without and with curved
-    // walls, every sharpening in one pass and in two, and none) and kept the lowest error;
-    // then the chosen sharpening once more with the planar-region projection, kept when it
-    // beat it.
+    // The encoder measured 25 candidates (both methods at three factors without and with
+    // curved walls, every sharpening in one pass and in two, and none) and kept the lowest
+    // error; then the chosen sharpening once more with the planar-region projection, kept
+    // when it beat it.
     let all = j["sharpen_trials"].as_array().unwrap();
     let trials: Vec<_> = all.iter().filter(|t| t["planar"] == false).collect();
     let planar: Vec<_> = all.iter().filter(|t| t["planar"] == true).collect();
-    assert_eq!(trials.len(), 19, "{j}");
+    assert_eq!(trials.len(), 25, "{j}");
     let chosen = j["sharpen_method"].as_str().unwrap();
     assert_eq!(planar.len(), usize::from(chosen != "none"), "{j}");
-    // The stream states curved walls only where they differ from the method's own (on for
-    // extended, off for papers).
-    let chosen_walls = j["sharpen_curved_walls"]
-        .as_f64()
-        .unwrap_or(if chosen == "extended" { 2.0 } else { 0.0 });
+    // The stream states curved walls only where they are on.
+    let chosen_walls = j["sharpen_curved_walls"].as_f64().unwrap_or(0.0);
     let chosen_error = trials
         .iter()
         .find(|t| {
@@ -588,7 +585,7 @@ fn decode_sharpen_reads_the_streams_curved_walls_and_passes() {
     // ... and `--curved-walls` overriding the stream's factor.
     let off = decode(&hinted, &["--sharpen", "--curved-walls", "0"], "h0.off");
     assert!(off == without);
-    // Field 27 at 0 turns the extended method's own walls off.
+    // Field 27 at 200 turns curved walls on for the extended method too.
     let extended = [
         "--sharpen",
         "--method",
@@ -598,12 +595,12 @@ fn decode_sharpen_reads_the_streams_curved_walls_and_passes() {
     ];
     let expected = decode(
         &stream,
-        &[&extended[..], &["--curved-walls", "0"]].concat(),
+        &[&extended[..], &["--curved-walls", "2"]].concat(),
         "e0.off",
     );
     assert!(
         decode(
-            &stating(0, 0, "extended-off.whet"),
+            &stating(0, 200, "extended-walls.whet"),
             &["--sharpen"],
             "he.off"
         ) == expected

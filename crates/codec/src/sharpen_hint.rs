@@ -88,9 +88,9 @@ impl SharpenHint {
 
     /// The curved-wall factor a swing stream's header states for its sharpening (field 27, in
     /// hundredths; `whet_sharpen::SharpenOptions::curved_wall_factor`): `Some(0.0)` for off
-    /// (value 0), the factor for a value in [`Self::CURVED_WALL_HUNDREDTHS`]; `None` (the
-    /// method's own) without the field, with another value, for other modes, or without a
-    /// hint this whet knows (the factor goes with its method, as field 23 does).
+    /// (value 0), the factor for a value in [`Self::CURVED_WALL_HUNDREDTHS`]; `None` (off, the
+    /// sharpener's default) without the field, with another value, for other modes, or
+    /// without a hint this whet knows (the factor goes with its method, as field 23 does).
     pub fn curved_walls_of(header: &whet_format::Header) -> Option<f64> {
         Self::of(header)?;
         header

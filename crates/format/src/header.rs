@@ -169,8 +169,7 @@ pub mod tag {
     /// (swing; absent, or outside 1..=1000: none).
     pub const PLANAR_TOLERANCE: u64 = 25;
     /// u64 (format 1.2, optional): the EdgeSharpener curved-wall factor that goes with
-    /// [`SHARPEN_METHOD`], in hundredths, 0 for off (swing; absent, or another value: the
-    /// method's own).
+    /// [`SHARPEN_METHOD`], in hundredths, 0 for off (swing; absent, or another value: off).
     pub const SHARPEN_CURVED_WALLS: u64 = 27;
     /// u64 (format 1.2, optional): how many EdgeSharpener passes go with
     /// [`SHARPEN_METHOD`] (swing; absent, or outside 1..=4: one).

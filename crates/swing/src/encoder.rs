@@ -58,8 +58,7 @@ pub struct SharpenTrial {
     pub hint: SharpenHint,
     /// EdgeSharpener's smooth factor (irrelevant for [`SharpenHint::Unsharpened`]).
     pub smooth_factor: f64,
-    /// EdgeSharpener's curved-wall factor (`SharpenOptions::curved_walls`, the method's own
-    /// unless the candidate sets one; 0: off).
+    /// EdgeSharpener's curved-wall factor (`SharpenOptions::curved_walls`; 0: off).
     pub curved_walls: f64,
     /// EdgeSharpener passes (`SharpenOptions::passes`; irrelevant for
     /// [`SharpenHint::Unsharpened`]).
@@ -251,8 +250,8 @@ pub struct SwingOutput {
     pub sharpen_hint: Option<SharpenHint>,
     /// The smooth factor that goes with [`Self::sharpen_hint`] (optional header field 23).
     pub sharpen_smooth_factor: Option<f64>,
-    /// The curved-wall factor that goes with [`Self::sharpen_hint`] when it is not the
-    /// method's own (optional header field 27; `None`: the method's own).
+    /// The curved-wall factor that goes with [`Self::sharpen_hint`] when on (optional header
+    /// field 27; `None`: off).
     pub sharpen_curved_walls: Option<f64>,
     /// The EdgeSharpener passes that go with [`Self::sharpen_hint`] when more than one
     /// (optional header field 29).
@@ -397,21 +396,23 @@ impl SwingEncoder {
         // by more than the sampling noise of a measurement (about 0.3 % at 300 000
         // samples).
         const MARGIN: f64 = 0.995;
-        // (method, smooth factor, curved-wall factor; `None`: the method's own, which is on
-        // for the extended method and off for the papers'). The papers' method with curved
-        // walls comes after the others, and every sharpening in two passes after all of them
-        // in one, so that each extension is chosen only where it beats what comes before it
-        // by the margin.
-        const W: Option<f64> = Some(PAPERS_CURVED_WALL_FACTOR);
-        const SHARPENINGS: [(SharpenHint, f64, Option<f64>); 9] = [
+        // (method, smooth factor, curved-wall factor; `None`: off). The sharpenings with
+        // curved walls come after the others, and every sharpening in two passes after all of
+        // them in one, so that each extension is chosen only where it beats what comes before
+        // it by the margin.
+        const W: Option<f64> = Some(CURVED_WALL_FACTOR);
+        const SHARPENINGS: [(SharpenHint, f64, Option<f64>); 12] = [
             (SharpenHint::Extended, DEFAULT_SMOOTH_FACTOR, None),
             (SharpenHint::Papers, DEFAULT_SMOOTH_FACTOR, None),
             (SharpenHint::Extended, 1.5, None),
             (SharpenHint::Papers, 1.5, None),
             (SharpenHint::Extended, 1.0, None),
             (SharpenHint::Papers, 1.0, None),
+            (SharpenHint::Extended, DEFAULT_SMOOTH_FACTOR, W),
             (SharpenHint::Papers, DEFAULT_SMOOTH_FACTOR, W),
+            (SharpenHint::Extended, 1.5, W),
             (SharpenHint::Papers, 1.5, W),
+            (SharpenHint::Extended, 1.0, W),
             (SharpenHint::Papers, 1.0, W),
         ];
         let candidates: Vec<Candidate> = [1, TWO_PASSES]
@@ -1217,9 +1218,8 @@ pub fn encode(mesh: &Mesh, opts: &SwingOptions) -> Result<SwingOutput, Error> {
 /// 23 is sharpened with.
 const DEFAULT_SMOOTH_FACTOR: f64 = 2.0;
 
-/// The curved-wall factor of the papers' method's candidates with curved walls (the
-/// extended method has them on by default, at the same factor; docs/swing.md section 2).
-pub const PAPERS_CURVED_WALL_FACTOR: f64 = whet_sharpen::DEFAULT_CURVED_WALL_FACTOR;
+/// The curved-wall factor of the candidates with curved walls (docs/swing.md section 2).
+pub const CURVED_WALL_FACTOR: f64 = whet_sharpen::DEFAULT_CURVED_WALL_FACTOR;
 
 /// A 64-bit hash of a mesh's positions (bit for bit) and triangles: equal meshes have equal
 /// keys, and two different meshes one with probability about 2^-64.

@@ -81,7 +81,7 @@ fn refuses_bad_options() {
     assert_eq!(SharpenOptions::DEFAULT.method, Method::Extended);
     assert_eq!(SharpenOptions::DEFAULT.smooth_factor, 2.0);
     assert_eq!(SharpenOptions::DEFAULT.curved_wall_factor, None);
-    assert_eq!(SharpenOptions::DEFAULT.curved_walls(), 2.0);
+    assert_eq!(SharpenOptions::DEFAULT.curved_walls(), 0.0);
     assert_eq!(SharpenOptions::PAPERS.curved_walls(), 0.0);
     let off = SharpenOptions::DEFAULT.with_curved_wall_factor(0.0);
     assert_eq!(off.curved_walls(), 0.0);

@@ -3,7 +3,7 @@
 //! passes (`SharpenOptions::passes`): the sharpener run again on its own output.
 
 use whet_mesh::{DVec3, Mesh};
-use whet_sharpen::{sharpen, Method, SharpenOptions};
+use whet_sharpen::{sharpen, SharpenOptions};
 
 /// Radius of the cylinder, in grid steps: it turns by about 16 degrees per step, over a
 /// smooth threshold of twice the mean angle (9.4 degrees with the noise below, 0.05 steps;
@@ -92,12 +92,9 @@ fn a_tight_cylinder_beside_a_plate_gets_its_chamfer_split_with_curved_walls_only
         let r = &walls.report;
         assert!(r.curved_wall_edges > 0, "{method}: {r:?}");
         assert_eq!(r.curved_wall_factor, 2.0);
-        // The extended method has them by default (at 2); the papers' method has not.
+        // Off by default, for both methods.
         let default = sharpen(&mesh, &opts).unwrap();
-        match method {
-            Method::Extended => assert_eq!(default.mesh, walls.mesh),
-            _ => assert_eq!(default.mesh, plain.mesh),
-        }
+        assert_eq!(default.mesh, plain.mesh, "{method}");
         // The interior rows of the chamfer (11 cells, one new vertex on each cell's
         // crossing edge) get vertices near the crease: between the plate and the
         // cylinder's tangent plane one step from it, within a quarter step.

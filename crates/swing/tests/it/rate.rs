@@ -207,12 +207,12 @@ fn automatic_angle_bits_climb_on_flat_parts_and_stay_low_on_smooth_ones() {
     assert!((out.bits_per_original_vertex() / 3.0 - 1.0).abs() <= 0.05);
     let decoded = whet_codec::decode(&out.bytes, &whet_codec::DecodeOptions::DEFAULT).unwrap();
     assert_eq!(decoded, out.retiled);
-    // The sharpening choice retiled its candidates at the chosen bits (nine methods, factors
-    // and curved walls, in one pass and in two, each the same retiling, and none), then
-    // tried the chosen one with the planar-region projection.
+    // The sharpening choice retiled its candidates at the chosen bits (twelve methods,
+    // factors and curved walls, in one pass and in two, each the same retiling, and none),
+    // then tried the chosen one with the planar-region projection.
     let unprojected = out.sharpen_trials.iter().filter(|t| !t.planar).count();
-    assert_eq!(unprojected, 19, "{:?}", out.sharpen_trials);
-    assert!(out.sharpen_trials.len() <= 20, "{:?}", out.sharpen_trials);
+    assert_eq!(unprojected, 25, "{:?}", out.sharpen_trials);
+    assert!(out.sharpen_trials.len() <= 26, "{:?}", out.sharpen_trials);
 
     // spot, smooth: every bit is paid for on curved patches (measured: 5-6 bits best).
     let out = encode(
@@ -276,16 +276,16 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
         let hint = out.sharpen_hint.unwrap();
         assert_ne!(hint, not, "{name}: {:?}", out.sharpen_trials);
         assert_eq!(SharpenHint::of(&header(&out.bytes)), Some(hint));
-        // Nineteen candidates, then the chosen sharpening with the planar-region projection.
+        // 25 candidates, then the chosen sharpening with the planar-region projection.
         let (planar, trials): (Vec<&whet_swing::SharpenTrial>, Vec<_>) =
             out.sharpen_trials.iter().partition(|t| t.planar);
-        assert_eq!(trials.len(), 19, "{name}");
+        assert_eq!(trials.len(), 25, "{name}");
         assert_eq!(planar.len(), usize::from(hint != SharpenHint::Unsharpened));
         let h = header(&out.bytes);
         let stated = SharpenHint::planar_of(&h);
         assert_eq!(stated.map(|s| s.0), out.planar_factor, "{name}");
         // The reported error is the chosen candidate's (with the projection when it won by
-        // the margin), the lowest of the nineteen but for the margin.
+        // the margin), the lowest of the 25 but for the margin.
         let chosen = out.rms_pct.unwrap();
         let unprojected = match (out.planar_factor, planar.first()) {
             (Some(f), Some(p)) => {
@@ -331,8 +331,8 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
             let t = trials.iter().find(|t| t.rms_pct == unprojected).unwrap();
             assert!(t.max_pct <= input_max, "{name}: {t:?} over {input_max}");
         }
-        // The stream states the choice: method and factor, and curved walls where they
-        // differ from the method's own (on for extended, off for papers).
+        // The stream states the choice: method and factor, and curved walls and passes where
+        // they are on and more than one.
         let factor = SharpenHint::smooth_factor_of(&h);
         assert_eq!(factor, out.sharpen_smooth_factor, "{name}");
         let walls = SharpenHint::curved_walls_of(&h);
@@ -342,12 +342,7 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
         if hint != SharpenHint::Unsharpened {
             let t = trials.iter().find(|t| t.rms_pct == unprojected).unwrap();
             assert_eq!(factor, Some(t.smooth_factor), "{name}");
-            let own = if hint == SharpenHint::Extended {
-                2.0
-            } else {
-                0.0
-            };
-            assert_eq!(walls.unwrap_or(own), t.curved_walls, "{name}");
+            assert_eq!(walls.unwrap_or(0.0), t.curved_walls, "{name}");
             assert_eq!(passes.unwrap_or(1), t.passes, "{name}");
         }
         // The stream decodes to the encoder's mesh and stays within the size target (the
