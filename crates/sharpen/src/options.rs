@@ -177,7 +177,7 @@ impl SharpenOptions {
         self
     }
 
-    /// Sets the curved-wall factor (0: off), in place of the method's own.
+    /// Sets the curved-wall factor (0: off).
     pub const fn with_curved_wall_factor(mut self, factor: f64) -> Self {
         self.curved_wall_factor = Some(factor);
         self

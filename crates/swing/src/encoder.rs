@@ -1253,7 +1253,7 @@ fn unfiltered(out: &SwingOutput) -> Result<std::borrow::Cow<'_, Mesh>, Error> {
 pub const TWO_PASSES: u32 = 2;
 
 /// A sharpening the encoder can state: the hint (field 21; `None`: no hint, the stream of a
-/// plain encode), smooth factor (23), curved-wall factor (27; `None`: the method's own) and
+/// plain encode), smooth factor (23), curved-wall factor (27; `None`: off) and
 /// passes (29).
 #[derive(Clone, Copy, Debug)]
 struct Candidate {
