@@ -627,3 +627,39 @@ fn decode_sharpen_reads_the_streams_curved_walls_and_passes() {
     assert!(decode(&two, &["--sharpen"], "h2.off") == explicit);
     assert!(decode(&two, &["--sharpen", "--passes", "1"], "h21.off") == without);
 }
+
+#[test]
+fn bad_passes_and_curved_walls_exit_2_with_a_message() {
+    let dir = scratch_dir("cli-sharpen-bad-options");
+    let mesh = dir.join("cube.off");
+    let o = whet(&["synth", "cube", "-o", s(&mesh), "--resolution", "12"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = dir.join("out.off");
+    let stream = dir.join("c.whet");
+    let o = whet(&["encode", s(&mesh), "-o", s(&stream), "--bpv", "4"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let sharpen = ["sharpen", s(&mesh), "-o", s(&out)];
+    let decode = ["decode", s(&stream), "-o", s(&out)];
+    let cases: [(&[&str], &[&str], &str); 7] = [
+        (&sharpen, &["--passes", "0"], "passes"),
+        (&sharpen, &["--passes", "5"], "passes"),
+        (&sharpen, &["--curved-walls", "0.5"], "curved_wall"),
+        (&sharpen, &["--curved-walls", "NaN"], "curved_wall"),
+        (&decode, &["--sharpen", "--passes", "9"], "passes"),
+        // Checked even where no sharpening runs.
+        (
+            &decode,
+            &["--sharpen", "--method", "none", "--curved-walls", "7"],
+            "curved_wall",
+        ),
+        // Without --sharpen the flags mean nothing: clap refuses them.
+        (&decode, &["--passes", "2"], "--sharpen"),
+    ];
+    for (command, extra, says) in cases {
+        let args = [command, extra].concat();
+        let o = whet(&args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(says), "{args:?}: {err}");
+    }
+}

@@ -448,7 +448,10 @@ impl SwingEncoder {
         // Sharpening must not make the worst place worse than the mesh it sharpens (the issue's
         // "no case gets worse"): the RMS decides among the candidates whose max stays within
         // that mesh's.
-        let input_max = self.unfiltered_figures(prep, &out)?.1;
+        // Every candidate's stream decodes, without its surface filter, to this same mesh
+        // (they differ in header fields only): decoded once for all of them.
+        let input = unfiltered(&out)?.into_owned();
+        let input_max = self.measure_mesh(prep, &input, &mut Vec::new())?.1;
         // Candidates whose output is the same mesh (curved walls that turn no edge smooth, a
         // second pass that changes nothing) are measured once.
         let mut measured = Vec::new();
@@ -457,13 +460,12 @@ impl SwingEncoder {
             let opts = c.sharpen_options();
             let ((rms, max), stream) = if i == 0 {
                 // `out` was encoded for this one.
-                let f =
-                    self.measure_figures(prep, &out, ErrorOf::Sharpened, &opts, &mut measured)?;
+                let f = self.measure_sharpened(prep, &out, &input, &opts, &mut measured)?;
                 (f, None)
             } else {
                 let Some(p) = streams.next() else { break };
                 (
-                    self.measure_figures(prep, &p, ErrorOf::Sharpened, &opts, &mut measured)?,
+                    self.measure_sharpened(prep, &p, &input, &opts, &mut measured)?,
                     Some(p),
                 )
             };
@@ -523,7 +525,7 @@ impl SwingEncoder {
             }
             .sharpen_options();
             let (rms, max) =
-                self.measure_figures(prep, &planar, ErrorOf::Sharpened, &opts, &mut Vec::new())?;
+                self.measure_sharpened(prep, &planar, &input, &opts, &mut Vec::new())?;
             trials.push(SharpenTrial {
                 rms_pct: rms,
                 max_pct: max,
@@ -956,17 +958,6 @@ impl SwingEncoder {
             .0)
     }
 
-    /// The symmetric RMS and max errors of `out`'s decoded mesh without its surface filter
-    /// (what `whet decode --sharpen` sharpens), in % of the diagonal.
-    fn unfiltered_figures(&self, prep: &Prepared, out: &SwingOutput) -> Result<(f64, f64), Error> {
-        let r = metro(
-            &prep.mesh,
-            &*unfiltered(out)?,
-            &MetroOptions::DEFAULT.with_samples(self.opts.metro_samples),
-        )?;
-        Ok((r.symmetric.rms_pct, r.symmetric.max_pct))
-    }
-
     /// [`Self::measure_as`] with the max error too: `(rms, max)` in % of the diagonal.
     /// `measured` holds the figures of meshes measured before, by [`mesh_key`]: a mesh found
     /// there is not measured again.
@@ -978,37 +969,53 @@ impl SwingEncoder {
         sharpen: &whet_sharpen::SharpenOptions,
         measured: &mut Vec<(u64, (f64, f64))>,
     ) -> Result<(f64, f64), Error> {
-        let (sharpened, input);
-        let mesh = match error_of {
-            ErrorOf::Decoded => &out.retiled,
+        match error_of {
+            ErrorOf::Decoded => self.measure_mesh(prep, &out.retiled, measured),
             ErrorOf::Sharpened => {
-                // `whet decode --sharpen`: the mesh without its surface filter, sharpened.
-                // (then the stream's filter for after sharpening, as `whet decode --sharpen`)
-                input = unfiltered(out)?;
-                let input = &*input;
-                match whet_sharpen::sharpen(input, sharpen) {
-                    Ok(s) => {
-                        sharpened = {
-                            let mut m = s.mesh;
-                            out.sharpened_filter.apply_after_sharpening(input, &mut m);
-                            if let Some(f) = out.planar_factor {
-                                let opts =
-                                    whet_sharpen::PlanarOptions::for_swing(out.angle_bits, f);
-                                // The sharpened mesh is a manifold; were it refused, the
-                                // decoder keeps it unprojected too (with a warning).
-                                let _ = whet_sharpen::flatten_planar_regions(&mut m, &opts);
-                            }
-                            m
-                        };
-                        &sharpened
-                    }
-                    // A retiled mesh is a valid manifold; should the sharpener refuse one
-                    // anyway, `whet decode --sharpen` would fail the same way, and the
-                    // decoded mesh is what the user keeps.
-                    Err(_) => input,
-                }
+                self.measure_sharpened(prep, out, &*unfiltered(out)?, sharpen, measured)
             }
+        }
+    }
+
+    /// [`Self::measure_figures`] of `whet decode --sharpen`'s output: `input`, `out`'s decoded
+    /// mesh without its surface filter, sharpened, then the stream's filter for after
+    /// sharpening and its planar projection.
+    fn measure_sharpened(
+        &self,
+        prep: &Prepared,
+        out: &SwingOutput,
+        input: &Mesh,
+        sharpen: &whet_sharpen::SharpenOptions,
+        measured: &mut Vec<(u64, (f64, f64))>,
+    ) -> Result<(f64, f64), Error> {
+        let sharpened = match whet_sharpen::sharpen(input, sharpen) {
+            Ok(s) => {
+                let mut m = s.mesh;
+                out.sharpened_filter.apply_after_sharpening(input, &mut m);
+                if let Some(f) = out.planar_factor {
+                    let opts = whet_sharpen::PlanarOptions::for_swing(out.angle_bits, f);
+                    // The sharpened mesh is a manifold; were it refused, the decoder keeps it
+                    // unprojected too (with a warning).
+                    let _ = whet_sharpen::flatten_planar_regions(&mut m, &opts);
+                }
+                Some(m)
+            }
+            // A retiled mesh is a valid manifold; should the sharpener refuse one anyway,
+            // `whet decode --sharpen` would fail the same way, and the decoded mesh is what
+            // the user keeps.
+            Err(_) => None,
         };
+        self.measure_mesh(prep, sharpened.as_ref().unwrap_or(input), measured)
+    }
+
+    /// The symmetric `(rms, max)` errors of `mesh` against the original, % of the diagonal;
+    /// `measured` holds the figures of meshes measured before, by [`mesh_key`].
+    fn measure_mesh(
+        &self,
+        prep: &Prepared,
+        mesh: &Mesh,
+        measured: &mut Vec<(u64, (f64, f64))>,
+    ) -> Result<(f64, f64), Error> {
         let key = mesh_key(mesh);
         if let Some((_, f)) = measured.iter().find(|(k, _)| *k == key) {
             return Ok(*f);
@@ -1223,7 +1230,7 @@ pub const CURVED_WALL_FACTOR: f64 = whet_sharpen::DEFAULT_CURVED_WALL_FACTOR;
 
 /// A 64-bit hash of a mesh's positions (bit for bit) and triangles: equal meshes have equal
 /// keys, and two different meshes one with probability about 2^-64.
-fn mesh_key(mesh: &Mesh) -> u64 {
+pub(crate) fn mesh_key(mesh: &Mesh) -> u64 {
     use std::hash::{Hash, Hasher};
     let mut h = std::collections::hash_map::DefaultHasher::new();
     mesh.positions.len().hash(&mut h);

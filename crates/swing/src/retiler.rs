@@ -493,19 +493,21 @@ pub(crate) fn retile_fitted(
         let filter = crate::fit_displacements(&kept, &fields.normal, &fields.smoothed, closest);
         // Candidates that sharpen to the same mesh (the papers' method with curved walls
         // that turn no edge smooth, a second pass that changes nothing) share one fit.
-        let mut fitted: Vec<(Option<whet_mesh::Mesh>, SurfaceFilter)> = Vec::new();
+        // (Keyed by a hash, not by the meshes: 25 candidates' meshes need not stay in memory.)
+        let mut fitted: Vec<(Option<u64>, SurfaceFilter)> = Vec::new();
         let after = sharpen
             .iter()
             .map(|o| {
                 let sharp = whet_sharpen::sharpen(&kept, o).ok().map(|s| s.mesh);
-                if let Some((_, f)) = fitted.iter().find(|(m, _)| *m == sharp) {
+                let key = sharp.as_ref().map(crate::encoder::mesh_key);
+                if let Some((_, f)) = fitted.iter().find(|(k, _)| *k == key) {
                     return *f;
                 }
                 let f = match &sharp {
                     Some(s) => fit_after_sharpening(&kept, &fields, s, closest),
                     None => SurfaceFilter::NONE,
                 };
-                fitted.push((sharp, f));
+                fitted.push((key, f));
                 f
             })
             .collect();
