@@ -284,8 +284,8 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
         let h = header(&out.bytes);
         let stated = SharpenHint::planar_of(&h);
         assert_eq!(stated.map(|s| s.0), out.planar_factor, "{name}");
-        // The reported error is the chosen candidate's (with the projection when it won by
-        // the margin), the lowest of the 25 but for the margin.
+        // The reported error is the chosen candidate's (with the projection when its score
+        // won by the margin), the lowest score of the 25 but for the margin.
         let chosen = out.rms_pct.unwrap();
         let unprojected = match (out.planar_factor, planar.first()) {
             (Some(f), Some(p)) => {
@@ -300,12 +300,13 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
                             && t.passes == p.passes
                     })
                     .unwrap();
-                assert!(chosen < 0.995 * t.rms_pct, "{name}");
+                assert!(p.score() < 0.995 * t.score(), "{name}");
                 t.rms_pct
             }
             (None, p) => {
                 if let Some(p) = p {
-                    assert!(p.rms_pct >= 0.995 * chosen, "{name}");
+                    let t = trials.iter().find(|t| t.rms_pct == chosen).unwrap();
+                    assert!(p.score() >= 0.995 * t.score(), "{name}");
                 }
                 chosen
             }
@@ -317,16 +318,25 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
                 .any(|t| t.hint == hint && t.rms_pct == unprojected),
             "{name}"
         );
-        // A later candidate must win by the encoder's margin (0.5 %), among those that do
-        // not raise the max error over the sharpened mesh's; the chosen one does not.
+        // A later candidate must win by the encoder's margin (0.5 %) in score (RMS times the
+        // max to the power MAX_ERROR_WEIGHT), among those that do not raise the max error
+        // over the sharpened mesh's; the chosen one does not.
         let input_max = out.sharpen_input_max_pct.unwrap();
+        let chosen_score = trials
+            .iter()
+            .find(|t| t.hint == hint && t.rms_pct == unprojected)
+            .unwrap()
+            .score();
         assert!(
             trials
                 .iter()
                 .filter(|t| t.max_pct <= input_max)
-                .all(|t| unprojected * 0.995 <= t.rms_pct),
+                .all(|t| chosen_score * 0.995 <= t.score()),
             "{name}"
         );
+        let score =
+            |t: &whet_swing::SharpenTrial| t.rms_pct * t.max_pct.powf(whet_swing::MAX_ERROR_WEIGHT);
+        assert!(trials.iter().all(|t| t.score() == score(t)), "{name}");
         if hint != SharpenHint::Unsharpened {
             let t = trials.iter().find(|t| t.rms_pct == unprojected).unwrap();
             assert!(t.max_pct <= input_max, "{name}: {t:?} over {input_max}");
