@@ -1509,6 +1509,7 @@ impl<'a> Run<'a> {
         stack.clear();
         stack.extend_from_slice(&self.s.touched);
         reset(&mut self.s.settled_ok, self.s.touched.len(), 0);
+        let mut projected: Vec<u32> = Vec::new();
         while let Some(t) = stack.pop() {
             let t = t as usize;
             self.choose_diagonal(t);
@@ -1543,6 +1544,19 @@ impl<'a> Run<'a> {
                             victim = None;
                         }
                         if victim.is_some() {
+                            if let Some(u) = self.project_inside_vertex(piece, t, &mut projected) {
+                                victim = None;
+                                stack.push(t as u32);
+                                for w in self.triangles_of(u) {
+                                    if w as usize != t && self.s.tflags[w as usize] & T_TOUCHED != 0
+                                    {
+                                        stack.push(w);
+                                    }
+                                }
+                                break 'pieces;
+                            }
+                        }
+                        if victim.is_some() {
                             break 'pieces;
                         }
                     } else {
@@ -1573,6 +1587,131 @@ impl<'a> Run<'a> {
             }
         }
         self.s.stack = stack;
+    }
+
+    /// Settling's alternative to unsnapping (extended method; docs/sharpen.md, "What we
+    /// extend", step 12): a piece of `piece_triangle` folds because a snapped vertex (a
+    /// corner, a split) moved past an input vertex that stayed where marching cubes or the
+    /// retiler put it, inside the cut. That vertex moves instead: onto the nearest plane of
+    /// the piece's snapped vertices when it has no label plane, else onto the line of one of
+    /// its label planes with one of theirs; the nearest such point within half its mean edge
+    /// whose untouched triangles stay unfolded and thick. Each vertex is tried once
+    /// (`projected`), and the move is kept only when it leaves no piece around the vertex
+    /// folded. Returns the vertex moved.
+    fn project_inside_vertex(
+        &mut self,
+        piece: &[u32; 3],
+        piece_triangle: usize,
+        projected: &mut Vec<u32>,
+    ) -> Option<u32> {
+        let nv = self.mesh.positions.len();
+        if self.opts.method == Method::Papers {
+            return None;
+        }
+        let mut planes: Vec<Plane> = Vec::new();
+        for &v in piece {
+            if self.is_snapped(v) {
+                self.for_each_plane(v, |pl| planes.push(*pl));
+            }
+        }
+        let thin = self.opts.min_angle_degrees.to_radians();
+        let mut best: Option<(f64, u32, DVec3)> = None;
+        for &u in piece {
+            if u as usize >= nv
+                || self.s.vflags[u as usize] & V_MOVED != 0
+                || projected.contains(&u)
+                || self.table.is_boundary_vertex(VertexId(u))
+            {
+                continue;
+            }
+            let p = self.mesh.positions[u as usize];
+            let mut len = 0.0;
+            let mut k = 0usize;
+            for c in self.table.vertex_corners(VertexId(u)) {
+                len += (self.mesh.positions[self.cv(next(c.index())) as usize] - p).length();
+                k += 1;
+            }
+            if k == 0 {
+                continue;
+            }
+            let limit = 0.5 * len / k as f64;
+            let own = crate::extended::planes_of(self, u);
+            let mut targets: Vec<DVec3> = Vec::new();
+            if own.is_empty() {
+                for pl in &planes {
+                    targets.push(p - (p - pl.point).dot(pl.normal) * pl.normal);
+                }
+            } else {
+                for a in own {
+                    for b in &planes {
+                        if let Ok(q) = crate::snap::edge_point(&a.plane, b, p, &self.limits) {
+                            targets.push(q);
+                        }
+                    }
+                }
+            }
+            for w in targets {
+                let d = w.distance(p);
+                if d > limit || best.is_some_and(|b| d >= b.0) {
+                    continue;
+                }
+                // Untouched triangles are not settled: they must stay unfolded here.
+                let ok = self.table.vertex_corners(VertexId(u)).all(|c| {
+                    let t = c.index() / 3;
+                    if self.s.tflags[t] & T_TOUCHED != 0 {
+                        return true;
+                    }
+                    let q = self.mesh.triangles[t].map(|x| {
+                        if x == u {
+                            w
+                        } else {
+                            self.positions[x as usize]
+                        }
+                    });
+                    let area = (q[1] - q[0]).cross(q[2] - q[0]);
+                    area.dot(self.s.normals[t]) > 0.0 && min_angle(&q) >= thin
+                });
+                if ok {
+                    best = Some((d, u, w));
+                }
+            }
+        }
+        let (_, u, w) = best?;
+        projected.push(u);
+        // Kept only when no piece around the vertex (its triangle's included) is left folded:
+        // a vertex put on a crease line that its neighbours' splits also lie on makes flat
+        // pieces whose folds unsnap those splits one after another (synth cube 128 r1: max
+        // 0.187 % -> 0.245 % without this test).
+        let mut around: Vec<usize> = self
+            .table
+            .vertex_corners(VertexId(u))
+            .map(|c| c.index() / 3)
+            .filter(|&x| self.s.tflags[x] & T_TOUCHED != 0)
+            .collect();
+        around.push(piece_triangle);
+        let before = self.positions[u as usize];
+        self.positions[u as usize] = w;
+        self.s.vflags[u as usize] |= V_MOVED;
+        if around.iter().any(|&x| self.folds(x)) {
+            self.positions[u as usize] = before;
+            self.s.vflags[u as usize] &= !V_MOVED;
+            // The diagonals the test chose were for the moved vertex.
+            for &x in &around {
+                self.choose_diagonal(x);
+            }
+            return None;
+        }
+        Some(u)
+    }
+
+    /// Whether a piece of touched triangle `t` (one not too thin to judge) is reversed.
+    fn folds(&mut self, t: usize) -> bool {
+        self.choose_diagonal(t);
+        let (pieces, n) = self.pieces(t);
+        pieces[..n].iter().any(|piece| {
+            let p = piece.map(|v| self.positions[v as usize]);
+            min_angle(&p) >= SETTLE_MIN_ANGLE.to_radians() && self.is_reversed(piece, t, &p)
+        })
     }
 
     /// New edges may be this many times the longest input edge: 1 in the papers; 2 in the
