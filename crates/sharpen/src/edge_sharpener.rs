@@ -1602,7 +1602,8 @@ impl<'a> Run<'a> {
     /// retiler put it, inside the cut. That vertex moves instead: onto the nearest plane of
     /// the piece's snapped vertices when it has no label plane, else onto the line of one of
     /// its label planes with one of theirs; the nearest such point within [`FOLD_MOVE_LIMIT`]
-    /// of its mean edge whose untouched triangles stay unfolded and thick. Each vertex is tried once
+    /// of its mean edge whose untouched triangles stay unfolded and thick (they become
+    /// touched when the move is kept). Each vertex is tried once
     /// (`projected`), and the move is kept only when it leaves no piece around the vertex
     /// folded. Returns the vertex moved.
     fn project_inside_vertex(
@@ -1662,7 +1663,8 @@ impl<'a> Run<'a> {
                 if d > limit || best.is_some_and(|b| d >= b.0) {
                     continue;
                 }
-                // Untouched triangles are not settled: they must stay unfolded here.
+                // Untouched triangles were not laid out for settling: they must stay unfolded
+                // here.
                 let ok = self.table.vertex_corners(VertexId(u)).all(|c| {
                     let t = c.index() / 3;
                     if self.s.tflags[t] & T_TOUCHED != 0 {
@@ -1676,7 +1678,14 @@ impl<'a> Run<'a> {
                         }
                     });
                     let area = (q[1] - q[0]).cross(q[2] - q[0]);
-                    area.dot(self.s.normals[t]) > 0.0 && min_angle(&q) >= thin
+                    // Judged like a piece: against the plane of its vertices it lies on best.
+                    // Its own input normal refused the move at a pyramid base corner whose
+                    // input triangle leans across the crease (synth pyramid 128 r1).
+                    let n = match self.expected_normal(&self.mesh.triangles[t], t) {
+                        DVec3::ZERO => self.s.normals[t],
+                        e => e,
+                    };
+                    area.dot(n) > 0.0 && min_angle(&q) >= thin
                 });
                 if ok {
                     best = Some((d, u, w));
@@ -1707,6 +1716,20 @@ impl<'a> Run<'a> {
                 self.choose_diagonal(x);
             }
             return None;
+        }
+        // Its untouched triangles moved with it: settling and the sliver pass now see
+        // them as touched (each one whole, a single piece).
+        let untouched: Vec<usize> = self
+            .table
+            .vertex_corners(VertexId(u))
+            .map(|c| c.index() / 3)
+            .filter(|&x| self.s.tflags[x] & T_TOUCHED == 0)
+            .collect();
+        for x in untouched {
+            self.s.tflags[x] |= T_TOUCHED;
+            self.s.touched_index[x] = self.s.touched.len() as u32;
+            self.s.touched.push(x as u32);
+            self.s.settled_ok.push(0);
         }
         Some(u)
     }
