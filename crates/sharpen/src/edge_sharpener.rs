@@ -1633,16 +1633,10 @@ impl<'a> Run<'a> {
                 continue;
             }
             let p = self.mesh.positions[u as usize];
-            let mut len = 0.0;
-            let mut k = 0usize;
-            for c in self.table.vertex_corners(VertexId(u)) {
-                len += (self.mesh.positions[self.cv(next(c.index())) as usize] - p).length();
-                k += 1;
-            }
-            if k == 0 {
+            let Some(mean) = self.mean_input_edge(u) else {
                 continue;
-            }
-            let limit = FOLD_MOVE_LIMIT * len / k as f64;
+            };
+            let limit = FOLD_MOVE_LIMIT * mean;
             let own = crate::extended::planes_of(self, u);
             let mut targets: Vec<DVec3> = Vec::new();
             if own.is_empty() {
@@ -1732,6 +1726,18 @@ impl<'a> Run<'a> {
             self.s.settled_ok.push(0);
         }
         Some(u)
+    }
+
+    /// Mean length of the input edges at input vertex `v` (`None` for an unused vertex).
+    pub(crate) fn mean_input_edge(&self, v: u32) -> Option<f64> {
+        let p = self.mesh.positions[v as usize];
+        let mut len = 0.0;
+        let mut k = 0usize;
+        for c in self.table.vertex_corners(VertexId(v)) {
+            len += (self.mesh.positions[self.cv(next(c.index())) as usize] - p).length();
+            k += 1;
+        }
+        (k > 0).then(|| len / k as f64)
     }
 
     /// Whether a piece of touched triangle `t` (one not too thin to judge) is reversed.

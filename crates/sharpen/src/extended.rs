@@ -1206,14 +1206,7 @@ pub(crate) fn corner_vertices(run: &mut Run) -> Vec<u32> {
             }
         }
         let Some((d, v)) = best else { continue };
-        let p = run.mesh.positions[v as usize];
-        let mut len = 0.0;
-        let mut k = 0usize;
-        for cc in run.table.vertex_corners(VertexId(v)) {
-            len += (run.mesh.positions[run.cv(next(cc.index())) as usize] - p).length();
-            k += 1;
-        }
-        let mean = len / k.max(1) as f64;
+        let mean = run.mean_input_edge(v).unwrap_or(0.0);
         if d > CORNER_MOVE_LIMIT * mean || placed.iter().any(|q| q.distance(w) < 0.5 * mean) {
             continue;
         }
