@@ -78,7 +78,7 @@ impl SharpenTrial {
     /// What the encoder's choice minimises: the RMS error times the max error to the power
     /// [`MAX_ERROR_WEIGHT`] (docs/swing.md section 2, "The max error counts too").
     pub fn score(&self) -> f64 {
-        sharpening_score(self.rms_pct, self.max_pct)
+        self.rms_pct * self.max_pct.max(0.0).powf(MAX_ERROR_WEIGHT)
     }
 }
 
@@ -88,10 +88,6 @@ impl SharpenTrial {
 /// max 0.26 % -> 0.42 %); a quarter makes a max 34 % lower worth an RMS 10 % higher, and
 /// keeps RMS the main figure.
 pub const MAX_ERROR_WEIGHT: f64 = 0.25;
-
-fn sharpening_score(rms_pct: f64, max_pct: f64) -> f64 {
-    rms_pct * max_pct.max(0.0).powf(MAX_ERROR_WEIGHT)
-}
 
 /// The planar-region projection's tolerance, in angle steps, that the encoder tries after
 /// the best sharpening (`whet_sharpen::PlanarOptions::for_swing`; docs/swing.md section 2):

@@ -220,6 +220,18 @@ fn issue6_welding_clears_the_cluster_gaps() {
     assert_eq!((a.mesh, a.tags), (b.mesh, b.tags));
 }
 
+/// Max-error gain of the default sharpener on `kind` at `res`, rotation `rot`, and the output
+/// checks, after asserting that the output stays a manifold with no new boundary edge.
+fn max_gain_and_checks(kind: ShapeKind, res: usize, rot: usize) -> (f64, crate::support::Checks) {
+    let (truth, input) = sampled(kind, res, rot);
+    let before = error(&truth, &input, SAMPLES);
+    let out = sharpen(&input, &SharpenOptions::DEFAULT).unwrap();
+    let after = error(&truth, &out.mesh, SAMPLES);
+    let c = check(&truth, &input, &out);
+    assert!(c.manifold && c.new_boundary_edges == 0, "{}", kind.name());
+    (before.max_pct / after.max_pct, c)
+}
+
 #[test]
 fn issue6_settling_moves_the_vertex_a_snap_folds_over() {
     // A snap that folds a piece over an input vertex left inside the cut used to be given up;
@@ -228,18 +240,9 @@ fn issue6_settling_moves_the_vertex_a_snap_folds_over() {
     // 2.62x in docs/results.md ("Moving the vertex a snap folds over", 1M samples), 2.09x ->
     // 2.62x here (50k samples; measured with the move turned off and on); the bound sits
     // between.
-    let (truth, input) = sampled(ShapeKind::Cube, 64, 1);
-    let before = error(&truth, &input, SAMPLES);
-    let out = sharpen(&input, &SharpenOptions::DEFAULT).unwrap();
-    let after = error(&truth, &out.mesh, SAMPLES);
-    let c = check(&truth, &input, &out);
-    assert!(c.manifold && c.new_boundary_edges == 0);
+    let (gain, c) = max_gain_and_checks(ShapeKind::Cube, 64, 1);
     assert!(c.min_new_angle >= 1.0 - 1e-9, "{}", c.min_new_angle);
-    assert!(
-        before.max_pct / after.max_pct >= 2.35,
-        "{before:?} -> {after:?} ({:.2}x)",
-        before.max_pct / after.max_pct
-    );
+    assert!(gain >= 2.35, "{gain:.2}x");
 }
 
 #[test]
@@ -249,15 +252,6 @@ fn issue6_a_folding_corner_moves_the_triangle_leaning_across_the_crease() {
     // the corner, judged like a piece (its vertices' planes) it takes it (docs/results.md,
     // "Moving the vertex a snap folds over": max gain 1.30x -> 1.84x at 1M samples; here, at
     // 50k samples, 1.31x before and 1.85x after).
-    let (truth, input) = sampled(ShapeKind::Pyramid, 128, 1);
-    let before = error(&truth, &input, SAMPLES);
-    let out = sharpen(&input, &SharpenOptions::DEFAULT).unwrap();
-    let after = error(&truth, &out.mesh, SAMPLES);
-    let c = check(&truth, &input, &out);
-    assert!(c.manifold && c.new_boundary_edges == 0);
-    assert!(
-        before.max_pct / after.max_pct >= 1.6,
-        "{before:?} -> {after:?} ({:.2}x)",
-        before.max_pct / after.max_pct
-    );
+    let (gain, _) = max_gain_and_checks(ShapeKind::Pyramid, 128, 1);
+    assert!(gain >= 1.6, "{gain:.2}x");
 }
