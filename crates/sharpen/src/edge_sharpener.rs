@@ -64,10 +64,14 @@ pub(crate) const T_TOUCHED: u8 = 8;
 const SETTLE_MIN_ANGLE: f64 = 5.0;
 
 /// How far settling may move an input vertex that a snap folds over, in mean edges around it
-/// (`Run::project_inside_vertex`). Measured on the marching-cubes table (docs/results.md,
+/// (`Run::project_inside_vertex`), unless a snapped vertex of the folding piece moved farther:
+/// then as far as that one moved. Measured on the marching-cubes table (docs/results.md,
 /// "Moving the vertex a snap folds over"): 0.5 first; 0.75 gained on 11 of 30 rows and lost
 /// on none (cube 96 r0 max 2.42x -> 2.97x), 1.0 lost RMS on pyramid 96 r1; the swing-decoded
-/// rows did not move at either.
+/// rows did not move at either. The deeper reach ("A deep corner's inside vertex"): a vertex
+/// inside a cut corner lies no deeper under the corner's planes than the cut itself, which
+/// the corner vertex's move measures (synth pyramid 64 r1: the apex vertex moved 1.6 mean
+/// edges, and the vertex it folded over needed 0.88).
 const FOLD_MOVE_LIMIT: f64 = 0.75;
 
 /// A split whose vertex would move by less than this fraction of its edge changes nothing
@@ -1602,7 +1606,8 @@ impl<'a> Run<'a> {
     /// retiler put it, inside the cut. That vertex moves instead: onto the nearest plane of
     /// the piece's snapped vertices when it has no label plane, else onto the line of one of
     /// its label planes with one of theirs; the nearest such point within [`FOLD_MOVE_LIMIT`]
-    /// of its mean edge whose untouched triangles stay unfolded and thick (they become
+    /// of its mean edge (or as far as the piece's farthest moved snapped vertex went) whose
+    /// untouched triangles stay unfolded and thick (they become
     /// touched when the move is kept). Each vertex is tried once
     /// (`projected`), and the move is kept only when it leaves no piece around the vertex
     /// folded. Returns the vertex moved.
@@ -1623,6 +1628,12 @@ impl<'a> Run<'a> {
             }
         }
         let thin = self.opts.min_angle_degrees.to_radians();
+        // The depth of the cut the piece's snapped vertices measure.
+        let deepest = piece
+            .iter()
+            .filter(|&&v| self.is_snapped(v))
+            .map(|&v| self.positions[v as usize].distance(self.rest_of(v)))
+            .fold(0.0f64, f64::max);
         let mut best: Option<(f64, u32, DVec3)> = None;
         for &u in piece {
             if u as usize >= nv
@@ -1636,7 +1647,7 @@ impl<'a> Run<'a> {
             let Some(mean) = self.mean_input_edge(u) else {
                 continue;
             };
-            let limit = FOLD_MOVE_LIMIT * mean;
+            let limit = (FOLD_MOVE_LIMIT * mean).max(deepest);
             let own = crate::extended::planes_of(self, u);
             let mut targets: Vec<DVec3> = Vec::new();
             if own.is_empty() {
