@@ -267,3 +267,15 @@ fn issue6_a_deep_corner_moves_the_vertex_inside_its_cut() {
     assert!(c.min_new_angle >= 1.0 - 1e-9, "{}", c.min_new_angle);
     assert!(gain >= 2.0, "{gain:.2}x");
 }
+
+#[test]
+fn issue6_one_noisy_neighbour_plane_does_not_refuse_a_crease_snap() {
+    // Pyramid 48, rotation 1: a base-crease edge's snap onto the true crease was refused by
+    // the consistency test because one neighbour's plane, borrowed by a vertex deep in the
+    // acute cut, leans 7.7 degrees into the chamfer; one such miss is now allowed
+    // (CONSISTENCY_MISSES). docs/results.md ("One noisy plane", 1M samples): max gain 1.63x
+    // -> 2.16x; here, at 50k samples, 1.64x before and 2.16x after; the bound sits between.
+    let (gain, c) = max_gain_and_checks(ShapeKind::Pyramid, 48, 1);
+    assert!(c.min_new_angle >= 1.0 - 1e-9, "{}", c.min_new_angle);
+    assert!(gain >= 1.9, "{gain:.2}x");
+}
