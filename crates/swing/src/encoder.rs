@@ -460,13 +460,27 @@ impl SwingEncoder {
         .into_iter();
         let mut trials = Vec::new();
         let mut best: Option<(SharpenTrial, Option<SwingOutput>)> = None;
-        // Sharpening must not make the worst place worse than the mesh it sharpens (the issue's
-        // "no case gets worse"): the score (RMS weighted by the max, `MAX_ERROR_WEIGHT`)
-        // decides among the candidates whose max stays within that mesh's.
+        // Sharpening must not make a case worse (the "no case gets worse", RMS or
+        // max): the score (RMS weighted by the max, `MAX_ERROR_WEIGHT`) decides among the
+        // candidates whose max stays within that of the mesh they sharpen and whose RMS stays
+        // within that of the plain decoded mesh (no sharpening). Without the second bound the
+        // score took a 19 % lower max for a 7 % higher RMS on screwdriver at 12 bpv (docs/rd).
         // Every candidate's stream decodes, without its surface filter, to this same mesh
         // (they differ in header fields only): decoded once for all of them.
         let input = unfiltered(&out)?.into_owned();
         let input_max = self.measure_mesh(prep, &input, &mut Vec::new())?.1;
+        let opts = whet_sharpen::SharpenOptions::DEFAULT;
+        let (decoded, decoded_max) =
+            self.measure_figures(prep, &out, ErrorOf::Decoded, &opts, &mut Vec::new())?;
+        let none = SharpenTrial {
+            hint: SharpenHint::Unsharpened,
+            smooth_factor: DEFAULT_SMOOTH_FACTOR,
+            curved_walls: 0.0,
+            passes: 1,
+            rms_pct: decoded,
+            max_pct: decoded_max,
+            planar: false,
+        };
         // Candidates whose output is the same mesh (curved walls that turn no edge smooth, a
         // second pass that changes nothing) are measured once.
         let mut measured = Vec::new();
@@ -495,6 +509,7 @@ impl SwingEncoder {
             };
             trials.push(trial);
             if max <= input_max
+                && rms <= none.rms_pct
                 && best
                     .as_ref()
                     .is_none_or(|(b, _)| trial.score() < MARGIN * b.score())
@@ -502,18 +517,6 @@ impl SwingEncoder {
                 best = Some((trial, stream));
             }
         }
-        let opts = whet_sharpen::SharpenOptions::DEFAULT;
-        let (decoded, decoded_max) =
-            self.measure_figures(prep, &out, ErrorOf::Decoded, &opts, &mut Vec::new())?;
-        let none = SharpenTrial {
-            hint: SharpenHint::Unsharpened,
-            smooth_factor: DEFAULT_SMOOTH_FACTOR,
-            curved_walls: 0.0,
-            passes: 1,
-            rms_pct: decoded,
-            max_pct: decoded_max,
-            planar: false,
-        };
         trials.push(none);
         let (chosen_trial, stream) = match best {
             Some((b, s)) if none.score() >= MARGIN * b.score() => (b, s),
@@ -554,6 +557,7 @@ impl SwingEncoder {
             trials.push(projected);
             if projected.score() < MARGIN * chosen_trial.score()
                 && max <= input_max.max(chosen_trial.max_pct)
+                && rms <= none.rms_pct
             {
                 chosen = planar;
                 chosen.rms_pct = Some(rms);

@@ -320,8 +320,14 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
         );
         // A later candidate must win by the encoder's margin (0.5 %) in score (RMS times the
         // max to the power MAX_ERROR_WEIGHT), among those that do not raise the max error
-        // over the sharpened mesh's; the chosen one does not.
+        // over the sharpened mesh's nor the RMS error over the plain decoded mesh's; the
+        // chosen one does not.
         let input_max = out.sharpen_input_max_pct.unwrap();
+        let none_rms = trials
+            .iter()
+            .find(|t| t.hint == SharpenHint::Unsharpened)
+            .unwrap()
+            .rms_pct;
         let chosen_score = trials
             .iter()
             .find(|t| t.hint == hint && t.rms_pct == unprojected)
@@ -330,7 +336,7 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
         assert!(
             trials
                 .iter()
-                .filter(|t| t.max_pct <= input_max)
+                .filter(|t| t.max_pct <= input_max && t.rms_pct <= none_rms)
                 .all(|t| chosen_score * 0.995 <= t.score()),
             "{name}"
         );
@@ -340,6 +346,8 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
         if hint != SharpenHint::Unsharpened {
             let t = trials.iter().find(|t| t.rms_pct == unprojected).unwrap();
             assert!(t.max_pct <= input_max, "{name}: {t:?} over {input_max}");
+            assert!(t.rms_pct <= none_rms, "{name}: {t:?} over {none_rms}");
+            assert!(chosen <= none_rms, "{name}: {chosen} over {none_rms}");
         }
         // The stream states the choice: method and factor, and curved walls and passes where
         // they are on and more than one.
