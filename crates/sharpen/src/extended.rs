@@ -152,7 +152,7 @@ fn snap_chamfer_vertices(run: &mut Run) {
             continue;
         }
         if run.s.lp_len[v as usize] > 1 {
-            // Assume it stays; a successful move below removes it from the list.
+            // Assume it stays; a kept move below takes it off the list.
             stay.push(v);
         }
         kept.clear();
@@ -179,39 +179,131 @@ fn snap_chamfer_vertices(run: &mut Run) {
             len += (run.mesh.positions[run.cv(next(c.index())) as usize] - p).length();
             k += 1;
         }
-        if k == 0 || target.distance(p) > MOVE_LIMIT * len / k as f64 {
+        // The vertex lies within `CREASE_TOLERANCE * reach` of its planes (see
+        // `crease_vertices`), and the crease of a wedge of interior angle `a` is `1 / sin(a / 2)`
+        // (`sqrt 2` times `reach`) farther than the planes from a point inside it: the limit
+        // grows with the square of the reach.
+        let reach = match surfaces.as_slice() {
+            [a, b] => acute_reach(run, &[a, b]),
+            [a, b, c] => acute_reach(run, &[a, b, c]),
+            more => acute_reach(run, &more.iter().collect::<Vec<_>>()),
+        };
+        if k == 0 || target.distance(p) > MOVE_LIMIT * reach * reach * len / k as f64 {
             continue;
         }
-        // The fan around the vertex must stay unfolded and free of thin triangles.
-        let thin = run.opts.min_angle_degrees.to_radians();
-        let fan_ok = run.table.vertex_corners(VertexId(v)).all(|c| {
-            let t = c.index() / 3;
-            let tri = run.mesh.triangles[t];
-            let q = tri.map(|x| {
-                if x == v {
-                    target
-                } else {
-                    run.mesh.positions[x as usize]
-                }
-            });
-            let area = (q[1] - q[0]).cross(q[2] - q[0]);
-            area.dot(run.mesh.face_cross(t)) > 0.0 && crate::edge_sharpener::min_angle(&q) >= thin
-        });
-        if fan_ok {
-            moves.push((v, target));
-            stay.pop();
-        }
+        moves.push((v, target));
+    }
+    // Each move with the neighbours at rest: the fan must stay unfolded and free of thin
+    // triangles.
+    let thin = run.opts.min_angle_degrees.to_radians();
+    let mut keep: Vec<bool> = moves
+        .iter()
+        .map(|&(v, target)| {
+            run.table.vertex_corners(VertexId(v)).all(|c| {
+                let t = c.index() / 3;
+                let q = run.mesh.triangles[t].map(|x| {
+                    if x == v {
+                        target
+                    } else {
+                        run.mesh.positions[x as usize]
+                    }
+                });
+                let area = (q[1] - q[0]).cross(q[2] - q[0]);
+                area.dot(run.mesh.face_cross(t)) > 0.0
+                    && crate::edge_sharpener::min_angle(&q) >= thin
+            })
+        })
+        .collect();
+    if keep.iter().any(|&k| !k) {
+        second_chance(run, &moves, &mut keep, thin);
     }
     // A chamfer vertex that cannot reach its crease is on one surface only.
     for v in stay {
-        run.s.lp_len[v as usize] = 1;
+        // `moves` is in vertex order.
+        let kept_move = moves
+            .binary_search_by_key(&v, |m| m.0)
+            .is_ok_and(|i| keep[i]);
+        if !kept_move {
+            run.s.lp_len[v as usize] = 1;
+        }
     }
-    for (v, target) in moves {
+    for (&(v, target), &k) in moves.iter().zip(&keep) {
+        if !k {
+            continue;
+        }
         run.positions[v as usize] = target;
         run.s.vflags[v as usize] |= V_MOVED;
         for c in run.table.vertex_corners(VertexId(v)) {
             run.s.tflags[c.index() / 3] |= T_TOUCHED;
         }
+    }
+}
+
+/// The moves of [`snap_chamfer_vertices`] refused with their neighbours at rest, tried again
+/// with every other candidate move in place (`run.positions` is left as it was). A chamfer
+/// triangle whose vertices all move, onto the crease and a face, turns by up to the chamfer's
+/// angle, against its input normal though not folded: such a triangle is judged by the label
+/// plane it now lies on best, as [`Run::is_reversed`] judges pieces, and must face the way
+/// that plane does. Moves whose fan still folds or thins give up one by one (in vertex order)
+/// until every kept move's fan is sound with all kept moves in place. Synth pyramid at 128 r1:
+/// a vertex inside a 58-degree cut, whose neighbour moved onto the crease too, left a gap of
+/// 2.4 edges in the crease (docs/results.md, "A vertex inside an acute cut").
+fn second_chance(run: &mut Run, moves: &[(u32, DVec3)], keep: &mut [bool], thin: f64) {
+    for &(v, target) in moves {
+        run.positions[v as usize] = target;
+    }
+    let lies_right = |run: &Run, t: usize| {
+        let tri = run.mesh.triangles[t];
+        let q = tri.map(|x| run.positions[x as usize]);
+        if crate::edge_sharpener::min_angle(&q) < thin {
+            return false;
+        }
+        let area = (q[1] - q[0]).cross(q[2] - q[0]);
+        if area.dot(run.mesh.face_cross(t)) > 0.0 {
+            return true;
+        }
+        let longest2 = (0..3)
+            .map(|k| q[k].distance_squared(q[(k + 1) % 3]))
+            .fold(0.0f64, f64::max);
+        let mut best = (f64::INFINITY, DVec3::ZERO);
+        for &x in &tri {
+            for lp in planes_of(run, x) {
+                let d = q
+                    .iter()
+                    .map(|y| (*y - lp.plane.point).dot(lp.plane.normal).abs())
+                    .fold(0.0f64, f64::max);
+                if d < best.0 {
+                    best = (d, lp.plane.normal);
+                }
+            }
+        }
+        // On the plane as `Run::is_reversed`'s fold test counts it (a fifth of the longest
+        // side), and facing its way.
+        best.0 * best.0 <= 0.04 * longest2 && area.dot(best.1) > 0.0
+    };
+    let mut retry: Vec<usize> = (0..moves.len()).filter(|&i| !keep[i]).collect();
+    loop {
+        let before = retry.len();
+        retry.retain(|&i| {
+            let v = moves[i].0;
+            let sound = run
+                .table
+                .vertex_corners(VertexId(v))
+                .all(|c| lies_right(run, c.index() / 3));
+            if !sound {
+                run.positions[v as usize] = run.mesh.positions[v as usize];
+            }
+            sound
+        });
+        if retry.len() == before {
+            break;
+        }
+    }
+    for &i in &retry {
+        keep[i] = true;
+    }
+    for &(v, _) in moves {
+        run.positions[v as usize] = run.mesh.positions[v as usize];
     }
 }
 
@@ -626,14 +718,25 @@ fn crease_vertices(run: &mut Run) {
         if k == 0 {
             continue;
         }
-        let factor = if run.s.vflags[v as usize] & V_CHAMFER != 0 {
+        let chamfer = run.s.vflags[v as usize] & V_CHAMFER != 0;
+        let factor = if chamfer {
             CREASE_TOLERANCE
         } else {
             RED_CREASE_TOLERANCE
         };
         let tol = factor * len / k as f64;
         for &lp in &found {
-            if (p - lp.plane.point).dot(lp.plane.normal).abs() <= tol {
+            // A chamfer vertex inside an acute cut lies deeper under both planes (marching
+            // cubes cuts a wedge `acute_reach` times deeper than a right angle): synth pyramid,
+            // 58-degree edges, vertices 0.38 edges under both planes.
+            let reach = if chamfer {
+                own.iter()
+                    .map(|o| acute_reach(run, &[&o.plane, &lp.plane]))
+                    .fold(1.0f64, f64::max)
+            } else {
+                1.0
+            };
+            if (p - lp.plane.point).dot(lp.plane.normal).abs() <= tol * reach {
                 extra.push((v, lp));
             }
         }
