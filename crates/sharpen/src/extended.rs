@@ -68,6 +68,7 @@ pub(crate) fn classify(run: &mut Run) {
     run.surface_samples = is_surface_sampling(run.mesh);
     if !run.surface_samples {
         demote_corridors(run);
+        demote_strip_arms(run);
     }
     border_planes(run);
     if run.surface_samples {
@@ -337,23 +338,8 @@ fn demote_corridors(run: &mut Run) {
     if nregions == 0 {
         return;
     }
-    // A region is thick when it has a *deep* vertex: a core vertex (filter 1: all its edges
-    // smooth, so its whole fan lies in one region) whose neighbours are all core too. One pass
-    // over the corners.
-    let core = |v: usize| run.s.vflags[v] & V_CORE != 0;
-    let mut deep: Vec<bool> = (0..nv).map(core).collect();
-    let mut of: Vec<u32> = vec![NONE; nv];
-    for (t, tri) in run.mesh.triangles.iter().enumerate() {
-        for k in 0..3 {
-            let v = tri[k] as usize;
-            if deep[v] {
-                of[v] = run.s.region[t];
-                if !core(tri[(k + 1) % 3] as usize) {
-                    deep[v] = false;
-                }
-            }
-        }
-    }
+    // A region is thick when it has a deep vertex.
+    let (deep, of) = deep_vertices(run);
     let mut thick = vec![false; nregions];
     for v in 0..nv {
         if deep[v] && of[v] != NONE {
@@ -399,21 +385,203 @@ fn demote_corridors(run: &mut Run) {
     if !any {
         return;
     }
-    let mut gone: Vec<usize> = Vec::new();
-    for t in 0..nt {
-        let r = run.s.region[t];
-        if r != NONE && demoted[r as usize] {
-            run.s.region[t] = NONE;
-            run.s.tflags[t] &= !T_RED;
-            gone.push(t);
+    let gone: Vec<usize> = (0..nt)
+        .filter(|&t| {
+            let r = run.s.region[t];
+            r != NONE && demoted[r as usize]
+        })
+        .collect();
+    demote(run, &gone);
+}
+
+/// The *deep* vertices, each a core vertex (filter 1: all its edges smooth, so its whole fan
+/// lies in one region) whose neighbours are all core too, and the region of each (`NONE` for
+/// the others). One pass over the corners.
+fn deep_vertices(run: &Run) -> (Vec<bool>, Vec<u32>) {
+    let nv = run.mesh.positions.len();
+    let core = |v: usize| run.s.vflags[v] & V_CORE != 0;
+    let mut deep: Vec<bool> = (0..nv).map(core).collect();
+    let mut of: Vec<u32> = vec![NONE; nv];
+    for (t, tri) in run.mesh.triangles.iter().enumerate() {
+        for k in 0..3 {
+            let v = tri[k] as usize;
+            if deep[v] {
+                of[v] = run.s.region[t];
+                if !core(tri[(k + 1) % 3] as usize) {
+                    deep[v] = false;
+                }
+            }
         }
     }
-    // Filter 4 again for the red triangles that remain, only where it can change: the edges
-    // and vertices of the demoted triangles (a corner is red when a triangle on either side
-    // of its edge is, a vertex when a triangle around it is). The same flags as running it over
-    // the whole mesh (test builds check), for a few hundred triangles instead of all.
+    (deep, of)
+}
+
+/// An inner edge of a region (both triangles in it) that turns by more than this many smooth
+/// thresholds is a crease the region reaches around: see [`demote_strip_arms`]. Measured on
+/// the synth table (docs/results.md, "Strip arms"): 4 found only fandisk 64 r1's and the
+/// pyramid's arms; 3 also fandisk 48 r1's; 2.5 found a narrow corner region of the pyramid at
+/// 48 r1 (max 2.16x -> 1.06x) and cube 32 r0 lost max.
+pub(crate) const STRONG_INNER_TURN: f64 = 3.0;
+
+/// How many triangles [`demote_strip_arms`] grows from one side of a strong inner edge,
+/// through smooth edges of the region, looking for a deep vertex.
+pub(crate) const ARM_PROBE: usize = 8;
+
+/// An arm's triangles lie within this many rings of a strong inner edge (see
+/// [`demote_strip_arms`]): without the bound, fandisk 48 r1's arm grew along a face's border
+/// into 329 triangles far from its crease; 2 and 4 rings gave the same rows at 2x and 3x, 4
+/// a little more RMS.
+pub(crate) const ARM_RINGS: usize = 4;
+
+/// Demotes *strip arms*: the chamfer strip of a crease that fades out (synth fandisk) is smooth
+/// and joined, through smooth edges around the crease's end, to one of its two faces, so it is
+/// one thick region with that face and never a corridor; its edges with that face are inner
+/// edges of the region that turn by the chamfer's angle, its vertices share the region with
+/// the face's, and no chamfer edge is found along the whole crease. From each side of such a
+/// strong inner edge ([`STRONG_INNER_TURN`]) the region is grown through smooth edges for
+/// [`ARM_PROBE`] triangles: the face side soon reaches a deep vertex, the strip side (a band a
+/// few triangles wide, every vertex next to a crease) does not. The strip side is then grown
+/// through smooth edges over the region's triangles that hold no deep vertex and touch a
+/// strong inner edge or the region's border, and taken out of the region like a corridor.
+#[inline(never)] // one call per run; kept out of line so profiles show it
+fn demote_strip_arms(run: &mut Run) {
+    let nt = run.mesh.triangles.len();
+    let nv = run.mesh.positions.len();
+    let threshold = (STRONG_INNER_TURN * run.smooth_threshold) as f32;
+    let opposite = run.table.opposites();
+    let mut strong: Vec<(usize, usize)> = Vec::new();
+    for (c, &o) in opposite.iter().enumerate() {
+        if o == NONE || (o as usize) < c {
+            continue;
+        }
+        let o = o as usize;
+        let r = run.s.region[c / 3];
+        if r != NONE && run.s.region[o / 3] == r && run.s.angles[c].max(run.s.angles[o]) > threshold
+        {
+            strong.push((c, o));
+        }
+    }
+    if strong.is_empty() {
+        return;
+    }
+    let (deep, _) = deep_vertices(run);
+    // Vertices of a strong inner edge, or on the border of their region (a triangle around
+    // them in another region, or in none): the vertices an arm's triangles touch.
+    let mut edge_vertex = vec![false; nv];
+    for &(c, _) in &strong {
+        edge_vertex[run.cv(next(c)) as usize] = true;
+        edge_vertex[run.cv(crate::edge_sharpener::prev(c)) as usize] = true;
+    }
+    for (c, &o) in opposite.iter().enumerate() {
+        if o != NONE && run.s.region[c / 3] != run.s.region[o as usize / 3] {
+            edge_vertex[run.cv(next(c)) as usize] = true;
+            edge_vertex[run.cv(crate::edge_sharpener::prev(c)) as usize] = true;
+        }
+    }
+    // Vertices within ARM_RINGS rings of a strong inner edge: an arm is a band along its
+    // crease, and growing along a face's border elsewhere is a leak.
+    let mut near = vec![false; nv];
+    let mut ring: Vec<u32> = Vec::new();
+    for &(c, _) in &strong {
+        for v in [run.cv(next(c)), run.cv(crate::edge_sharpener::prev(c))] {
+            if !near[v as usize] {
+                near[v as usize] = true;
+                ring.push(v);
+            }
+        }
+    }
+    for _ in 0..ARM_RINGS {
+        let mut next_ring = Vec::new();
+        for &v in &ring {
+            for vc in run.table.vertex_corners(VertexId(v)) {
+                let w = run.cv(next(vc.index()));
+                if !near[w as usize] {
+                    near[w as usize] = true;
+                    next_ring.push(w);
+                }
+            }
+        }
+        ring = next_ring;
+    }
+    let tri = |t: usize| run.mesh.triangles[t];
+    let has_deep = |t: usize| tri(t).iter().any(|&v| deep[v as usize]);
+    let arm_like = |t: usize| {
+        !has_deep(t)
+            && tri(t).iter().all(|&v| near[v as usize])
+            && tri(t).iter().any(|&v| edge_vertex[v as usize])
+    };
+    // Growth through smooth edges inside one region, breadth first; `stamp` marks the
+    // triangles one growth has reached (a new number per growth, no clearing).
+    let mut stamp: Vec<u32> = vec![0; nt];
+    let mut generation = 0u32;
+    let mut reached: Vec<usize> = Vec::new();
+    let mut grow =
+        |t0: usize, cap: usize, admit: &dyn Fn(usize) -> bool, reached: &mut Vec<usize>| {
+            generation += 1;
+            let r = run.s.region[t0];
+            reached.clear();
+            reached.push(t0);
+            stamp[t0] = generation;
+            let mut i = 0;
+            while i < reached.len() && reached.len() < cap {
+                let t = reached[i];
+                i += 1;
+                for c in 3 * t..3 * t + 3 {
+                    let o = opposite[c];
+                    if o == NONE || run.s.cflags[c] & crate::edge_sharpener::C_BROWN == 0 {
+                        continue;
+                    }
+                    let u = o as usize / 3;
+                    if run.s.region[u] == r && stamp[u] != generation && admit(u) {
+                        stamp[u] = generation;
+                        reached.push(u);
+                    }
+                }
+            }
+        };
+    let mut in_arm = vec![false; nt];
+    let mut gone: Vec<usize> = Vec::new();
+    for &(c, o) in &strong {
+        // Which sides look like a strip: no deep vertex within the probe. Exactly one must
+        // (near a corner or an apex both faces are narrow, and neither is known to be the
+        // strip).
+        let mut thin = [false; 2];
+        for (k, t) in [c / 3, o / 3].into_iter().enumerate() {
+            if !has_deep(t) {
+                grow(t, ARM_PROBE, &|_| true, &mut reached);
+                thin[k] = !reached.iter().any(|&u| has_deep(u));
+            }
+        }
+        if thin[0] == thin[1] {
+            continue;
+        }
+        {
+            let t = if thin[0] { c / 3 } else { o / 3 };
+            if in_arm[t] {
+                continue;
+            }
+            grow(t, usize::MAX, &|u| !in_arm[u] && arm_like(u), &mut reached);
+            for &u in &reached {
+                in_arm[u] = true;
+            }
+            gone.extend_from_slice(&reached);
+        }
+    }
+    demote(run, &gone);
+}
+
+/// Takes the triangles `gone` out of their regions (no longer red), and runs filter 4 again
+/// for the red triangles that remain, only where it can change: the edges and vertices of the
+/// demoted triangles (a corner is red when a triangle on either side of its edge is, a vertex
+/// when a triangle around it is). The same flags as running it over the whole mesh (test
+/// builds check), for a few hundred triangles instead of all.
+fn demote(run: &mut Run, gone: &[usize]) {
+    for &t in gone {
+        run.s.region[t] = NONE;
+        run.s.tflags[t] &= !T_RED;
+    }
     let red = |run: &Run, t: usize| run.s.tflags[t] & T_RED != 0;
-    for &t in &gone {
+    for &t in gone {
         for c in 3 * t..3 * t + 3 {
             let o = run.table.opposite(CornerId(c as u32));
             let edge_red = o.is_some_and(|o| red(run, o.index() / 3));
@@ -431,6 +599,7 @@ fn demote_corridors(run: &mut Run) {
     }
     #[cfg(debug_assertions)]
     {
+        let nt = run.mesh.triangles.len();
         let mut vflags: Vec<u8> = run.s.vflags.iter().map(|f| f & !V_RED).collect();
         let mut cflags: Vec<u8> = run.s.cflags.iter().map(|f| f & !C_RED).collect();
         for t in (0..nt).filter(|&t| red(run, t)) {
