@@ -184,39 +184,20 @@ fn snap_chamfer_vertices(run: &mut Run) {
         // `crease_vertices`), and the crease of a wedge of interior angle `a` is `1 / sin(a / 2)`
         // (`sqrt 2` times `reach`) farther than the planes from a point inside it: the limit
         // grows with the square of the reach.
-        let reach = match surfaces.as_slice() {
-            [a, b] => acute_reach(run, &[a, b]),
-            [a, b, c] => acute_reach(run, &[a, b, c]),
-            more => acute_reach(run, &more.iter().collect::<Vec<_>>()),
-        };
+        let reach = acute_reach(run, &surfaces.iter().collect::<Vec<_>>());
         if k == 0 || target.distance(p) > MOVE_LIMIT * reach * reach * len / k as f64 {
             continue;
         }
         moves.push((v, target));
     }
-    // Each move with the neighbours at rest: the fan must stay unfolded and free of thin
-    // triangles.
-    let thin = run.opts.min_angle_degrees.to_radians();
+    // Each move with the neighbours at rest (nothing has moved yet: `run.positions` are the
+    // input's): the fan must stay unfolded and free of thin triangles.
     let mut keep: Vec<bool> = moves
         .iter()
-        .map(|&(v, target)| {
-            run.table.vertex_corners(VertexId(v)).all(|c| {
-                let t = c.index() / 3;
-                let q = run.mesh.triangles[t].map(|x| {
-                    if x == v {
-                        target
-                    } else {
-                        run.mesh.positions[x as usize]
-                    }
-                });
-                let area = (q[1] - q[0]).cross(q[2] - q[0]);
-                area.dot(run.mesh.face_cross(t)) > 0.0
-                    && crate::edge_sharpener::min_angle(&q) >= thin
-            })
-        })
+        .map(|&(v, target)| fan_stays_unfolded(run, v, target))
         .collect();
     if keep.iter().any(|&k| !k) {
-        second_chance(run, &moves, &mut keep, thin);
+        second_chance(run, &moves, &mut keep);
     }
     // A chamfer vertex that cannot reach its crease is on one surface only.
     for v in stay {
@@ -249,7 +230,8 @@ fn snap_chamfer_vertices(run: &mut Run) {
 /// until every kept move's fan is sound with all kept moves in place. Synth pyramid at 128 r1:
 /// a vertex inside a 58-degree cut, whose neighbour moved onto the crease too, left a gap of
 /// 2.4 edges in the crease (docs/results.md, "A vertex inside an acute cut").
-fn second_chance(run: &mut Run, moves: &[(u32, DVec3)], keep: &mut [bool], thin: f64) {
+fn second_chance(run: &mut Run, moves: &[(u32, DVec3)], keep: &mut [bool]) {
+    let thin = run.opts.min_angle_degrees.to_radians();
     for &(v, target) in moves {
         run.positions[v as usize] = target;
     }
@@ -468,26 +450,23 @@ fn demote_strip_arms(run: &mut Run) {
     // Vertices of a strong inner edge, or on the border of their region (a triangle around
     // them in another region, or in none): the vertices an arm's triangles touch.
     let mut edge_vertex = vec![false; nv];
-    for &(c, _) in &strong {
-        edge_vertex[run.cv(next(c)) as usize] = true;
-        edge_vertex[run.cv(crate::edge_sharpener::prev(c)) as usize] = true;
-    }
-    for (c, &o) in opposite.iter().enumerate() {
-        if o != NONE && run.s.region[c / 3] != run.s.region[o as usize / 3] {
-            edge_vertex[run.cv(next(c)) as usize] = true;
-            edge_vertex[run.cv(crate::edge_sharpener::prev(c)) as usize] = true;
-        }
-    }
     // Vertices within ARM_RINGS rings of a strong inner edge: an arm is a band along its
     // crease, and growing along a face's border elsewhere is a leak.
     let mut near = vec![false; nv];
     let mut ring: Vec<u32> = Vec::new();
     for &(c, _) in &strong {
         for v in [run.cv(next(c)), run.cv(crate::edge_sharpener::prev(c))] {
+            edge_vertex[v as usize] = true;
             if !near[v as usize] {
                 near[v as usize] = true;
                 ring.push(v);
             }
+        }
+    }
+    for (c, &o) in opposite.iter().enumerate() {
+        if o != NONE && run.s.region[c / 3] != run.s.region[o as usize / 3] {
+            edge_vertex[run.cv(next(c)) as usize] = true;
+            edge_vertex[run.cv(crate::edge_sharpener::prev(c)) as usize] = true;
         }
     }
     for _ in 0..ARM_RINGS {
@@ -552,20 +531,15 @@ fn demote_strip_arms(run: &mut Run) {
                 thin[k] = !reached.iter().any(|&u| has_deep(u));
             }
         }
-        if thin[0] == thin[1] {
+        let t = if thin[0] { c / 3 } else { o / 3 };
+        if thin[0] == thin[1] || in_arm[t] {
             continue;
         }
-        {
-            let t = if thin[0] { c / 3 } else { o / 3 };
-            if in_arm[t] {
-                continue;
-            }
-            grow(t, usize::MAX, &|u| !in_arm[u] && arm_like(u), &mut reached);
-            for &u in &reached {
-                in_arm[u] = true;
-            }
-            gone.extend_from_slice(&reached);
+        grow(t, usize::MAX, &|u| !in_arm[u] && arm_like(u), &mut reached);
+        for &u in &reached {
+            in_arm[u] = true;
         }
+        gone.extend_from_slice(&reached);
     }
     demote(run, &gone);
 }
