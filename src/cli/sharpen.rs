@@ -24,8 +24,9 @@ pub struct SharpenArgs {
     #[arg(long, default_value = "extended")]
     method: String,
     /// extended: do not weld the clusters of near-coincident vertices joined by zero-area
-    /// triangles (marching cubes' output) that keep a chamfer from being cut; welded vertices
-    /// otherwise stay at their index, used by no triangle.
+    /// triangles (marching cubes' output). They are welded before the run, so that their
+    /// slivers do not keep chamfers from being cut, and put back wherever the output left them
+    /// untouched; a vertex that stays welded keeps its index, used by no triangle.
     #[arg(long)]
     no_weld: bool,
     /// extended and papers: where two rings of triangles lie outside every smooth region, an

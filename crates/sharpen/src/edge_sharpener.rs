@@ -153,9 +153,6 @@ pub(crate) struct Scratch {
     pub region_turn: Vec<f32>,
     pub region_start: Vec<u32>,
     pub region_angles: Vec<f32>,
-    /// Extended method: input slivers (by triangle) with a long edge that is a chamfer edge
-    /// the sliver keeps from splitting (`crate::weld`).
-    pub blocked: Vec<u32>,
     /// Curved walls: a mark per vertex (on a red triangle), then per triangle (deep).
     pub wall_marks: Vec<u8>,
 }
@@ -270,64 +267,75 @@ impl EdgeSharpener {
                 count: mesh.positions.len() + 2 * mesh.triangles.len(),
             }));
         }
-        let mut run = Run::new(
-            mesh,
-            &table,
-            &self.options,
-            &mut self.scratch,
-            report.clone(),
-        );
-        run.detect_chamfers();
-        let mut slivers = if self.options.method == Method::Extended && self.options.weld_clusters {
-            std::mem::take(&mut run.s.blocked)
+        let welded = if self.options.method == Method::Extended && self.options.weld_clusters {
+            crate::weld::weld_clusters(mesh, &table, self.options.min_angle_degrees.to_radians())
+                .and_then(|w| {
+                    let welded_table = crate::weld::welded_table(&table, &w)
+                        .or_else(|| CornerTable::new(&w.mesh).ok())?;
+                    Some((w, welded_table))
+                })
         } else {
-            Vec::new()
-        };
-        slivers.sort_unstable();
-        slivers.dedup();
-        let welded = if slivers.is_empty() {
             None
-        } else {
-            crate::weld::weld_clusters(
-                mesh,
-                &table,
-                &slivers,
-                self.options.min_angle_degrees.to_radians(),
-            )
-            .and_then(|w| {
-                // The merge checks keep the manifold; the full check comes with the table
-                // the second run needs anyway.
-                let welded_table = CornerTable::new(&w.mesh).ok()?;
-                Some((w, welded_table))
-            })
         };
-        let (out, parents, tags, mut report) = match &welded {
-            None => {
-                run.finish_detection();
-                let (out, parents, tags) = run.after_detect();
-                (out, parents, tags, run.report)
+        if let Some((w, welded_table)) = &welded {
+            let mut run = Run::new(
+                &w.mesh,
+                welded_table,
+                &self.options,
+                &mut self.scratch,
+                report.clone(),
+            );
+            // The smooth threshold is the input's: welding straightens or kinks the triangles
+            // around each cluster, and the mean angle it would measure moved the threshold
+            // of every region (synth pyramid 64 r1: 2.29 -> 2.35 degrees, a corner lost).
+            run.weld_patch = Some(crate::weld::WeldPatch {
+                input: mesh,
+                input_table: &table,
+                welded: w,
+            });
+            let (mut out, mut parents, mut tags) = run.run();
+            for p in &mut parents {
+                *p = FaceId(w.input_triangle[p.index()]);
             }
-            Some((w, welded_table)) => {
-                // The whole run again on the welded mesh: the welds change the triangles,
-                // so the smooth threshold, the regions and the labels may change too.
-                let welded_report = SharpenReport {
-                    welded_vertices: w.merged,
-                    ..report
-                };
-                let mut run = Run::new(
-                    &w.mesh,
+            let mut report = run.report;
+            // A run that sharpened nothing gives the input back, as it would unwelded (the
+            // clusters of an already sharp or smooth mesh are not the sharpener's business).
+            if report.new_vertices > 0 || report.moved_input_vertices > 0 {
+                let restored = crate::weld::restore_untouched(
+                    mesh,
+                    &table,
+                    w,
                     welded_table,
-                    &self.options,
-                    &mut self.scratch,
-                    welded_report,
+                    &mut out,
+                    &mut parents,
                 );
-                let (out, mut parents, tags) = run.run();
-                for p in &mut parents {
-                    *p = FaceId(w.input_triangle[p.index()]);
+                if restored.clusters > 0 {
+                    report.output_triangles = out.triangles.len();
+                    // Only edges at a restored cluster changed, and those are sharp only
+                    // where its kept vertex is tagged.
+                    if restored
+                        .members
+                        .iter()
+                        .any(|&(_, r)| tags.is_tagged(whet_mesh::VertexId(r)))
+                    {
+                        tags = restored.retag(&tags, &out);
+                        report.tagged_vertices = tags.vertices.len();
+                        report.sharp_edges = tags.edges.len();
+                    }
                 }
-                (out, parents, tags, run.report)
+                report.welded_vertices = restored.still_welded;
+                report.time = start.elapsed();
+                return Ok(Sharpened {
+                    mesh: out,
+                    parents,
+                    tags,
+                    report,
+                });
             }
-        };
+        }
+        let mut run = Run::new(mesh, &table, &self.options, &mut self.scratch, report);
+        let (out, parents, tags) = run.run();
+        let mut report = run.report;
         report.time = start.elapsed();
         Ok(Sharpened {
             mesh: out,
@@ -409,6 +417,9 @@ pub(crate) struct Run<'a> {
     pub positions: Vec<DVec3>,
     /// Longest input edge.
     pub max_edge: f64,
+    /// On a welded input: the input and its welding, so that the smooth threshold is the
+    /// input's (see [`crate::weld::WeldPatch`]).
+    pub weld_patch: Option<crate::weld::WeldPatch<'a>>,
     pub limits: SnapLimits,
     /// The smooth threshold, radians (`smooth_factor` times the mean normal angle).
     pub smooth_threshold: f64,
@@ -465,6 +476,7 @@ impl<'a> Run<'a> {
             report,
             positions: Vec::new(),
             max_edge: 0.0,
+            weld_patch: None,
             limits: SnapLimits::new(0.0),
             smooth_threshold: 0.0,
             ref_normals: Vec::new(),
@@ -476,11 +488,6 @@ impl<'a> Run<'a> {
 
     fn run(&mut self) -> (Mesh, Vec<FaceId>, SharpTags) {
         self.detect();
-        self.after_detect()
-    }
-
-    /// Everything after [`Run::detect`].
-    fn after_detect(&mut self) -> (Mesh, Vec<FaceId>, SharpTags) {
         self.insert_vertices();
         self.reset_reference_normals();
         self.settle_positions();
@@ -498,8 +505,7 @@ impl<'a> Run<'a> {
         self.finish_detection();
     }
 
-    /// [`Run::detect`] up to the chamfer edges and corner triangles, and the slivers that
-    /// keep a chamfer edge from splitting (which decide whether the input is welded first).
+    /// [`Run::detect`] up to the chamfer edges and corner triangles.
     #[inline(never)] // one call per run; kept out of line so profiles show it
     fn detect_chamfers(&mut self) {
         let nt = self.mesh.triangles.len();
@@ -508,7 +514,6 @@ impl<'a> Run<'a> {
         reset(&mut self.s.cflags, nc, 0);
         reset(&mut self.s.vflags, nv, 0);
         reset(&mut self.s.tflags, nt, 0);
-        self.s.blocked.clear();
         self.positions.clear();
         self.positions.reserve(nv + nt / 8);
         self.positions.extend_from_slice(&self.mesh.positions);
@@ -533,9 +538,43 @@ impl<'a> Run<'a> {
         }
     }
 
-    /// Smooth edges: face normals, the angle of every interior edge, the mean, brown flags.
+    /// Smooth edges: face normals, the angle of every interior edge, the mean (or
+    /// [`Run::mean_angle`]), brown flags.
     #[inline(never)] // one call per run; kept out of line so profiles show it
     fn smooth_edges(&mut self) {
+        let (mut sum, mut count) = self.edge_angles();
+        if let Some(patch) = self.weld_patch {
+            // The input's own edges in place of the welded ones around the clusters: the
+            // same sum as a pass over the input, for the price of the clusters' fans.
+            let (removed, added) = patch.angle_sums(self.table, &self.s.normals);
+            sum += added.0 - removed.0;
+            count = (count + added.1).saturating_sub(removed.1);
+        }
+        let mean = if count > 0 { sum / count as f64 } else { 0.0 };
+        let threshold = self.opts.smooth_factor * mean;
+        self.report.mean_angle_degrees = mean.to_degrees();
+        self.report.smooth_threshold_degrees = threshold.to_degrees();
+        self.limits = SnapLimits::new(threshold);
+        self.smooth_threshold = threshold;
+        let thr = threshold as f32;
+        let mut smooth = 0;
+        let s = &mut *self.s;
+        let opposite = self.table.opposites();
+        for (c, (&a, &o)) in s.angles.iter().zip(opposite).enumerate() {
+            // Only the lower corner of an interior edge holds its angle (-1 elsewhere).
+            if a >= 0.0 && a < thr && o != NONE {
+                s.cflags[c] |= C_BROWN;
+                s.cflags[o as usize] |= C_BROWN;
+                smooth += 1;
+            }
+        }
+        self.report.smooth_edges = smooth;
+    }
+
+    /// Face normals, the angle of every interior edge (at its lower corner; -1 elsewhere) and
+    /// the longest edge; returns the sum of the angles and their count (edges between two
+    /// triangles with a normal).
+    fn edge_angles(&mut self) -> (f64, usize) {
         let mesh = self.mesh;
         let nt = mesh.triangles.len();
         let nc = 3 * nt;
@@ -581,23 +620,7 @@ impl<'a> Run<'a> {
             }
         }
         self.max_edge = max_edge2.sqrt();
-        let mean = if count > 0 { sum / count as f64 } else { 0.0 };
-        let threshold = self.opts.smooth_factor * mean;
-        self.report.mean_angle_degrees = mean.to_degrees();
-        self.report.smooth_threshold_degrees = threshold.to_degrees();
-        self.limits = SnapLimits::new(threshold);
-        self.smooth_threshold = threshold;
-        let thr = threshold as f32;
-        let mut smooth = 0;
-        for (c, (&a, &o)) in s.angles.iter().zip(opposite).enumerate() {
-            // Only the lower corner of an interior edge holds its angle (-1 elsewhere).
-            if a >= 0.0 && a < thr && o != NONE {
-                s.cflags[c] |= C_BROWN;
-                s.cflags[o as usize] |= C_BROWN;
-                smooth += 1;
-            }
-        }
-        self.report.smooth_edges = smooth;
+        (sum, count)
     }
 
     /// Filters 1-3: red (core) vertices, the triangles around them, and the growth through
@@ -903,19 +926,9 @@ impl<'a> Run<'a> {
     }
 
     /// Whether the chamfer edge between corners `c` and `o` may be split: neither of its
-    /// triangles is an input sliver it is a long edge of. The extended method lists the
-    /// slivers that refuse it for [`crate::weld`].
-    fn split_allowed(&mut self, c: usize, o: usize) -> bool {
-        let mut allowed = true;
-        for x in [c, o] {
-            if self.split_blocked(x) {
-                allowed = false;
-                if self.opts.method == Method::Extended {
-                    self.s.blocked.push((x / 3) as u32);
-                }
-            }
-        }
-        allowed
+    /// triangles is an input sliver it is a long edge of.
+    fn split_allowed(&self, c: usize, o: usize) -> bool {
+        !self.split_blocked(c) && !self.split_blocked(o)
     }
 
     /// True when the edge opposite corner `c` is a long edge of an input sliver (a triangle
@@ -1908,7 +1921,7 @@ fn grow_through_brown(
 /// [`fast_angle`] (2e-5 rad). Both use only IEEE arithmetic and `sqrt`, so the smooth test gives
 /// the same answer on every platform (libm's `atan2` need not).
 #[inline]
-fn normal_angle(a: DVec3, b: DVec3) -> f64 {
+pub(crate) fn normal_angle(a: DVec3, b: DVec3) -> f64 {
     let c2 = a.distance_squared(b);
     if c2 < 0.25 {
         let c = c2.sqrt();

@@ -94,10 +94,11 @@ pub struct SharpenOptions {
     /// Normal filter: the neighbourhood flood does not cross an edge whose normals' dot product
     /// is `lambda` or less (an edge that is already sharp). In `[-1, 1]`.
     pub lambda: f64,
-    /// Extended method: weld marching cubes' clusters of near-coincident input vertices whose
-    /// slivers keep a chamfer edge from splitting, then run again on the welded mesh
-    /// (docs/sharpen.md, "What we extend", step 10); welded vertices stay at their indices,
-    /// used by no triangle. Default on.
+    /// Extended method: weld marching cubes' clusters of near-coincident input vertices
+    /// before the run (with the input's smooth threshold), so that their slivers do not keep
+    /// chamfer edges from splitting, and put back the clusters the run left untouched
+    /// (docs/sharpen.md, "What we extend", step 10); vertices that stay welded keep their
+    /// indices, used by no triangle. Default on.
     pub weld_clusters: bool,
     /// Curved walls (docs/sharpen.md): where two rings of triangles lie outside every smooth
     /// region, an edge turning by under this factor times the smooth threshold counts as

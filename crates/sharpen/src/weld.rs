@@ -8,17 +8,20 @@
 //! crease keeps a gap there and the max error sits in it. Welding each cluster into one vertex
 //! removes the slivers and lets the chamfer be cut.
 //!
-//! Only the clusters whose slivers keep a chamfer edge from splitting are welded (the
-//! engine's first detection lists them), so smooth regions and meshes without chamfers
-//! (already sharp ones) are never touched. A cluster holds the vertices joined to such a
-//! sliver's shortest edge by edges shorter than [`CLUSTER_EDGE`] mean edge lengths. Its
-//! vertices merge into the one whose position turns the remapped triangles least; the others
-//! stay at their indices with no triangle using them (the output promise "input vertex `i` is
-//! output vertex `i`" holds), and the triangles that had two of them disappear. A cluster is
-//! left alone when it touches the boundary, when the merge would break the manifold around
-//! it, or when a changed triangle would be a sliver.
+//! Every cluster is welded before the run ([`weld_clusters`]), so the engine runs once; the
+//! run keeps the input's smooth threshold. Afterwards [`restore_untouched`] puts back, as
+//! they were in the input, the clusters whose welded fans the run left exactly as they were,
+//! so smooth regions and meshes without chamfers (already sharp ones) keep their triangles.
+//! A cluster holds the vertices joined to a sliver's shortest edge by edges shorter than
+//! [`CLUSTER_EDGE`] mean edge lengths. Its vertices merge into the one whose position turns
+//! the remapped triangles least; the others stay at their indices with no triangle using them
+//! (the output promise "input vertex `i` is output vertex `i`" holds), and the triangles that
+//! had two of them disappear. A cluster is left alone when it touches the boundary, when the
+//! merge would break the manifold around it, or when a changed triangle would be a sliver.
 
-use whet_mesh::{CornerTable, Mesh, VertexId};
+use crate::SharpTags;
+use glam::DVec3;
+use whet_mesh::{CornerTable, FaceId, Mesh, VertexId};
 
 /// Vertices closer than this many mean edge lengths form a cluster. Marching cubes' clusters
 /// span up to a few hundredths of an edge (measured: welding within 0.01 changes nothing on
@@ -32,20 +35,14 @@ pub(crate) struct Welded {
     pub mesh: Mesh,
     /// Input triangle of each welded triangle.
     pub input_triangle: Vec<u32>,
-    /// Vertices merged into another.
-    pub merged: usize,
+    /// The vertex each input vertex was merged into (itself when not merged).
+    pub rep: Vec<u32>,
 }
 
-/// Welds the clusters of `mesh` (whose table is `table`) seeded by the input triangles
-/// `slivers` (each one's shortest edge, if under [`CLUSTER_EDGE`] mean edges); `min_angle`
-/// (radians) is the sliver threshold no changed triangle may fall under. `None` when no
-/// cluster could be welded.
-pub(crate) fn weld_clusters(
-    mesh: &Mesh,
-    table: &CornerTable,
-    slivers: &[u32],
-    min_angle: f64,
-) -> Option<Welded> {
+/// Welds the clusters of `mesh` (whose table is `table`), each seeded by a triangle whose
+/// shortest edge is under [`CLUSTER_EDGE`] mean edges; `min_angle` (radians) is the sliver
+/// threshold no changed triangle may fall under. `None` when no cluster could be welded.
+pub(crate) fn weld_clusters(mesh: &Mesh, table: &CornerTable, min_angle: f64) -> Option<Welded> {
     let nv = mesh.positions.len();
     let limit = CLUSTER_EDGE * table.mean_edge_length(&mesh.positions);
     // Also refuses a NaN length (no finite mean edge).
@@ -63,9 +60,9 @@ pub(crate) fn weld_clusters(
     let mut merged = 0usize;
     let mut cluster: Vec<u32> = Vec::new();
     let mut around: Vec<u32> = Vec::new();
-    for &t in slivers {
-        let tri = mesh.triangles[t as usize];
-        let p = mesh.triangle_positions(t as usize);
+    let mut before: Vec<(DVec3, f64)> = Vec::new();
+    for (t, &tri) in mesh.triangles.iter().enumerate() {
+        let p = mesh.triangle_positions(t);
         // The sliver's shortest edge, opposite its smallest angle.
         let (k, lengths) = crate::edge_sharpener::smallest_angle_corner(&p);
         let (a, b, d) = (tri[(k + 1) % 3], tri[(k + 2) % 3], lengths[k]);
@@ -111,15 +108,21 @@ pub(crate) fn weld_clusters(
         around.sort_unstable();
         around.dedup();
         around.retain(|&t| alive[t as usize]);
-        // The member whose position turns the remapped triangles least.
-        let mut best = (f64::INFINITY, a);
+        // The member whose position turns the remapped triangles least: the largest cosine
+        // of the worst turn (no arc cosine per candidate and triangle).
+        before.clear();
+        before.extend(around.iter().map(|&t| {
+            let n = mesh.face_cross(t as usize);
+            (n, n.length_squared())
+        }));
+        let mut best = (f64::NEG_INFINITY, a);
         for &r in &cluster {
             for &v in &cluster {
                 rep[v as usize] = r;
             }
-            let turn = largest_turn(mesh, &rep, &around);
-            if turn < best.0 || (turn == best.0 && r < best.1) {
-                best = (turn, r);
+            let cos = smallest_turn_cosine(mesh, &rep, &around, &before);
+            if cos > best.0 || (cos == best.0 && r < best.1) {
+                best = (cos, r);
             }
         }
         let root = best.1;
@@ -154,27 +157,367 @@ pub(crate) fn weld_clusters(
     Some(Welded {
         mesh: Mesh::new(mesh.positions.clone(), triangles),
         input_triangle,
-        merged,
+        rep,
     })
 }
 
-/// The largest angle by which merging (per `rep`) turns the normal of a triangle of `around`
-/// that keeps three distinct vertices.
-fn largest_turn(mesh: &Mesh, rep: &[u32], around: &[u32]) -> f64 {
-    let mut worst: f64 = 0.0;
-    for &t in around {
-        let before = mesh.triangles[t as usize];
-        let after = before.map(|v| rep[v as usize]);
-        if after == before || after[0] == after[1] || after[1] == after[2] || after[2] == after[0] {
+/// The corner table of `welded`, from the table of its input: a welded triangle's corners
+/// face the same triangles as in the input, except across the edges of removed triangles,
+/// which pair up anew by their vertices. (The merge checks keep every fan one cycle, so this
+/// pairing is the whole table.) `None` when an edge does not pair with exactly one reversed
+/// twin, or the arrays are out of range: then the caller builds the table from scratch,
+/// which says why.
+pub(crate) fn welded_table(input_table: &CornerTable, welded: &Welded) -> Option<CornerTable> {
+    const NONE: u32 = u32::MAX;
+    let mut new_index = vec![NONE; input_table.triangle_count()];
+    for (k, &t) in welded.input_triangle.iter().enumerate() {
+        new_index[t as usize] = k as u32;
+    }
+    let nt = welded.mesh.triangles.len();
+    let corner_vertex: Vec<u32> = welded.mesh.triangles.iter().flatten().copied().collect();
+    let input_opposite = input_table.opposites();
+    let mut opposite = vec![NONE; 3 * nt];
+    // Corners whose opposite triangle was removed, by their edge (from, to).
+    let mut loose: Vec<(u64, u32)> = Vec::new();
+    for (k, &t) in welded.input_triangle.iter().enumerate() {
+        for j in 0..3 {
+            let o = input_opposite[3 * t as usize + j];
+            if o == NONE {
+                continue;
+            }
+            let ot = new_index[o as usize / 3];
+            if ot != NONE {
+                opposite[3 * k + j] = 3 * ot + o % 3;
+            } else {
+                let a = corner_vertex[3 * k + (j + 1) % 3];
+                let b = corner_vertex[3 * k + (j + 2) % 3];
+                loose.push((u64::from(a) << 32 | u64::from(b), (3 * k + j) as u32));
+            }
+        }
+    }
+    loose.sort_unstable();
+    if loose.windows(2).any(|w| w[0].0 == w[1].0) {
+        return None;
+    }
+    for &(key, c) in &loose {
+        let twin = key.rotate_left(32);
+        let i = loose.binary_search_by_key(&twin, |e| e.0).ok()?;
+        opposite[c as usize] = loose[i].1;
+    }
+    CornerTable::from_relabelled(corner_vertex, opposite, welded.mesh.positions.len()).ok()
+}
+
+/// An input and its welding, for the smooth threshold of a run on the welded mesh.
+#[derive(Clone, Copy)]
+pub(crate) struct WeldPatch<'a> {
+    pub input: &'a Mesh,
+    pub input_table: &'a CornerTable,
+    pub welded: &'a Welded,
+}
+
+impl WeldPatch<'_> {
+    /// The normal angles (sum and count, as [`crate::edge_sharpener`]'s smooth pass adds
+    /// them) of the edges of the welded triangles around the kept vertices (`welded_table`,
+    /// unit normals `welded_normals`), and of the edges of the input triangles around every
+    /// clustered vertex: every other edge lies between triangles that welding left alone, so
+    /// the welded mesh's sum minus the first plus the second is the input's.
+    pub fn angle_sums(
+        &self,
+        welded_table: &CornerTable,
+        welded_normals: &[DVec3],
+    ) -> ((f64, usize), (f64, usize)) {
+        let rep = &self.welded.rep;
+        let mut roots: Vec<u32> = Vec::new();
+        let mut clustered: Vec<u32> = Vec::new();
+        for (v, &r) in rep.iter().enumerate() {
+            if r as usize != v {
+                roots.push(r);
+                clustered.push(v as u32);
+            }
+        }
+        roots.sort_unstable();
+        roots.dedup();
+        clustered.extend_from_slice(&roots);
+        let fans = |table: &CornerTable, vs: &[u32]| {
+            let mut ts: Vec<u32> = vs
+                .iter()
+                .flat_map(|&v| table.vertex_corners(VertexId(v)).map(|c| c.0 / 3))
+                .collect();
+            ts.sort_unstable();
+            ts.dedup();
+            ts
+        };
+        let sums = |table: &CornerTable, ts: &[u32], normal: &dyn Fn(usize) -> DVec3| {
+            let opposite = table.opposites();
+            let (mut sum, mut count) = (0.0, 0usize);
+            for &t in ts {
+                let n1 = normal(t as usize);
+                if n1 == DVec3::ZERO {
+                    continue;
+                }
+                for c in 3 * t as usize..3 * t as usize + 3 {
+                    let o = opposite[c];
+                    // Each edge once: from its lower corner when both sides are in the patch.
+                    if o == u32::MAX || (o < c as u32 && ts.binary_search(&(o / 3)).is_ok()) {
+                        continue;
+                    }
+                    let n2 = normal(o as usize / 3);
+                    if n2 == DVec3::ZERO {
+                        continue;
+                    }
+                    sum += crate::edge_sharpener::normal_angle(n1, n2);
+                    count += 1;
+                }
+            }
+            (sum, count)
+        };
+        let welded_fans = fans(welded_table, &roots);
+        let input_fans = fans(self.input_table, &clustered);
+        let removed = sums(welded_table, &welded_fans, &|t| welded_normals[t]);
+        let added = sums(self.input_table, &input_fans, &|t| {
+            self.input.face_normal(t)
+        });
+        (removed, added)
+    }
+}
+
+/// What [`restore_untouched`] put back.
+pub(crate) struct Restored {
+    /// Clusters restored.
+    pub clusters: usize,
+    /// Input vertices still merged into another.
+    pub still_welded: usize,
+    /// Each restored vertex with the vertex it had been merged into.
+    pub members: Vec<(u32, u32)>,
+}
+
+impl Restored {
+    /// `tags` of the output with every restored vertex tagged as the vertex it had been merged
+    /// into was (the sharp edges recomputed on `mesh`).
+    pub fn retag(&self, tags: &SharpTags, mesh: &Mesh) -> SharpTags {
+        let mut flags = vec![false; mesh.positions.len()];
+        for v in &tags.vertices {
+            if let Some(f) = flags.get_mut(v.index()) {
+                *f = true;
+            }
+        }
+        for &(v, root) in &self.members {
+            let tagged = tags.is_tagged(VertexId(root));
+            if let Some(f) = flags.get_mut(v as usize) {
+                *f = tagged;
+            }
+        }
+        SharpTags::from_vertex_flags(mesh, &flags)
+    }
+}
+
+/// After a run on `welded` (the welding of `input`; their tables `input_table` and
+/// `welded_table`): puts back the clusters the run left untouched, as they were in the input.
+/// A cluster is untouched when its kept vertex did not move and every output triangle around
+/// it is a welded triangle as it was, of unmoved input vertices, all of them there. Clusters
+/// sharing an input triangle are put back together or not at all, so every fan put back is
+/// the input's. `out` and `parents` (input triangle indices) are rewritten in place; the
+/// triangles put back keep their place in parent order (an output without any change
+/// elsewhere is the input again).
+pub(crate) fn restore_untouched(
+    input: &Mesh,
+    input_table: &CornerTable,
+    welded: &Welded,
+    welded_table: &CornerTable,
+    out: &mut Mesh,
+    parents: &mut Vec<FaceId>,
+) -> Restored {
+    let nv = input.positions.len();
+    let rep = &welded.rep;
+    // Cluster index of every vertex of a cluster (its kept vertex included), and a bit per
+    // kept vertex (the scan of the output tests three per triangle: a bitset stays in cache).
+    let mut cluster = vec![NO_CLUSTER; nv];
+    let mut roots: Vec<u32> = Vec::new();
+    let mut clustered: Vec<u32> = Vec::new();
+    let mut root_bits = vec![0u64; nv.div_ceil(64)];
+    for v in 0..nv {
+        let r = rep[v] as usize;
+        if r != v {
+            if cluster[r] == NO_CLUSTER {
+                cluster[r] = roots.len() as u32;
+                roots.push(r as u32);
+                clustered.push(r as u32);
+                root_bits[r / 64] |= 1 << (r % 64);
+            }
+            cluster[v] = cluster[r];
+            clustered.push(v as u32);
+        }
+    }
+    let n = roots.len();
+    let is_root =
+        |bits: &[u64], v: u32| (v as usize) < nv && bits[v as usize / 64] & (1 << (v % 64)) != 0;
+    let mut touched: Vec<bool> = roots
+        .iter()
+        .map(|&r| out.positions.get(r as usize) != Some(&input.positions[r as usize]))
+        .collect();
+    // Output triangles around each kept vertex: as many as welded ones, each as it was.
+    let mut missing: Vec<i64> = roots
+        .iter()
+        .map(|&r| welded_table.vertex_corners(VertexId(r)).count() as i64)
+        .collect();
+    let unmoved =
+        |v: u32| (v as usize) < nv && out.positions[v as usize] == input.positions[v as usize];
+    for (tri, p) in out.triangles.iter().zip(parents.iter()) {
+        if !tri.iter().any(|&v| is_root(&root_bits, v)) {
             continue;
         }
-        let normal = |tri: [u32; 3]| {
-            let [p0, p1, p2] = tri.map(|v| mesh.positions[v as usize]);
-            (p1 - p0).cross(p2 - p0)
+        let same = *tri == input.triangles[p.index()].map(|x| rep[x as usize])
+            && tri.iter().all(|&x| unmoved(x));
+        for &v in tri {
+            if is_root(&root_bits, v) {
+                let c = cluster[v as usize] as usize;
+                missing[c] -= 1;
+                touched[c] |= !same;
+            }
+        }
+    }
+    for (t, m) in touched.iter_mut().zip(&missing) {
+        *t |= *m != 0;
+    }
+    // Clusters sharing an input triangle share one fate.
+    fn find(group: &mut [u32], mut x: u32) -> u32 {
+        while group[x as usize] != x {
+            let g = group[group[x as usize] as usize];
+            group[x as usize] = g;
+            x = g;
+        }
+        x
+    }
+    let mut group: Vec<u32> = (0..n as u32).collect();
+    // Input triangles around the clustered vertices (each at most three times).
+    let mut fan: Vec<u32> = clustered
+        .iter()
+        .flat_map(|&v| input_table.vertex_corners(VertexId(v)).map(|c| c.0 / 3))
+        .collect();
+    fan.sort_unstable();
+    fan.dedup();
+    for &t in &fan {
+        let cs = input.triangles[t as usize].map(|v| cluster[v as usize]);
+        for k in 0..3 {
+            let (a, b) = (cs[k], cs[(k + 1) % 3]);
+            if a != NO_CLUSTER && b != NO_CLUSTER && a != b {
+                let (ga, gb) = (find(&mut group, a), find(&mut group, b));
+                if ga != gb {
+                    group[ga.max(gb) as usize] = ga.min(gb);
+                }
+            }
+        }
+    }
+    let mut group_touched = vec![false; n];
+    for i in 0..n {
+        if touched[i] {
+            let g = find(&mut group, i as u32);
+            group_touched[g as usize] = true;
+        }
+    }
+    let restore: Vec<bool> = (0..n)
+        .map(|i| !group_touched[find(&mut group, i as u32) as usize])
+        .collect();
+    let clusters = restore.iter().filter(|&&r| r).count();
+    let mut members = Vec::new();
+    let mut still_welded = 0;
+    for &v in &clustered {
+        let r = rep[v as usize];
+        if r != v {
+            if restore[cluster[v as usize] as usize] {
+                members.push((v, r));
+            } else {
+                still_welded += 1;
+            }
+        }
+    }
+    if clusters == 0 {
+        return Restored {
+            clusters,
+            still_welded,
+            members,
         };
-        let (n0, n1) = (normal(before), normal(after));
-        if n0.length_squared() > 0.0 && n1.length_squared() > 0.0 {
-            worst = worst.max(n0.angle_between(n1));
+    }
+    let mut restored_bits = vec![0u64; nv.div_ceil(64)];
+    for (i, &r) in roots.iter().enumerate() {
+        if restore[i] {
+            restored_bits[r as usize / 64] |= 1 << (r % 64);
+        }
+    }
+    // The map after the restoration: restored vertices are themselves again.
+    let map = |v: u32| {
+        let c = cluster[v as usize];
+        if c != NO_CLUSTER && restore[c as usize] {
+            v
+        } else {
+            rep[v as usize]
+        }
+    };
+    let degenerate = |t: [u32; 3]| t[0] == t[1] || t[1] == t[2] || t[2] == t[0];
+    // Input triangles the welding removed that come back, in input order (all of them touch
+    // a clustered vertex).
+    let back: Vec<u32> = fan
+        .iter()
+        .copied()
+        .filter(|&t| {
+            let tri = input.triangles[t as usize];
+            degenerate(tri.map(|x| rep[x as usize])) && !degenerate(tri.map(map))
+        })
+        .collect();
+    let mut triangles = Vec::with_capacity(out.triangles.len() + back.len());
+    let mut new_parents = Vec::with_capacity(out.triangles.len() + back.len());
+    let mut next_back = 0;
+    for (tri, p) in out.triangles.iter().zip(parents.iter()) {
+        while next_back < back.len() && (back[next_back] as usize) < p.index() {
+            let t = back[next_back];
+            triangles.push(input.triangles[t as usize].map(map));
+            new_parents.push(FaceId(t));
+            next_back += 1;
+        }
+        if tri.iter().any(|&v| is_root(&restored_bits, v)) {
+            triangles.push(input.triangles[p.index()].map(map));
+        } else {
+            triangles.push(*tri);
+        }
+        new_parents.push(*p);
+    }
+    for &t in &back[next_back..] {
+        triangles.push(input.triangles[t as usize].map(map));
+        new_parents.push(FaceId(t));
+    }
+    out.triangles = triangles;
+    *parents = new_parents;
+    Restored {
+        clusters,
+        still_welded,
+        members,
+    }
+}
+
+/// No cluster.
+const NO_CLUSTER: u32 = u32::MAX;
+
+/// The cosine of the largest angle by which merging (per `rep`) turns the normal of a
+/// triangle of `around` that keeps three distinct vertices (1 when none turns); `before`
+/// holds each one's unnormalised normal before the merge and its squared length.
+fn smallest_turn_cosine(
+    mesh: &Mesh,
+    rep: &[u32],
+    around: &[u32],
+    before: &[(glam::DVec3, f64)],
+) -> f64 {
+    let mut worst: f64 = 1.0;
+    for (&t, &(n0, l0)) in around.iter().zip(before) {
+        let tri = mesh.triangles[t as usize];
+        let after = tri.map(|v| rep[v as usize]);
+        if after == tri || after[0] == after[1] || after[1] == after[2] || after[2] == after[0] {
+            continue;
+        }
+        let [p0, p1, p2] = after.map(|v| mesh.positions[v as usize]);
+        let n1 = (p1 - p0).cross(p2 - p0);
+        let l1 = n1.length_squared();
+        if l0 > 0.0 && l1 > 0.0 {
+            worst = worst.min((n0.dot(n1) / (l0 * l1).sqrt()).clamp(-1.0, 1.0));
         }
     }
     worst
@@ -278,17 +621,21 @@ mod tests {
         (Mesh::new(positions, triangles), sliver)
     }
 
-    /// Every triangle as a seed (the engine passes only the slivers that block a chamfer).
-    fn all(mesh: &Mesh) -> Vec<u32> {
-        (0..mesh.triangles.len() as u32).collect()
+    /// Vertices merged into another.
+    fn merged(w: &Welded) -> usize {
+        w.rep
+            .iter()
+            .enumerate()
+            .filter(|&(v, &r)| r as usize != v)
+            .count()
     }
 
     #[test]
     fn a_cluster_welds_into_one_of_its_vertices() {
         let (mesh, _) = split_bipyramid();
         let table = CornerTable::new(&mesh).unwrap();
-        let w = weld_clusters(&mesh, &table, &all(&mesh), 1f64.to_radians()).unwrap();
-        assert_eq!(w.merged, 1);
+        let w = weld_clusters(&mesh, &table, 1f64.to_radians()).unwrap();
+        assert_eq!(merged(&w), 1);
         // The two slivers are gone; every other triangle is kept, with one apex for both.
         assert_eq!(w.mesh.triangles.len(), mesh.triangles.len() - 2);
         assert_eq!(w.input_triangle, (0..12).collect::<Vec<u32>>());
@@ -302,6 +649,130 @@ mod tests {
         CornerTable::new(&w.mesh).unwrap();
     }
 
+    /// A marching-cubes sampling of the synth cube turned off the grid axes (clusters on
+    /// its faces and at its chamfers), its table and its welding.
+    fn welded_cube() -> (Mesh, CornerTable, Welded) {
+        use whet_synth::{marching_cubes, Shape, ShapeKind, ShapeParams};
+        let rotation = glam::DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.5);
+        let shape = Shape::new(
+            ShapeKind::Cube,
+            &ShapeParams::default().with_rotation(rotation),
+        )
+        .unwrap();
+        let mesh = marching_cubes(&shape, 40).unwrap();
+        let table = CornerTable::new(&mesh).unwrap();
+        let w = weld_clusters(&mesh, &table, 1f64.to_radians()).unwrap();
+        (mesh, table, w)
+    }
+
+    #[test]
+    fn the_welded_table_from_the_input_table_is_the_table_built_afresh() {
+        let (mesh, _) = split_bipyramid();
+        let table = CornerTable::new(&mesh).unwrap();
+        let w = weld_clusters(&mesh, &table, 1f64.to_radians()).unwrap();
+        assert_eq!(
+            welded_table(&table, &w),
+            Some(CornerTable::new(&w.mesh).unwrap())
+        );
+        let (_, table, w) = welded_cube();
+        assert!(merged(&w) > 10, "{}", merged(&w));
+        assert_eq!(
+            welded_table(&table, &w),
+            Some(CornerTable::new(&w.mesh).unwrap())
+        );
+    }
+
+    #[test]
+    fn the_patched_angle_sum_is_the_inputs() {
+        // The sum and count of the normal angles of the interior edges, as the smooth pass
+        // adds them, over a whole mesh.
+        fn sums(mesh: &Mesh, table: &CornerTable) -> (f64, usize) {
+            let normals = mesh.face_normals();
+            let (mut sum, mut count) = (0.0, 0);
+            for (c, &o) in table.opposites().iter().enumerate() {
+                let (n1, n2) = (normals[c / 3], normals.get(o as usize / 3));
+                if let Some(&n2) = n2 {
+                    if (o as usize) > c && n1 != DVec3::ZERO && n2 != DVec3::ZERO {
+                        sum += crate::edge_sharpener::normal_angle(n1, n2);
+                        count += 1;
+                    }
+                }
+            }
+            (sum, count)
+        }
+        let (mesh, table, w) = welded_cube();
+        let wt = welded_table(&table, &w).unwrap();
+        let (ws, wc) = sums(&w.mesh, &wt);
+        let patch = WeldPatch {
+            input: &mesh,
+            input_table: &table,
+            welded: &w,
+        };
+        let (removed, added) = patch.angle_sums(&wt, &w.mesh.face_normals());
+        let (is, ic) = sums(&mesh, &table);
+        assert_eq!(wc + added.1 - removed.1, ic);
+        // Welding changes the sum (else this test would show nothing)...
+        assert!((ws - is).abs() > 1e-6, "{ws} {is}");
+        // ...and the patch restores it up to the order of the additions.
+        assert!(
+            (ws + added.0 - removed.0 - is).abs() < 1e-9 * is,
+            "{ws} {is}"
+        );
+    }
+
+    #[test]
+    fn untouched_clusters_come_back_as_they_were() {
+        let (mesh, table, w) = welded_cube();
+        let wt = welded_table(&table, &w).unwrap();
+        // A run that changed nothing: everything comes back, in the input's order.
+        let mut out = w.mesh.clone();
+        let mut parents: Vec<FaceId> = w.input_triangle.iter().map(|&t| FaceId(t)).collect();
+        let r = restore_untouched(&mesh, &table, &w, &wt, &mut out, &mut parents);
+        assert_eq!(r.still_welded, 0);
+        assert_eq!(r.members.len(), merged(&w));
+        assert_eq!(out.triangles, mesh.triangles);
+        assert_eq!(
+            parents,
+            (0..mesh.triangles.len() as u32)
+                .map(FaceId)
+                .collect::<Vec<_>>()
+        );
+        // A kept vertex that moved keeps its cluster (and those sharing a triangle with it)
+        // welded; the others come back, and the result is a valid manifold.
+        let (root, _) = w
+            .rep
+            .iter()
+            .enumerate()
+            .find(|&(v, &r)| r as usize != v)
+            .map(|(v, &r)| (r, v))
+            .unwrap();
+        let mut out = w.mesh.clone();
+        out.positions[root as usize] += DVec3::splat(1e-3);
+        let mut parents: Vec<FaceId> = w.input_triangle.iter().map(|&t| FaceId(t)).collect();
+        let r = restore_untouched(&mesh, &table, &w, &wt, &mut out, &mut parents);
+        assert!(
+            r.still_welded >= 1 && r.still_welded < merged(&w),
+            "{}",
+            r.still_welded
+        );
+        assert_eq!(r.still_welded + r.members.len(), merged(&w));
+        let mut used = vec![false; mesh.positions.len()];
+        for &v in out.triangles.iter().flatten() {
+            used[v as usize] = true;
+        }
+        // The moved vertex's cluster stays welded (its members unused); every member put back
+        // is used again.
+        assert!(
+            (0..mesh.positions.len()).any(|v| w.rep[v] == root && v != root as usize && !used[v])
+        );
+        assert!(r
+            .members
+            .iter()
+            .all(|&(m, k)| used[m as usize] && k != root));
+        CornerTable::new(&out).unwrap();
+        assert_eq!(out.triangles.len(), parents.len());
+    }
+
     #[test]
     fn clusters_that_would_break_the_manifold_or_make_slivers_stay() {
         let (mesh, _) = split_bipyramid();
@@ -310,9 +781,9 @@ mod tests {
         let mut far = mesh.clone();
         far.positions[8] = DVec3::new(0.2, 0.0, 1.0);
         let far_table = CornerTable::new(&far).unwrap();
-        assert!(weld_clusters(&far, &far_table, &all(&far), 1f64.to_radians()).is_none());
+        assert!(weld_clusters(&far, &far_table, 1f64.to_radians()).is_none());
         // A minimum angle no remapped triangle meets refuses the merge.
-        assert!(weld_clusters(&mesh, &table, &all(&mesh), 50f64.to_radians()).is_none());
+        assert!(weld_clusters(&mesh, &table, 50f64.to_radians()).is_none());
         // A tetrahedron with two coincident vertices: merging them leaves a two-triangle
         // pillow, which is refused.
         let tet = Mesh::new(
@@ -320,7 +791,7 @@ mod tests {
             vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]],
         );
         let tet_table = CornerTable::new(&tet).unwrap();
-        assert!(weld_clusters(&tet, &tet_table, &all(&tet), 1f64.to_radians()).is_none());
+        assert!(weld_clusters(&tet, &tet_table, 1f64.to_radians()).is_none());
     }
 
     #[test]
@@ -329,13 +800,13 @@ mod tests {
         // Open the bottom: the equator becomes a boundary, but the apex cluster is inside.
         mesh.triangles.drain(0..6);
         let table = CornerTable::new(&mesh).unwrap();
-        let w = weld_clusters(&mesh, &table, &all(&mesh), 1f64.to_radians()).unwrap();
-        assert_eq!(w.merged, 1);
+        let w = weld_clusters(&mesh, &table, 1f64.to_radians()).unwrap();
+        assert_eq!(merged(&w), 1);
         // A cluster on the boundary: split an equator vertex instead.
         let (mut open, _) = split_bipyramid();
         open.triangles.drain(0..6);
         open.triangles.retain(|t| !t.contains(&2));
         let table = CornerTable::new(&open).unwrap();
-        assert!(weld_clusters(&open, &table, &all(&open), 1f64.to_radians()).is_none());
+        assert!(weld_clusters(&open, &table, 1f64.to_radians()).is_none());
     }
 }

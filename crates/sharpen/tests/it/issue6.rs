@@ -173,6 +173,12 @@ fn issue6_welding_clears_the_cluster_gaps() {
     let welded = sharpen(&input, &SharpenOptions::DEFAULT).unwrap();
     assert_eq!(plain.report.welded_vertices, 0);
     assert!(welded.report.welded_vertices > 0);
+    // The smooth threshold is the input's (summed in another order: equal to rounding).
+    let (a, b) = (
+        welded.report.smooth_threshold_degrees,
+        plain.report.smooth_threshold_degrees,
+    );
+    assert!((a - b).abs() <= 1e-9 * b, "{a} {b}");
     let (p, w) = (
         error(&truth, &plain.mesh, SAMPLES),
         error(&truth, &welded.mesh, SAMPLES),
@@ -203,10 +209,10 @@ fn issue6_welding_clears_the_cluster_gaps() {
     // The papers' method never welds.
     let papers = sharpen(&input, &SharpenOptions::PAPERS).unwrap();
     assert_eq!(papers.report.welded_vertices, 0);
-    // Only clusters at a chamfer are welded: a smooth marching-cubes sphere has clusters
-    // too, and welding them would join triangles across its slivers at angles above the
-    // smooth threshold (a sphere at resolution 100 got 207 spurious sharp tags that way, with
-    // every cluster welded); it comes out exactly as without welding.
+    // A run that sharpens nothing comes back unwelded: a smooth marching-cubes sphere has
+    // clusters too, and the welds join triangles across its slivers at angles above the
+    // smooth threshold (a sphere at resolution 100 kept 306 tagged vertices that way); it
+    // comes out exactly as without welding.
     let sphere = marching_cubes(
         &Shape::new(ShapeKind::Sphere, &ShapeParams::default()).unwrap(),
         48,
@@ -218,6 +224,62 @@ fn issue6_welding_clears_the_cluster_gaps() {
     );
     assert_eq!(a.report.welded_vertices, 0);
     assert_eq!((a.mesh, a.tags), (b.mesh, b.tags));
+}
+
+#[test]
+fn issue6_clusters_away_from_the_creases_keep_their_triangles() {
+    // Every cluster is welded before the run and put back where the run left it untouched
+    // (docs/sharpen.md step 10): deep inside the cube's faces, farther than three mean edges
+    // from the truth's creases, every input triangle comes out as it went in, those of the
+    // clusters there included.
+    let (truth, input) = sampled(ShapeKind::Cube, 48, 1);
+    let out = sharpen(&input, &SharpenOptions::DEFAULT).unwrap();
+    assert!(out.report.new_vertices > 0 && out.report.welded_vertices > 0);
+    let table = whet_mesh::CornerTable::new(&input).unwrap();
+    let edge = table.mean_edge_length(&input.positions);
+    // The truth's creases: its edges whose triangles turn by more than 30 degrees.
+    let truth_table = whet_mesh::CornerTable::new(&truth).unwrap();
+    let normals = truth.face_normals();
+    let mut creases = Vec::new();
+    for (c, &o) in truth_table.opposites().iter().enumerate() {
+        if (o as usize) > c && normals[c / 3].angle_between(normals[o as usize / 3]) > 0.5 {
+            let t = truth.triangles[c / 3];
+            let (a, b) = (t[(c + 1) % 3], t[(c + 2) % 3]);
+            creases.push((truth.positions[a as usize], truth.positions[b as usize]));
+        }
+    }
+    let deep = |p: glam::DVec3| {
+        creases.iter().all(|&(a, b)| {
+            let d = b - a;
+            let s = ((p - a).dot(d) / d.length_squared()).clamp(0.0, 1.0);
+            p.distance(a + d * s) > 3.0 * edge
+        })
+    };
+    let mut output: Vec<[u32; 3]> = out.mesh.triangles.clone();
+    output.sort_unstable();
+    let (mut kept, mut clustered) = (0, 0);
+    for (t, tri) in input.triangles.iter().enumerate() {
+        if !tri.iter().all(|&v| deep(input.positions[v as usize])) {
+            continue;
+        }
+        let p = input.triangle_positions(t);
+        let shortest = (0..3)
+            .map(|k| p[k].distance(p[(k + 1) % 3]))
+            .fold(f64::INFINITY, f64::min);
+        if shortest < 0.05 * edge {
+            clustered += 1;
+        }
+        assert!(
+            output.binary_search(tri).is_ok(),
+            "input triangle {t} changed"
+        );
+        assert!(tri
+            .iter()
+            .all(|&v| out.mesh.positions[v as usize] == input.positions[v as usize]));
+        kept += 1;
+    }
+    // Deep triangles of clusters exist there (else the test shows nothing).
+    assert!(kept > 1000 && clustered > 10, "{kept} {clustered}");
 }
 
 /// Max- and RMS-error gains of the default sharpener on `kind` at `res`, rotation `rot`, and
