@@ -249,6 +249,10 @@ impl WeldPatch<'_> {
         };
         let sums = |table: &CornerTable, ts: &[u32], normal: &dyn Fn(usize) -> DVec3| {
             let opposite = table.opposites();
+            let mut in_patch = vec![false; table.triangle_count()];
+            for &t in ts {
+                in_patch[t as usize] = true;
+            }
             let (mut sum, mut count) = (0.0, 0usize);
             for &t in ts {
                 let n1 = normal(t as usize);
@@ -258,7 +262,7 @@ impl WeldPatch<'_> {
                 for c in 3 * t as usize..3 * t as usize + 3 {
                     let o = opposite[c];
                     // Each edge once: from its lower corner when both sides are in the patch.
-                    if o == u32::MAX || (o < c as u32 && ts.binary_search(&(o / 3)).is_ok()) {
+                    if o == u32::MAX || (o < c as u32 && in_patch[o as usize / 3]) {
                         continue;
                     }
                     let n2 = normal(o as usize / 3);
