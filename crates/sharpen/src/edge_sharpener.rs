@@ -1534,6 +1534,7 @@ impl<'a> Run<'a> {
         stack.extend_from_slice(&self.s.touched);
         reset(&mut self.s.settled_ok, self.s.touched.len(), 0);
         let mut projected: Vec<u32> = Vec::new();
+        let mut cornered: Vec<u32> = Vec::new();
         while let Some(t) = stack.pop() {
             let t = t as usize;
             self.choose_diagonal(t);
@@ -1580,6 +1581,19 @@ impl<'a> Run<'a> {
                                 break 'pieces;
                             }
                         }
+                        if let Some((v, _)) = victim {
+                            if self.move_split_to_corner(v, piece, &mut cornered) {
+                                victim = None;
+                                stack.push(t as u32);
+                                for w in self.triangles_of(v) {
+                                    if w as usize != t && self.s.tflags[w as usize] & T_TOUCHED != 0
+                                    {
+                                        stack.push(w);
+                                    }
+                                }
+                                break 'pieces;
+                            }
+                        }
                         if victim.is_some() {
                             break 'pieces;
                         }
@@ -1611,6 +1625,63 @@ impl<'a> Run<'a> {
             }
         }
         self.s.stack = stack;
+    }
+
+    /// Settling's other alternative to unsnapping a split (extended method): a split snapped
+    /// onto the crease of two planes folds a piece whose other vertices lie on a third
+    /// surface. Next to a corner where three surfaces meet, an edge from a vertex on one
+    /// crease to a vertex of the third face has its crease point on the line of a crease past
+    /// the corner, where that crease does not exist; the corner point is where the split
+    /// belongs. The split moves there (the three planes' point, within its edge's length of
+    /// its rest position), once (`tried`); if that still folds, settling unsnaps it.
+    fn move_split_to_corner(&mut self, v: u32, piece: &[u32; 3], tried: &mut Vec<u32>) -> bool {
+        let nv = self.mesh.positions.len();
+        if self.opts.method == Method::Papers || (v as usize) < nv || tried.contains(&v) {
+            return false;
+        }
+        tried.push(v);
+        let k = v as usize - nv;
+        let nvx = &self.s.new_vertices[k];
+        if nvx.status != SNAPPED || !matches!(nvx.kind, Kind::Edge(_)) {
+            return false;
+        }
+        let [Some(p0), Some(p1), None] = nvx.planes.p else {
+            return false;
+        };
+        let rest = nvx.rest;
+        let parallel = self.limits.parallel_cos;
+        let mut third: Option<Plane> = None;
+        for &u in piece {
+            if u != v {
+                self.for_each_plane(u, |pl| {
+                    if third.is_none()
+                        && p0.normal.dot(pl.normal).abs() < parallel
+                        && p1.normal.dot(pl.normal).abs() < parallel
+                    {
+                        third = Some(*pl);
+                    }
+                });
+            }
+        }
+        let Some(p2) = third else {
+            return false;
+        };
+        if p0.normal.dot(p1.normal.cross(p2.normal)).abs() < self.limits.dependent_det {
+            return false;
+        }
+        let Some(corner) = crate::snap::planes_point(&[p0, p1, p2], self.positions[v as usize])
+        else {
+            return false;
+        };
+        let ends = self.origin_vertices(v);
+        let length =
+            self.mesh.positions[ends[0] as usize].distance(self.mesh.positions[ends[1] as usize]);
+        if !corner.is_finite() || corner.distance(rest) > length {
+            return false;
+        }
+        self.positions[v as usize] = corner;
+        self.s.new_vertices[k].planes = Planes::three(p0, p1, p2);
+        true
     }
 
     /// Settling's alternative to unsnapping (extended method; docs/sharpen.md, "What we
