@@ -1568,31 +1568,24 @@ impl<'a> Run<'a> {
                         {
                             victim = None;
                         }
-                        if victim.is_some() {
-                            if let Some(u) = self.project_inside_vertex(piece, t, &mut projected) {
-                                victim = None;
-                                stack.push(t as u32);
-                                for w in self.triangles_of(u) {
-                                    if w as usize != t && self.s.tflags[w as usize] & T_TOUCHED != 0
-                                    {
-                                        stack.push(w);
-                                    }
+                        // The alternatives to unsnapping: move the vertex the snap folds
+                        // over, else move a split past a corner onto it.
+                        let moved = victim.and_then(|(v, _)| {
+                            self.project_inside_vertex(piece, t, &mut projected)
+                                .or_else(|| {
+                                    self.move_split_to_corner(v, piece, &mut cornered)
+                                        .then_some(v)
+                                })
+                        });
+                        if let Some(u) = moved {
+                            victim = None;
+                            stack.push(t as u32);
+                            for w in self.triangles_of(u) {
+                                if w as usize != t && self.s.tflags[w as usize] & T_TOUCHED != 0 {
+                                    stack.push(w);
                                 }
-                                break 'pieces;
                             }
-                        }
-                        if let Some((v, _)) = victim {
-                            if self.move_split_to_corner(v, piece, &mut cornered) {
-                                victim = None;
-                                stack.push(t as u32);
-                                for w in self.triangles_of(v) {
-                                    if w as usize != t && self.s.tflags[w as usize] & T_TOUCHED != 0
-                                    {
-                                        stack.push(w);
-                                    }
-                                }
-                                break 'pieces;
-                            }
+                            break 'pieces;
                         }
                         if victim.is_some() {
                             break 'pieces;
