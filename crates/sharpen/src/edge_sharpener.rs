@@ -538,8 +538,8 @@ impl<'a> Run<'a> {
         }
     }
 
-    /// Smooth edges: face normals, the angle of every interior edge, the mean (or
-    /// [`Run::mean_angle`]), brown flags.
+    /// Smooth edges: face normals, the angle of every interior edge, the mean (on a welded
+    /// input the input's, through [`Run::weld_patch`]), brown flags.
     #[inline(never)] // one call per run; kept out of line so profiles show it
     fn smooth_edges(&mut self) {
         let (mut sum, mut count) = self.edge_angles();
