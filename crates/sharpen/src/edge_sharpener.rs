@@ -1914,41 +1914,76 @@ impl<'a> Run<'a> {
 
 /// Labels the smooth regions: the connected components of red triangles through smooth
 /// edges (what filter 3's flood connects), numbered 0.. in order of their lowest triangle.
-/// A flood from each unlabelled red triangle in index order: the first triangle a region
-/// meets is its lowest, so regions are numbered as that order requires, and each red
-/// triangle is visited once.
+/// One scan in triangle order joins each red triangle to its red neighbours across brown
+/// edges (union-find in `region` itself, every link pointing to a lower triangle, so a root
+/// is its component's lowest triangle); a second scan in the same order turns the links into
+/// labels. Both scans read the arrays in order, where a flood would jump around the mesh (at
+/// 1M triangles the flood waited on memory: 8 % of the run, measured with perf).
 #[inline(never)] // one call per run; kept out of line so profiles show it
 fn label_regions(s: &mut Scratch, table: &CornerTable, nt: usize) {
     let region = &mut s.region;
     region.clear();
-    region.resize(nt, NONE);
+    region.extend(s.tflags[..nt].iter().enumerate().map(|(t, &f)| {
+        if f & T_RED != 0 {
+            t as u32
+        } else {
+            NONE
+        }
+    }));
+    // The root of `x`, halving the path on the way (links only ever point lower).
+    fn root(region: &mut [u32], mut x: u32) -> u32 {
+        loop {
+            let p = region[x as usize];
+            if p == x {
+                return x;
+            }
+            let g = region[p as usize];
+            region[x as usize] = g;
+            x = g;
+        }
+    }
     let opposite = table.opposites();
-    let mut stack = std::mem::take(&mut s.stack);
-    stack.clear();
-    let mut next_label = 0u32;
-    for t0 in 0..nt {
-        if s.tflags[t0] & T_RED == 0 || region[t0] != NONE {
+    for t in 0..nt {
+        if region[t] == NONE {
             continue;
         }
-        let label = next_label;
-        next_label += 1;
-        region[t0] = label;
-        let tflags = &s.tflags;
-        grow_through_brown(t0, &s.cflags, opposite, &mut stack, |u| {
-            let joins = region[u] == NONE && tflags[u] & T_RED != 0;
-            if joins {
-                region[u] = label;
+        for c in 3 * t..3 * t + 3 {
+            let o = opposite[c];
+            // Each brown edge once, from its higher triangle (brown edges are interior and
+            // flagged on both corners; a red triangle's brown neighbour is red).
+            if s.cflags[c] & C_BROWN == 0 || o == NONE || (o as usize / 3) > t {
+                continue;
             }
-            joins
-        });
+            let u = o / 3;
+            if region[u as usize] == NONE {
+                continue;
+            }
+            let (a, b) = (root(region, t as u32), root(region, u));
+            if a != b {
+                region[a.max(b) as usize] = a.min(b);
+            }
+        }
     }
-    s.stack = stack;
+    // A root (its own link) opens the next label; any other red triangle links lower, to a
+    // triangle already labelled in this scan, whose label it takes.
+    let mut next_label = 0u32;
+    for t in 0..nt {
+        let p = region[t];
+        if p == NONE {
+            continue;
+        }
+        region[t] = if p as usize == t {
+            next_label += 1;
+            next_label - 1
+        } else {
+            region[p as usize]
+        };
+    }
 }
 
 /// Grows from triangle `t0` across its brown (smooth) edges, depth first on `stack` (empty on
 /// return): `joins(u)` is asked once per brown edge of every triangle grown from, and a
-/// neighbour `u` it accepts (and marks) is grown from in turn. Filter 3 and the region labels
-/// both flood this way.
+/// neighbour `u` it accepts (and marks) is grown from in turn (filter 3's flood).
 fn grow_through_brown(
     t0: usize,
     cflags: &[u8],

@@ -845,8 +845,16 @@ impl Output {
         let nv = run.mesh.positions.len();
         let total = run.positions.len();
         let mut remap: Vec<u32> = vec![NONE; total - nv];
-        let mut tris = Vec::with_capacity(self.tris.len());
-        let mut parents = Vec::with_capacity(self.tris.len());
+        // Room for the triangles welding removed, which putting clusters back may return
+        // (growing a million-triangle output afterwards would copy it).
+        let spare = run.weld_patch.map_or(0, |p| {
+            p.input
+                .triangles
+                .len()
+                .saturating_sub(p.welded.mesh.triangles.len())
+        });
+        let mut tris = Vec::with_capacity(self.tris.len() + spare);
+        let mut parents = Vec::with_capacity(self.tris.len() + spare);
         for (s, t) in self.tris.iter().enumerate() {
             if self.alive[s] {
                 tris.push(*t);

@@ -35,6 +35,8 @@ pub(crate) struct Welded {
     pub mesh: Mesh,
     /// Input triangle of each welded triangle.
     pub input_triangle: Vec<u32>,
+    /// Welded triangle of each input triangle (`u32::MAX` for the ones welding removed).
+    pub welded_index: Vec<u32>,
     /// The vertex each input vertex was merged into (itself when not merged).
     pub rep: Vec<u32>,
 }
@@ -44,7 +46,37 @@ pub(crate) struct Welded {
 /// threshold no changed triangle may fall under. `None` when no cluster could be welded.
 pub(crate) fn weld_clusters(mesh: &Mesh, table: &CornerTable, min_angle: f64) -> Option<Welded> {
     let nv = mesh.positions.len();
-    let limit = CLUSTER_EDGE * table.mean_edge_length(&mesh.positions);
+    // One pass over the triangles for the mean edge length (each edge once, in the order
+    // `CornerTable::mean_edge_length` adds them: the same value) and each triangle's shortest
+    // side, so the scan for slivers below reads one array instead of the positions again.
+    let opposite = table.opposites();
+    let mut shortest: Vec<f32> = Vec::with_capacity(mesh.triangles.len());
+    let (mut sum, mut count) = (0.0f64, 0usize);
+    for (t, (tri, o3)) in mesh
+        .triangles
+        .iter()
+        .zip(opposite.chunks_exact(3))
+        .enumerate()
+    {
+        let p = tri.map(|v| mesh.positions[v as usize]);
+        let (k, lengths) = crate::edge_sharpener::smallest_angle_corner(&p);
+        // Rounded to f32 (relative error 6e-8; the scan allows for it); an overflow stays
+        // finite so the scan's margin cannot make it pass where the exact test would not.
+        shortest.push((lengths[k] as f32).min(f32::MAX));
+        for (j, &o) in o3.iter().enumerate() {
+            // Each interior edge from its lower corner, each boundary edge once.
+            if o == u32::MAX || o as usize > 3 * t + j {
+                sum += lengths[j].sqrt();
+                count += 1;
+            }
+        }
+    }
+    let mean = if count == 0 { 0.0 } else { sum / count as f64 };
+    debug_assert_eq!(
+        mean.to_bits(),
+        table.mean_edge_length(&mesh.positions).to_bits()
+    );
+    let limit = CLUSTER_EDGE * mean;
     // Also refuses a NaN length (no finite mean edge).
     if limit.is_nan() || limit <= 0.0 {
         return None;
@@ -61,7 +93,12 @@ pub(crate) fn weld_clusters(mesh: &Mesh, table: &CornerTable, min_angle: f64) ->
     let mut cluster: Vec<u32> = Vec::new();
     let mut around: Vec<u32> = Vec::new();
     let mut before: Vec<(DVec3, f64)> = Vec::new();
+    // Above this, a triangle's rounded shortest side cannot hide an exact one under `limit2`.
+    let candidate = limit2 * (1.0 + 1e-6);
     for (t, &tri) in mesh.triangles.iter().enumerate() {
+        if f64::from(shortest[t]) >= candidate {
+            continue;
+        }
         let p = mesh.triangle_positions(t);
         // The sliver's shortest edge, opposite its smallest angle.
         let (k, lengths) = crate::edge_sharpener::smallest_angle_corner(&p);
@@ -148,15 +185,20 @@ pub(crate) fn weld_clusters(mesh: &Mesh, table: &CornerTable, min_angle: f64) ->
     }
     let mut triangles = Vec::with_capacity(mesh.triangles.len());
     let mut input_triangle = Vec::with_capacity(mesh.triangles.len());
+    let mut welded_index = Vec::with_capacity(mesh.triangles.len());
     for (t, tri) in mesh.triangles.iter().enumerate() {
         if alive[t] {
+            welded_index.push(triangles.len() as u32);
             triangles.push(tri.map(|v| rep[v as usize]));
             input_triangle.push(t as u32);
+        } else {
+            welded_index.push(u32::MAX);
         }
     }
     Some(Welded {
         mesh: Mesh::new(mesh.positions.clone(), triangles),
         input_triangle,
+        welded_index,
         rep,
     })
 }
@@ -169,9 +211,9 @@ pub(crate) fn weld_clusters(mesh: &Mesh, table: &CornerTable, min_angle: f64) ->
 /// which says why.
 pub(crate) fn welded_table(input_table: &CornerTable, welded: &Welded) -> Option<CornerTable> {
     const NONE: u32 = u32::MAX;
-    let mut new_index = vec![NONE; input_table.triangle_count()];
-    for (k, &t) in welded.input_triangle.iter().enumerate() {
-        new_index[t as usize] = k as u32;
+    let new_index = &welded.welded_index;
+    if new_index.len() != input_table.triangle_count() {
+        return None;
     }
     let nt = welded.mesh.triangles.len();
     let corner_vertex: Vec<u32> = welded.mesh.triangles.iter().flatten().copied().collect();
@@ -217,55 +259,62 @@ pub(crate) struct WeldPatch<'a> {
 
 impl WeldPatch<'_> {
     /// The normal angles (sum and count, as [`crate::edge_sharpener`]'s smooth pass adds
-    /// them) of the edges of the welded triangles around the kept vertices (`welded_table`,
-    /// unit normals `welded_normals`), and of the edges of the input triangles around every
-    /// clustered vertex: every other edge lies between triangles that welding left alone, so
-    /// the welded mesh's sum minus the first plus the second is the input's.
+    /// them) of the edges of the welded triangles that welding changed (`welded_table`, unit
+    /// normals `welded_normals`), and of the edges of the input triangles it changed or
+    /// removed: those holding a merged vertex (not the one kept). Every other triangle is in
+    /// both meshes with the same vertices and, across every edge of two such triangles, the
+    /// same neighbour (the welded table pairs anew only across removed triangles, whose
+    /// neighbours there hold a merged vertex), so the welded mesh's sum minus the first plus
+    /// the second is the input's.
     pub fn angle_sums(
         &self,
         welded_table: &CornerTable,
         welded_normals: &[DVec3],
     ) -> ((f64, usize), (f64, usize)) {
         let rep = &self.welded.rep;
-        let mut roots: Vec<u32> = Vec::new();
-        let mut clustered: Vec<u32> = Vec::new();
+        let mut input_changed: Vec<u32> = Vec::new();
         for (v, &r) in rep.iter().enumerate() {
             if r as usize != v {
-                roots.push(r);
-                clustered.push(v as u32);
+                let corners = self.input_table.vertex_corners(VertexId(v as u32));
+                input_changed.extend(corners.map(|c| c.0 / 3));
             }
         }
-        roots.sort_unstable();
-        roots.dedup();
-        clustered.extend_from_slice(&roots);
-        let fans = |table: &CornerTable, vs: &[u32]| {
-            let mut ts: Vec<u32> = vs
-                .iter()
-                .flat_map(|&v| table.vertex_corners(VertexId(v)).map(|c| c.0 / 3))
-                .collect();
-            ts.sort_unstable();
-            ts.dedup();
-            ts
-        };
-        let sums = |table: &CornerTable, ts: &[u32], normal: &dyn Fn(usize) -> DVec3| {
+        input_changed.sort_unstable();
+        input_changed.dedup();
+        // Their welded images.
+        let welded_index = &self.welded.welded_index;
+        let welded_changed: Vec<u32> = input_changed
+            .iter()
+            .map(|&t| welded_index[t as usize])
+            .filter(|&k| k != u32::MAX)
+            .collect();
+        // `normal(t, in_patch)`: the unit normal of triangle `t`.
+        let sums = |table: &CornerTable, ts: &[u32], normal: &dyn Fn(usize, bool) -> DVec3| {
             let opposite = table.opposites();
-            let mut in_patch = vec![false; table.triangle_count()];
+            // A bit per triangle: the patch is a few percent of the mesh, the bits stay in
+            // cache.
+            let mut in_patch = vec![0u64; table.triangle_count().div_ceil(64)];
             for &t in ts {
-                in_patch[t as usize] = true;
+                in_patch[t as usize / 64] |= 1 << (t % 64);
             }
             let (mut sum, mut count) = (0.0, 0usize);
             for &t in ts {
-                let n1 = normal(t as usize);
+                let n1 = normal(t as usize, true);
                 if n1 == DVec3::ZERO {
                     continue;
                 }
                 for c in 3 * t as usize..3 * t as usize + 3 {
                     let o = opposite[c];
-                    // Each edge once: from its lower corner when both sides are in the patch.
-                    if o == u32::MAX || (o < c as u32 && in_patch[o as usize / 3]) {
+                    if o == u32::MAX {
                         continue;
                     }
-                    let n2 = normal(o as usize / 3);
+                    // Each edge once: from its lower corner when both sides are in the patch.
+                    let u = o as usize / 3;
+                    let both = in_patch[u / 64] & (1 << (u % 64)) != 0;
+                    if (o as usize) < c && both {
+                        continue;
+                    }
+                    let n2 = normal(u, both);
                     if n2 == DVec3::ZERO {
                         continue;
                     }
@@ -275,11 +324,14 @@ impl WeldPatch<'_> {
             }
             (sum, count)
         };
-        let welded_fans = fans(welded_table, &roots);
-        let input_fans = fans(self.input_table, &clustered);
-        let removed = sums(welded_table, &welded_fans, &|t| welded_normals[t]);
-        let added = sums(self.input_table, &input_fans, &|t| {
-            self.input.face_normal(t)
+        let removed = sums(welded_table, &welded_changed, &|t, _| welded_normals[t]);
+        // An unchanged input triangle's normal is its welded image's (the same vertices).
+        let added = sums(self.input_table, &input_changed, &|t, changed| {
+            if changed {
+                self.input.face_normal(t)
+            } else {
+                welded_normals[welded_index[t] as usize]
+            }
         });
         (removed, added)
     }
@@ -353,8 +405,18 @@ pub(crate) fn restore_untouched(
         }
     }
     let n = roots.len();
-    let is_root =
-        |bits: &[u64], v: u32| (v as usize) < nv && bits[v as usize / 64] & (1 << (v % 64)) != 0;
+    // Bits for every output vertex (new ones clear), so the scan of the output tests its
+    // three vertices without a range check or a branch each.
+    let no = out.positions.len().max(nv);
+    root_bits.resize(no.div_ceil(64), 0);
+    let is_root = |bits: &[u64], v: u32| bits[v as usize / 64] >> (v % 64) & 1 != 0;
+    let touches = |bits: &[u64], t: &[u32; 3]| {
+        (bits[t[0] as usize / 64] >> (t[0] % 64)
+            | bits[t[1] as usize / 64] >> (t[1] % 64)
+            | bits[t[2] as usize / 64] >> (t[2] % 64))
+            & 1
+            != 0
+    };
     let mut touched: Vec<bool> = roots
         .iter()
         .map(|&r| out.positions.get(r as usize) != Some(&input.positions[r as usize]))
@@ -366,10 +428,13 @@ pub(crate) fn restore_untouched(
         .collect();
     let unmoved =
         |v: u32| (v as usize) < nv && out.positions[v as usize] == input.positions[v as usize];
-    for (tri, p) in out.triangles.iter().zip(parents.iter()) {
-        if !tri.iter().any(|&v| is_root(&root_bits, v)) {
+    // Output triangles around the kept vertices (only they can change below).
+    let mut around_roots: Vec<u32> = Vec::new();
+    for (i, (tri, p)) in out.triangles.iter().zip(parents.iter()).enumerate() {
+        if !touches(&root_bits, tri) {
             continue;
         }
+        around_roots.push(i as u32);
         let same = *tri == input.triangles[p.index()].map(|x| rep[x as usize])
             && tri.iter().all(|&x| unmoved(x));
         for &v in tri {
@@ -442,7 +507,7 @@ pub(crate) fn restore_untouched(
             members,
         };
     }
-    let mut restored_bits = vec![0u64; nv.div_ceil(64)];
+    let mut restored_bits = vec![0u64; no.div_ceil(64)];
     for (i, &r) in roots.iter().enumerate() {
         if restore[i] {
             restored_bits[r as usize / 64] |= 1 << (r % 64);
@@ -468,29 +533,37 @@ pub(crate) fn restore_untouched(
             degenerate(tri.map(|x| rep[x as usize])) && !degenerate(tri.map(map))
         })
         .collect();
-    let mut triangles = Vec::with_capacity(out.triangles.len() + back.len());
-    let mut new_parents = Vec::with_capacity(out.triangles.len() + back.len());
-    let mut next_back = 0;
-    for (tri, p) in out.triangles.iter().zip(parents.iter()) {
-        while next_back < back.len() && (back[next_back] as usize) < p.index() {
-            let t = back[next_back];
-            triangles.push(input.triangles[t as usize].map(map));
-            new_parents.push(FaceId(t));
-            next_back += 1;
+    // The triangles around restored kept vertices become the input's again...
+    for &i in &around_roots {
+        let i = i as usize;
+        if touches(&restored_bits, &out.triangles[i]) {
+            out.triangles[i] = input.triangles[parents[i].index()].map(map);
         }
-        if tri.iter().any(|&v| is_root(&restored_bits, v)) {
-            triangles.push(input.triangles[p.index()].map(map));
-        } else {
-            triangles.push(*tri);
+    }
+    // ...and each triangle coming back goes before the first output triangle (after the
+    // one before it) of a later parent, so an output without any other change is the input
+    // in its order. Where each goes, by one read of the parents; then the output moves up
+    // segment by segment from the end, in place (a fresh copy of a million-triangle output
+    // cost more in page faults than the moves).
+    let n = out.triangles.len();
+    let mut at = Vec::with_capacity(back.len());
+    let mut i = 0;
+    for &t in &back {
+        while i < n && parents[i].index() <= t as usize {
+            i += 1;
         }
-        new_parents.push(*p);
+        at.push(i);
     }
-    for &t in &back[next_back..] {
-        triangles.push(input.triangles[t as usize].map(map));
-        new_parents.push(FaceId(t));
+    out.triangles.resize(n + back.len(), [0; 3]);
+    parents.resize(n + back.len(), FaceId(0));
+    let mut end = n;
+    for (j, (&t, &pos)) in back.iter().zip(&at).enumerate().rev() {
+        out.triangles.copy_within(pos..end, pos + j + 1);
+        parents.copy_within(pos..end, pos + j + 1);
+        out.triangles[pos + j] = input.triangles[t as usize].map(map);
+        parents[pos + j] = FaceId(t);
+        end = pos;
     }
-    out.triangles = triangles;
-    *parents = new_parents;
     Restored {
         clusters,
         still_welded,
