@@ -174,6 +174,38 @@ fn main() {
             out.mesh.positions[*i]
         );
     }
+    // Output faces farthest from the reference (the forward max can sit inside a face, away
+    // from every vertex): each face sampled on a barycentric grid of step 1/8.
+    let mut faces: Vec<(f64, usize, glam::DVec3)> = out
+        .mesh
+        .triangles
+        .iter()
+        .enumerate()
+        .map(|(t, tri)| {
+            let [a, b, c] = tri.map(|v| out.mesh.positions[v as usize]);
+            let mut worst = (0.0f64, a);
+            for i in 0..=8 {
+                for j in 0..=8 - i {
+                    let p = a + (b - a) * (i as f64 / 8.0) + (c - a) * (j as f64 / 8.0);
+                    let d = to_ref.closest_point(p).distance;
+                    if d > worst.0 {
+                        worst = (d, p);
+                    }
+                }
+            }
+            (worst.0, t, worst.1)
+        })
+        .collect();
+    faces.sort_by(|a, b| b.0.total_cmp(&a.0));
+    println!("output faces farthest from the reference:");
+    for (d, t, p) in faces.iter().take(4) {
+        println!(
+            "  t{t} (from {}) {:?}: {:.3}% at {p:.4}",
+            out.parents[*t].index(),
+            out.mesh.triangles[*t],
+            d / diag * 100.0
+        );
+    }
     // Reference crease points (edges of the reference) farthest from the output.
     let to_out = Bvh::new(&out.mesh);
     let step = input.mean_edge_length() * 0.05;

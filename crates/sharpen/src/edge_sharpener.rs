@@ -42,6 +42,9 @@ pub(crate) const NONE: u32 = u32::MAX;
 pub(crate) const C_BROWN: u8 = 1;
 pub(crate) const C_RED: u8 = 2;
 pub(crate) const C_BLUE: u8 = 4;
+/// The edge between two twin corner triangles ([`Run::pair_twin_centres`]): not split, and
+/// inside the one fan around their shared centre.
+pub(crate) const C_TWIN: u8 = 8;
 
 // Vertex flags.
 pub(crate) const V_USED: u8 = 1;
@@ -58,6 +61,13 @@ pub(crate) const T_RED: u8 = 1;
 pub(crate) const T_GREEN: u8 = 2;
 pub(crate) const T_DIAG: u8 = 4;
 pub(crate) const T_TOUCHED: u8 = 8;
+
+/// Two corner centres closer than this fraction of the chamfer edge between their triangles
+/// are one corner ([`Run::pair_twin_centres`]). Measured on the marching-cubes table
+/// (results.md, "Twin corner triangles"): the pairs that folded lay within 0.03-0.06 of an
+/// edge; at 0.25, pairs 0.2 apart merged too and fandisk 128 r0 lost its corner (max 2.00x
+/// -> 1.77x), since the middle of two distinct corner points is neither.
+const TWIN_CENTRE: f64 = 0.1;
 
 /// Pieces thinner than this (degrees) are left to the sliver pass by the orientation check of
 /// `settle_positions`: their normal is dominated by rounding and snapping noise.
@@ -88,6 +98,9 @@ pub(crate) enum Kind {
     Edge(u32),
     /// In the middle of this corner triangle.
     Center(u32),
+    /// The one centre of two twin corner triangles ([`Run::pair_twin_centres`]), the lower
+    /// first; at rest in the middle of the edge between them.
+    TwinCenter(u32, u32),
 }
 
 /// One inserted vertex.
@@ -433,6 +446,8 @@ pub(crate) struct Run<'a> {
     /// Corner snaps computed while dropping idle splits, by triangle, in increasing order,
     /// with the anchor they were computed for.
     pub corner_cache: Vec<(u32, DVec3, EdgeSnap)>,
+    /// Twin corner triangles, each pair twice (`(t, u)` and `(u, t)`), sorted.
+    pub twins: Vec<(u32, u32)>,
     /// Extended method: the input is a regular tiling whose vertices are surface samples
     /// (`crate::extended::is_surface_sampling`).
     pub surface_samples: bool,
@@ -482,6 +497,7 @@ impl<'a> Run<'a> {
             ref_normals: Vec::new(),
             snap_cache: Vec::new(),
             corner_cache: Vec::new(),
+            twins: Vec::new(),
             surface_samples: false,
         }
     }
@@ -1010,6 +1026,67 @@ impl<'a> Run<'a> {
             }
         }
         self.report.corner_triangles = green;
+        self.twins.clear();
+        if self.opts.method == Method::Extended {
+            self.pair_twin_centres();
+        }
+    }
+
+    /// Extended method: two corner triangles across a chamfer edge whose centres snap to
+    /// nearly one point (within [`TWIN_CENTRE`] of the edge's length) are one corner cut
+    /// twice: two centres there squeeze the pieces between them until one folds, and
+    /// unsnapping it leaves the corner half cut. Such twins share one centre instead, a fan
+    /// over the boundary of the two triangles (the edge between them is not split, and
+    /// flagged [`C_TWIN`]), at the middle of their two corner points. Each triangle has at
+    /// most one twin; triangles keeping three chamfer edges are left alone.
+    fn pair_twin_centres(&mut self) {
+        for i in 0..self.corner_cache.len() {
+            let (t, _, snapped) = self.corner_cache[i];
+            let t = t as usize;
+            let Ok((p, _)) = snapped else { continue };
+            if self.s.tflags[t] & T_GREEN == 0 || self.twin_of(t) != NONE {
+                continue;
+            }
+            for c in 3 * t..3 * t + 3 {
+                if self.s.cflags[c] & C_BLUE == 0 {
+                    continue;
+                }
+                let Some(o) = self.table.opposite(CornerId(c as u32)) else {
+                    continue;
+                };
+                let u = o.index() / 3;
+                if u < t || self.s.tflags[u] & T_GREEN == 0 || self.twin_of(u) != NONE {
+                    continue;
+                }
+                let Ok(j) = self.corner_cache.binary_search_by_key(&(u as u32), |e| e.0) else {
+                    continue; // three chamfer edges
+                };
+                let Ok((q, _)) = self.corner_cache[j].2 else {
+                    continue;
+                };
+                let (a, b) = (self.cv(next(c)), self.cv(prev(c)));
+                let len = self.positions[a as usize].distance(self.positions[b as usize]);
+                if p.distance(q) > TWIN_CENTRE * len {
+                    continue;
+                }
+                self.s.cflags[c] = (self.s.cflags[c] & !C_BLUE) | C_TWIN;
+                self.s.cflags[o.index()] = (self.s.cflags[o.index()] & !C_BLUE) | C_TWIN;
+                // One chamfer edge fewer to split, one corner fewer (the pair is one).
+                self.report.chamfer_edges = self.report.chamfer_edges.saturating_sub(1);
+                self.report.corner_triangles = self.report.corner_triangles.saturating_sub(1);
+                self.twins.push((t as u32, u as u32));
+                self.twins.push((u as u32, t as u32));
+                self.twins.sort_unstable();
+                break;
+            }
+        }
+    }
+
+    /// The twin of corner triangle `t` ([`Run::pair_twin_centres`]), `NONE` if it has none.
+    pub(crate) fn twin_of(&self, t: usize) -> u32 {
+        self.twins
+            .binary_search_by_key(&(t as u32), |e| e.0)
+            .map_or(NONE, |i| self.twins[i].1)
     }
 
     /// Inserts one vertex per blue edge and green triangle, computes the planes at the ends of
@@ -1083,7 +1160,15 @@ impl<'a> Run<'a> {
         }
         for t in 0..nt {
             let f = self.s.tflags[t];
-            if f & T_GREEN != 0 {
+            let twin = if f & T_GREEN != 0 {
+                self.twin_of(t)
+            } else {
+                NONE
+            };
+            if twin != NONE && (twin as usize) < t {
+                // The lower twin made the shared centre.
+                self.s.center[t] = self.s.center[twin as usize];
+            } else if f & T_GREEN != 0 {
                 let tri = mesh.triangles[t];
                 let rest = (self.positions[tri[0] as usize]
                     + self.positions[tri[1] as usize]
@@ -1111,12 +1196,39 @@ impl<'a> Run<'a> {
                     }
                     _ => self.corner_snap(tri, rest),
                 };
-                let (pos, status, planes) = match snapped {
+                let (mut pos, mut status, planes) = match snapped {
                     Ok((p, planes)) => (p, SNAPPED, planes),
                     Err(r) => (rest, 1 + r.index() as u8, Planes::default()),
                 };
+                let mut kind = Kind::Center(t as u32);
+                let mut rest = rest;
+                if twin != NONE {
+                    // One centre for both: at rest in the middle of the edge between them
+                    // (every piece of either triangle then lies inside it), snapped to the
+                    // middle of the two corner points.
+                    let u = twin as usize;
+                    kind = Kind::TwinCenter(t as u32, twin);
+                    let c = (3 * t..3 * t + 3)
+                        .find(|&c| self.s.cflags[c] & C_TWIN != 0)
+                        .unwrap_or(3 * t);
+                    let (a, b) = (self.cv(next(c)), self.cv(prev(c)));
+                    rest = (self.positions[a as usize] + self.positions[b as usize]) * 0.5;
+                    let tri_u = mesh.triangles[u];
+                    let anchor_u = (self.positions[tri_u[0] as usize]
+                        + self.positions[tri_u[1] as usize]
+                        + self.positions[tri_u[2] as usize])
+                        / 3.0;
+                    match (status == SNAPPED, self.corner_snap(tri_u, anchor_u)) {
+                        (true, Ok((q, _))) => pos = (pos + q) * 0.5,
+                        (true, Err(r)) => {
+                            status = 1 + r.index() as u8;
+                            pos = rest;
+                        }
+                        _ => pos = rest,
+                    }
+                }
                 self.s.new_vertices.push(NewVertex {
-                    kind: Kind::Center(t as u32),
+                    kind,
                     rest,
                     status,
                     planes,
@@ -1395,19 +1507,31 @@ impl<'a> Run<'a> {
         let w = self.s.center.get(t).copied().unwrap_or(NONE);
         if w != NONE {
             let mut cycle = [0u32; 6];
+            // The piece on a twin edge belongs to neither twin: the fan around the shared
+            // centre runs over the boundary of the two triangles.
+            let mut skip = [false; 6];
             let mut n = 0;
-            for (v, split) in [(tri[0], m[2]), (tri[1], m[0]), (tri[2], m[1])] {
+            for (i, (v, split)) in [(tri[0], m[2]), (tri[1], m[0]), (tri[2], m[1])]
+                .into_iter()
+                .enumerate()
+            {
                 cycle[n] = v;
+                // The edge from tri[i] to tri[i + 1] is opposite corner i + 2.
+                skip[n] = split == NONE && self.s.cflags[3 * t + (i + 2) % 3] & C_TWIN != 0;
                 n += 1;
                 if split != NONE {
                     cycle[n] = split;
                     n += 1;
                 }
             }
+            let mut k2 = 0;
             for k in 0..n {
-                out[k] = [cycle[k], cycle[(k + 1) % n], w];
+                if !skip[k] {
+                    out[k2] = [cycle[k], cycle[(k + 1) % n], w];
+                    k2 += 1;
+                }
             }
-            return (out, n);
+            return (out, k2);
         }
         let split = m.iter().filter(|&&x| x != NONE).count();
         match split {
@@ -1491,6 +1615,15 @@ impl<'a> Run<'a> {
         match self.s.new_vertices[k].kind {
             Kind::Edge(c) => vec![self.cv(next(c as usize)), self.cv(prev(c as usize))],
             Kind::Center(t) => self.mesh.triangles[t as usize].to_vec(),
+            Kind::TwinCenter(t, u) => {
+                let mut vs = self.mesh.triangles[t as usize].to_vec();
+                for v in self.mesh.triangles[u as usize] {
+                    if !vs.contains(&v) {
+                        vs.push(v);
+                    }
+                }
+                vs
+            }
         }
     }
 
@@ -1518,6 +1651,7 @@ impl<'a> Run<'a> {
                 [c / 3, o]
             }
             Kind::Center(t) => [t, NONE],
+            Kind::TwinCenter(t, u) => [t, u],
         }
     }
 

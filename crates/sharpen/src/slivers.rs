@@ -394,6 +394,15 @@ impl Output {
                 }
             }
         }
+        // Twin corner triangles share their centre's fan: one goes back only with the other.
+        for &(t, u) in &run.twins {
+            let (i, j) = (touched_index[t as usize], touched_index[u as usize]);
+            if t < u && i != NONE && j != NONE {
+                groups.union(i, j);
+                pristine[i as usize] = false;
+                pristine[j as usize] = false;
+            }
+        }
         let new_count = self.is_new.iter().filter(|&&x| x).count();
         Local {
             slots,
