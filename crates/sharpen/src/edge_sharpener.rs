@@ -767,34 +767,14 @@ impl<'a> Run<'a> {
         if self.opts.method == Method::Extended {
             label_regions(s, table, nt);
         }
-        // Filter 3bis: tag the ends of non-brown edges between two red triangles ... (red
-        // triangle by red triangle, the corner arrays walked in step)
-        for (t, (tri, (o3, cf3))) in mesh
-            .triangles
-            .iter()
-            .zip(opposite.chunks_exact(3).zip(s.cflags.chunks_exact(3)))
-            .enumerate()
-        {
-            if s.tflags[t] & T_RED == 0 {
-                continue;
-            }
-            for (j, (after, before)) in AFTER_BEFORE.into_iter().enumerate() {
-                let o = o3[j];
-                if cf3[j] & C_BROWN != 0 || o == NONE {
-                    continue;
-                }
-                if s.tflags[o as usize / 3] & T_RED != 0 {
-                    s.vflags[tri[after] as usize] |= V_TAG;
-                    s.vflags[tri[before] as usize] |= V_TAG;
-                }
-            }
-        }
-        // ... and vertices whose red triangles form more than one fan, counted in filter 4's
-        // loop. A red corner k starts a run of red triangles around its vertex when the
-        // triangle clockwise before it, across the edge opposite prev(k), is not red: so each
-        // red-region border edge (opposite corner c of a red triangle) starts a run at next(c).
+        // Filters 3bis and 4 in one walk over the red triangles (the corner arrays walked in
+        // step). 3bis tags the ends of non-brown edges between two red triangles, and
+        // vertices whose red triangles form more than one fan, counted here: a red corner k
+        // starts a run of red triangles around its vertex when the triangle clockwise before
+        // it, across the edge opposite prev(k), is not red, so each red-region border edge
+        // (opposite corner c of a red triangle) starts a run at next(c). Filter 4 paints the
+        // edges and vertices of red triangles.
         let mut runs = vec![0u8; mesh.positions.len()];
-        // Filter 4: edges and vertices of red triangles.
         for (t, (tri, o3)) in mesh
             .triangles
             .iter()
@@ -804,15 +784,22 @@ impl<'a> Run<'a> {
             if s.tflags[t] & T_RED == 0 {
                 continue;
             }
-            for (k, (after, _)) in AFTER_BEFORE.into_iter().enumerate() {
-                s.cflags[3 * t + k] |= C_RED;
+            for (k, (after, before)) in AFTER_BEFORE.into_iter().enumerate() {
+                let c = 3 * t + k;
+                let brown = s.cflags[c] & C_BROWN != 0;
+                s.cflags[c] |= C_RED;
                 s.vflags[tri[k] as usize] |= V_RED;
                 let o = o3[k];
                 let border = if o == NONE {
                     true
                 } else {
                     s.cflags[o as usize] |= C_RED;
-                    s.tflags[o as usize / 3] & T_RED == 0
+                    let red = s.tflags[o as usize / 3] & T_RED != 0;
+                    if red && !brown {
+                        s.vflags[tri[after] as usize] |= V_TAG;
+                        s.vflags[tri[before] as usize] |= V_TAG;
+                    }
+                    !red
                 };
                 if border {
                     let v = tri[after] as usize;
@@ -2081,6 +2068,9 @@ fn label_regions(s: &mut Scratch, table: &CornerTable, nt: usize) {
         if region[t] == NONE {
             continue;
         }
+        // The root of t's set: t itself until this loop joins it (links are made only from
+        // the higher triangle of an edge, so none reached t before).
+        let mut rt = t as u32;
         for c in 3 * t..3 * t + 3 {
             let o = opposite[c];
             // Each brown edge once, from its higher triangle (brown edges are interior and
@@ -2092,9 +2082,10 @@ fn label_regions(s: &mut Scratch, table: &CornerTable, nt: usize) {
             if region[u as usize] == NONE {
                 continue;
             }
-            let (a, b) = (root(region, t as u32), root(region, u));
-            if a != b {
-                region[a.max(b) as usize] = a.min(b);
+            let ru = root(region, u);
+            if ru != rt {
+                region[rt.max(ru) as usize] = rt.min(ru);
+                rt = rt.min(ru);
             }
         }
     }
