@@ -326,13 +326,14 @@ impl WeldPatch<'_> {
         };
         let removed = sums(welded_table, &welded_changed, &|t, _| welded_normals[t]);
         // An unchanged input triangle's normal is its welded image's (the same vertices).
-        let added = sums(self.input_table, &input_changed, &|t, changed| {
-            if changed {
-                self.input.face_normal(t)
-            } else {
-                welded_normals[welded_index[t] as usize]
-            }
-        });
+        let added = sums(
+            self.input_table,
+            &input_changed,
+            &|t, changed| match welded_normals.get(welded_index[t] as usize) {
+                Some(&n) if !changed => n,
+                _ => self.input.face_normal(t),
+            },
+        );
         (removed, added)
     }
 }
