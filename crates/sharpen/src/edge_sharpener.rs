@@ -393,6 +393,7 @@ fn compose_passes(first: Sharpened, next: Sharpened) -> Sharpened {
         output_triangles: b.output_triangles,
         chamfer_edges: a.chamfer_edges + b.chamfer_edges,
         corner_triangles: a.corner_triangles + b.corner_triangles,
+        twin_corners: a.twin_corners + b.twin_corners,
         chamfer_vertices: a.chamfer_vertices + b.chamfer_vertices,
         inserted_vertices: a.inserted_vertices + b.inserted_vertices,
         new_vertices: a.new_vertices + b.new_vertices,
@@ -1061,6 +1062,7 @@ impl<'a> Run<'a> {
                 // One chamfer edge fewer to split, one corner fewer (the pair is one).
                 self.report.chamfer_edges = self.report.chamfer_edges.saturating_sub(1);
                 self.report.corner_triangles = self.report.corner_triangles.saturating_sub(1);
+                self.report.twin_corners += 1;
                 self.twins.push((t as u32, u as u32));
                 self.twins.push((u as u32, t as u32));
                 self.twins.sort_unstable();

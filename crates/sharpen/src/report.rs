@@ -84,8 +84,12 @@ pub struct SharpenReport {
     pub smooth_edges: usize,
     /// Chamfer (blue) edges: each got a new vertex.
     pub chamfer_edges: usize,
-    /// Corner (green) triangles: each got a new vertex.
+    /// Corner (green) triangles: each got a new vertex (a pair of twins counts once).
     pub corner_triangles: usize,
+    /// Pairs of twin corner triangles that share one centre (extended method;
+    /// docs/sharpen.md, "What we extend", step 13); each pair's shared edge is not counted in
+    /// `chamfer_edges`.
+    pub twin_corners: usize,
     /// Input vertices classified as chamfer vertices by the extended detection (0 in papers
     /// mode).
     pub chamfer_vertices: usize,
@@ -182,7 +186,7 @@ impl SharpenReport {
     /// `absolute_feature_vertices`, `presmooth_iterations`, `filtered_normals`,
     /// `rectified_normals`, `update_iterations`, `flips_avoided`, `swaps`, `collapses`,
     /// `detection_ms`, `filtering_ms` and `updating_ms` (zeros for the other methods), then
-    /// `curved_wall_factor`, `curved_wall_edges` and `passes`.
+    /// `curved_wall_factor`, `curved_wall_edges`, `passes` and `twin_corners`.
     pub fn to_json(&self) -> String {
         let mut s = String::with_capacity(768);
         // Writing to a String cannot fail.
@@ -233,7 +237,8 @@ impl SharpenReport {
              \"absolute_feature_vertices\":{},\"presmooth_iterations\":{},\"filtered_normals\":{},\
              \"rectified_normals\":{},\"update_iterations\":{},\"flips_avoided\":{},\"swaps\":{},\
              \"collapses\":{},\"detection_ms\":{},\"filtering_ms\":{},\"updating_ms\":{},\
-             \"curved_wall_factor\":{},\"curved_wall_edges\":{},\"passes\":{}}}",
+             \"curved_wall_factor\":{},\"curved_wall_edges\":{},\"passes\":{},\
+             \"twin_corners\":{}}}",
             json_num(self.rho),
             json_num(self.eta),
             json_num(self.lambda),
@@ -253,6 +258,7 @@ impl SharpenReport {
             json_num(self.curved_wall_factor),
             self.curved_wall_edges,
             self.passes,
+            self.twin_corners,
         );
         s
     }
@@ -298,6 +304,7 @@ mod tests {
             "curved_wall_factor",
             "curved_wall_edges",
             "passes",
+            "twin_corners",
         ] {
             assert_eq!(j.matches(&format!("\"{key}\":")).count(), 1, "{key} in {j}");
         }

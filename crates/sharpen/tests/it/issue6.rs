@@ -413,4 +413,12 @@ fn issue6_twin_corner_triangles_share_one_centre() {
     // at 50k samples, measured before and after: 2.42x -> 3.16x; the bound sits between.
     let (max_gain, _) = sound_gains(ShapeKind::Cube, 48, 1);
     assert!(max_gain >= 2.8, "{max_gain:.2}x");
+    // The report counts the pairs (two on this sampling, one at each of two opposite
+    // corners: measured), and the papers' method has none.
+    let (_, input) = sampled(ShapeKind::Cube, 48, 1);
+    let out = sharpen(&input, &SharpenOptions::DEFAULT).unwrap();
+    assert_eq!(out.report.twin_corners, 2);
+    assert!(out.report.to_json().contains("\"twin_corners\":2"));
+    let papers = SharpenOptions::DEFAULT.with_method(whet_sharpen::Method::Papers);
+    assert_eq!(sharpen(&input, &papers).unwrap().report.twin_corners, 0);
 }
