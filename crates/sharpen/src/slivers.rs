@@ -442,11 +442,12 @@ impl Output {
         let tri = self.tris[s];
         let p = self.points(run, s);
         let nv = run.mesh.positions.len() as u32;
-        let mut order: [(f64, usize); 3] = [0, 1, 2].map(|k| {
-            let e1 = p[(k + 1) % 3] - p[k];
-            let e2 = p[(k + 2) % 3] - p[k];
-            (crate::edge_sharpener::fast_angle(e1, e2), k)
-        });
+        // Corners by their angle, smallest first: by the length of the opposite side, which
+        // orders them exactly (the larger side faces the larger angle) and, unlike an angle,
+        // stays defined where two vertices coincide (a zero-length side faces the zero angle;
+        // both angles at its ends are undefined).
+        let mut order: [(f64, usize); 3] =
+            [0, 1, 2].map(|k| (p[(k + 1) % 3].distance_squared(p[(k + 2) % 3]), k));
         order.sort_by(|a, b| a.0.total_cmp(&b.0));
         let mut best: Option<(f64, Op)> = None;
         let consider = |q: Option<f64>, op: Op, best: &mut Option<(f64, Op)>| {
