@@ -1428,6 +1428,22 @@ impl<'a> Run<'a> {
         folded
     }
 
+    /// Extended method: whether `tri` is input triangle `parent` itself (no piece of it) and
+    /// faced against the plane its vertices lie on best ([`Run::expected_normal`]) at their
+    /// rest positions already: a triangle marching cubes folded, not one the moves turned.
+    fn folded_at_rest(&self, tri: &[u32; 3], parent: usize) -> bool {
+        if self.opts.method == Method::Papers {
+            return false;
+        }
+        let m = self.mesh.triangles[parent];
+        if !(0..3).any(|k| *tri == [m[k], m[(k + 1) % 3], m[(k + 2) % 3]]) {
+            return false;
+        }
+        let n = self.expected_normal(tri, parent);
+        let q = tri.map(|v| self.rest_of(v));
+        n != DVec3::ZERO && (q[1] - q[0]).cross(q[2] - q[0]).dot(n) <= 0.0
+    }
+
     /// True when every vertex of `tri` is a corner of input triangle `t` (unmoved) or a new
     /// vertex of `t`'s subdivision at its rest position.
     fn at_rest_in(&self, tri: &[u32; 3], t: usize) -> bool {
@@ -1678,7 +1694,11 @@ impl<'a> Run<'a> {
                 // A thin piece's normal means little; the sliver pass removes it (and checks
                 // the orientation of what replaces it).
                 if min_angle(&p) >= SETTLE_MIN_ANGLE.to_radians() {
-                    if self.is_reversed(piece, t, &p) {
+                    let reversed = self.is_reversed(piece, t, &p);
+                    if reversed && self.folded_at_rest(piece, t) {
+                        // Not the moves' doing (step 15): the sliver pass flips or collapses
+                        // it, and unsnaps its vertices only if it cannot.
+                    } else if reversed {
                         victim = self
                             .worst_snapped(piece.iter().copied())
                             .map(|v| (v, UnmovedReason::Flipped));
