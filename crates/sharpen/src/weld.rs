@@ -91,6 +91,7 @@ pub(crate) fn weld_clusters(mesh: &Mesh, table: &CornerTable, min_angle: f64) ->
     let mut in_cluster: Vec<bool> = Vec::new();
     let mut merged = 0usize;
     let mut cluster: Vec<u32> = Vec::new();
+    let mut refused: Vec<Vec<u32>> = Vec::new();
     let mut around: Vec<u32> = Vec::new();
     let mut before: Vec<(DVec3, f64)> = Vec::new();
     // Above this, a triangle's rounded shortest side cannot hide an exact one under `limit2`.
@@ -138,46 +139,25 @@ pub(crate) fn weld_clusters(mesh: &Mesh, table: &CornerTable, min_angle: f64) ->
             // On the boundary (welding would change it), or not a marching-cubes cluster.
             continue;
         }
-        around.clear();
-        for &v in &cluster {
-            around.extend(table.vertex_corners(VertexId(v)).map(|c| c.0 / 3));
-        }
-        around.sort_unstable();
-        around.dedup();
-        around.retain(|&t| alive[t as usize]);
-        // The member whose position turns the remapped triangles least: the largest cosine
-        // of the worst turn (no arc cosine per candidate and triangle).
-        before.clear();
-        before.extend(around.iter().map(|&t| {
-            let n = mesh.face_cross(t as usize);
-            (n, n.length_squared())
-        }));
-        let mut best = (f64::NEG_INFINITY, a);
-        for &r in &cluster {
-            for &v in &cluster {
-                rep[v as usize] = r;
-            }
-            let cos = smallest_turn_cosine(mesh, &rep, &around, &before);
-            if cos > best.0 || (cos == best.0 && r < best.1) {
-                best = (cos, r);
-            }
-        }
-        let root = best.1;
-        for &v in &cluster {
-            rep[v as usize] = root;
-        }
-        if merge_keeps_manifold(mesh, &rep, &around, root, min_angle) {
-            for &t in &around {
-                let [x, y, z] = mesh.triangles[t as usize].map(|v| rep[v as usize]);
-                if x == y || y == z || z == x {
-                    alive[t as usize] = false;
-                }
-            }
-            merged += cluster.len() - 1;
+        let scratch = (&mut around, &mut before);
+        if let Some(n) = merge_cluster(
+            mesh, table, &cluster, &mut rep, &mut alive, min_angle, scratch,
+        ) {
+            merged += n;
         } else {
-            for &v in &cluster {
-                rep[v as usize] = v;
-            }
+            refused.push(std::mem::take(&mut cluster));
+        }
+    }
+    // A cluster can be refused for a sliver that a cluster welded after it removes (two
+    // clusters across one triangle, each a face of a crease: synth cube 32 r0, where the
+    // refused one left a needle that blocked the move restoring the crease). One more try
+    // each, in the same order, once the first round is done.
+    for cluster in &refused {
+        let scratch = (&mut around, &mut before);
+        if let Some(n) = merge_cluster(
+            mesh, table, cluster, &mut rep, &mut alive, min_angle, scratch,
+        ) {
+            merged += n;
         }
     }
     if merged == 0 {
@@ -201,6 +181,63 @@ pub(crate) fn weld_clusters(mesh: &Mesh, table: &CornerTable, min_angle: f64) ->
         welded_index,
         rep,
     })
+}
+
+/// Merges `cluster` into the member whose position turns the triangles around it least, if
+/// they stay an oriented manifold with no new sliver ([`merge_keeps_manifold`]): updates
+/// `rep` and `alive` and returns the number of vertices merged away; `None`, with `rep` as it
+/// was, when refused. `around` and `before` are scratch buffers.
+fn merge_cluster(
+    mesh: &Mesh,
+    table: &CornerTable,
+    cluster: &[u32],
+    rep: &mut [u32],
+    alive: &mut [bool],
+    min_angle: f64,
+    (around, before): (&mut Vec<u32>, &mut Vec<(DVec3, f64)>),
+) -> Option<usize> {
+    around.clear();
+    for &v in cluster {
+        around.extend(table.vertex_corners(VertexId(v)).map(|c| c.0 / 3));
+    }
+    around.sort_unstable();
+    around.dedup();
+    around.retain(|&t| alive[t as usize]);
+    // The member whose position turns the remapped triangles least: the largest cosine of
+    // the worst turn (no arc cosine per candidate and triangle).
+    before.clear();
+    before.extend(around.iter().map(|&t| {
+        let n = mesh.face_cross(t as usize);
+        (n, n.length_squared())
+    }));
+    let mut best = (f64::NEG_INFINITY, cluster[0]);
+    for &r in cluster {
+        for &v in cluster {
+            rep[v as usize] = r;
+        }
+        let cos = smallest_turn_cosine(mesh, rep, around, before);
+        if cos > best.0 || (cos == best.0 && r < best.1) {
+            best = (cos, r);
+        }
+    }
+    let root = best.1;
+    for &v in cluster {
+        rep[v as usize] = root;
+    }
+    if merge_keeps_manifold(mesh, rep, around, root, min_angle) {
+        for &t in around.iter() {
+            let [x, y, z] = mesh.triangles[t as usize].map(|v| rep[v as usize]);
+            if x == y || y == z || z == x {
+                alive[t as usize] = false;
+            }
+        }
+        Some(cluster.len() - 1)
+    } else {
+        for &v in cluster {
+            rep[v as usize] = v;
+        }
+        None
+    }
 }
 
 /// The corner table of `welded`, from the table of its input: a welded triangle's corners

@@ -229,9 +229,11 @@ fn issue6_welding_clears_the_cluster_gaps() {
 #[test]
 fn issue6_clusters_away_from_the_creases_keep_their_triangles() {
     // Every cluster is welded before the run and put back where the run left it untouched
-    // (docs/sharpen.md step 10): deep inside the cube's faces, farther than three mean edges
+    // (docs/sharpen.md step 10): deep inside the cube's faces, farther than 3.5 mean edges
     // from the truth's creases, every input triangle comes out as it went in, those of the
-    // clusters there included.
+    // clusters there included. (3 edges until refused clusters got a second try: one welded
+    // on its second try shares an input triangle with a touched cluster nearer the crease, so
+    // both stay welded, and one triangle with a vertex 3.01 edges from the crease changed.)
     let (truth, input) = sampled(ShapeKind::Cube, 48, 1);
     let out = sharpen(&input, &SharpenOptions::DEFAULT).unwrap();
     assert!(out.report.new_vertices > 0 && out.report.welded_vertices > 0);
@@ -252,7 +254,7 @@ fn issue6_clusters_away_from_the_creases_keep_their_triangles() {
         creases.iter().all(|&(a, b)| {
             let d = b - a;
             let s = ((p - a).dot(d) / d.length_squared()).clamp(0.0, 1.0);
-            p.distance(a + d * s) > 3.0 * edge
+            p.distance(a + d * s) > 3.5 * edge
         })
     };
     let mut output: Vec<[u32; 3]> = out.mesh.triangles.clone();
@@ -457,4 +459,21 @@ fn issue6_a_corner_keeps_its_vertex_over_a_triangle_marching_cubes_folded() {
     // the bound sits between.
     let (max_gain, _) = sound_gains(ShapeKind::Pyramid, 96, 0);
     assert!(max_gain >= 2.2, "{max_gain:.2}x");
+}
+
+#[test]
+fn issue6_a_cluster_refused_for_its_neighbours_sliver_is_welded_after_it() {
+    // Cube 32, rotation 0: two marching-cubes clusters sit across one triangle, one on each
+    // face of a crease. Welded first, the one refused because the triangle between them
+    // would become a sliver (its other short edge is the second cluster's); the second then
+    // welded, the first stayed, and its needle blocked the move of the vertex inside the cut
+    // onto the crease. Refused clusters now get one more try after the others (docs/
+    // sharpen.md, "What we extend", step 10; docs/results.md, "A second try for refused
+    // clusters", 1M samples: max gain 1.62x -> 2.22x). Measured here at 50k samples before
+    // and after: 1.62x -> 2.22x, 39 -> 42 welded vertices; the bound sits between.
+    let (max_gain, _) = sound_gains(ShapeKind::Cube, 32, 0);
+    assert!(max_gain >= 2.0, "{max_gain:.2}x");
+    let (_, input) = sampled(ShapeKind::Cube, 32, 0);
+    let out = sharpen(&input, &SharpenOptions::DEFAULT).unwrap();
+    assert_eq!(out.report.welded_vertices, 42);
 }
