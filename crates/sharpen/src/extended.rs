@@ -36,7 +36,12 @@ use crate::snap::{self, Plane};
 /// 85-90 % of gray vertices lie within 0.25 edge lengths of the nearest neighbouring plane, the
 /// rest are vertices the interpolation put inside the chamfer. Tuned on the synth table
 /// (docs/results.md): 0.5 gains a little RMS at 64-128 but mislabels vertices of fandisk at 32
-/// (one case then gets worse), 0.3 loses RMS everywhere.
+/// (one case then gets worse), 0.3 loses RMS everywhere. Widened by the wedge's acute reach
+/// (2026-12-03, [`gray_vertices`]). Re-swept then, flat: 0.5 and 0.6 gain on seven and ten
+/// rows of the marching-cubes table (all but two of them pyramid rows) and lose on none, but
+/// make the rotated synth `blend` (fillets 2.6 cells wide at 64) 12-18 % worse in RMS; the
+/// flat value stays and only acute cuts get more (docs/results.md, "Gray vertices in acute
+/// cuts").
 pub(crate) const GRAY_TOLERANCE: f64 = 0.4;
 
 /// Labelling passes over the gray vertices (each reaches one ring further into a chamfer).
@@ -795,6 +800,7 @@ fn gray_vertices(run: &mut Run) {
         })
         .collect();
     let mut found: Vec<(u32, LabelPlane)> = Vec::new();
+    let mut around: Vec<LabelPlane> = Vec::new();
     for _ in 0..GRAY_PASSES {
         found.clear();
         for &g in &gray {
@@ -802,11 +808,13 @@ fn gray_vertices(run: &mut Run) {
             let mut len = 0.0;
             let mut k = 0usize;
             let mut best: Option<(f64, LabelPlane)> = None;
+            around.clear();
             for c in run.table.vertex_corners(VertexId(g)) {
                 let u = run.cv(next(c.index()));
                 len += (run.mesh.positions[u as usize] - p).length();
                 k += 1;
                 for lp in planes_of(run, u) {
+                    around.push(*lp);
                     let d = (p - lp.plane.point).dot(lp.plane.normal).abs();
                     let better = match &best {
                         None => true,
@@ -818,7 +826,16 @@ fn gray_vertices(run: &mut Run) {
                 }
             }
             if let Some((d, lp)) = best {
-                if k > 0 && d <= GRAY_TOLERANCE * len / k as f64 {
+                // Inside an acute cut the vertex lies deeper under the plane it belongs to
+                // (marching cubes cuts a wedge of interior angle `a` `acute_reach` times deeper
+                // than a right angle), so the tolerance widens with the sharpest wedge the
+                // plane makes with another surface around the vertex, as step 4's does.
+                let reach = around
+                    .iter()
+                    .filter(|o| !same_surface(run, o, &lp))
+                    .map(|o| acute_reach(run, &[&lp.plane, &o.plane]))
+                    .fold(1.0f64, f64::max);
+                if k > 0 && d <= GRAY_TOLERANCE * reach * len / k as f64 {
                     found.push((g, lp));
                 }
             }
