@@ -8,7 +8,7 @@
 //! cargo run --release -p whet-sharpen --example sharpen_diag -- rocker_arm.off 4 6 extended
 //! ```
 //!
-//! A synth shape takes `<shape> <resolution> <rotation 0|1> <method>`; a shared fixture
+//! A synth shape takes `<shape> <resolution> <rotation 0|1|2|3> <method>`; a shared fixture
 //! (`*.off`) takes `<fixture> <vertex ratio> - <method>` and uses the stand-in retiling of
 //! `support::cached_stand_in`, or `<fixture> <bpv> <angle bits|auto> <method>` and uses the
 //! swing-decoded fixture of `swing_inputs::swing_input` (auto: optimised for sharpening).
@@ -75,8 +75,14 @@ fn main() {
     } else {
         let kind: ShapeKind = arg(&args, 1, ShapeKind::Cube);
         let res: usize = arg(&args, 2, 64);
-        let rot: usize = arg::<usize>(&args, 3, 0).min(1);
-        let params = ShapeParams::default().with_rotation(support::rotations()[rot]);
+        // 0 and 1: the tables' generic rotations; 2: none (creases along the grid); 3: a
+        // small turn (creases drift slowly across the grid).
+        let rotation = match arg::<usize>(&args, 3, 0) {
+            2 => glam::DQuat::IDENTITY,
+            3 => glam::DQuat::from_axis_angle(glam::DVec3::new(0.3, 0.2, 1.0).normalize(), 0.05),
+            r => support::rotations()[r.min(1)],
+        };
+        let params = ShapeParams::default().with_rotation(rotation);
         let shape = or_die(Shape::new(kind, &params), "shape");
         (
             shape.truth_mesh(),

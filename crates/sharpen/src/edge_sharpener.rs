@@ -172,6 +172,9 @@ pub(crate) struct Scratch {
     pub region_turn: Vec<f32>,
     pub region_start: Vec<u32>,
     pub region_angles: Vec<f32>,
+    /// Extended method on marching cubes: the label pairs whose chamfer is a rounded blend
+    /// (`crate::extended::blend_creases`), sorted, smaller label first.
+    pub blend_creases: Vec<(u32, u32)>,
     /// Curved walls: a mark per vertex (on a red triangle), then per triangle (deep).
     pub wall_marks: Vec<u8>,
 }

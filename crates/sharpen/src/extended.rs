@@ -88,7 +88,115 @@ pub(crate) fn classify(run: &mut Run) {
         gray_vertices(run);
     }
     crease_vertices(run);
+    run.s.blend_creases.clear();
+    if !run.surface_samples {
+        blend_creases(run);
+    }
     snap_chamfer_vertices(run);
+}
+
+/// A chamfer-edge end lies *inside* its own plane when it is more than this fraction of the
+/// edge's length under it (see [`blend_creases`]; fillet arcs put their gray vertices 0.1-0.3
+/// edges under the planes they are labelled with, cut creases theirs on them).
+pub(crate) const BLEND_DEPTH: f64 = 0.05;
+
+/// A crease is a rounded blend when more than this fraction of its chamfer edges have both
+/// ends inside their own planes (after [`BLEND_PRIOR_EDGES`]; see [`blend_creases`]).
+/// Swept with `sharpen_diag` on 31 cases of ten synth shapes (2026-12-03; docs/results.md,
+/// "Rounded blends"): 0.4 leaves the blend at 64 cells r0 1.4x worse in RMS than its input
+/// (0.3 and 0.2 restore it); 0.3 still sharpens the blend at 48 cells r0 (RMS 0.083 % against
+/// 0.051 % at 0.2); 0.15 changes no sharp case either, 0.1 moves the octahedron's corners
+/// (32 cells r1 max 0.82 % -> 0.96 %). 0.2 keeps a step from both; 0.15-0.4 change no row of
+/// the marching-cubes table or the noise table.
+pub(crate) const BLEND_FRACTION: f64 = 0.2;
+
+/// The fraction of a crease is taken as if it also had this many edges at the fraction of the
+/// whole mesh's chamfer edges: a crease of one to four edges says little on its own (at a cut corner the
+/// vertices lie inside all planes, so the single edges between the faces that meet at the
+/// grid-aligned pyramid's apex have both ends inside), while on a mesh whose creases are
+/// mostly blends its short creases are too (the corners where three fillets meet).
+pub(crate) const BLEND_PRIOR_EDGES: f64 = 4.0;
+
+/// Marching cubes: finds the creases (pairs of labels) that are rounded blends rather than
+/// cut sharp edges, into `run.s.blend_creases`. [`consistent`] refuses every point computed
+/// from the planes of such a pair, and [`snap_chamfer_vertices`] does not move a vertex onto
+/// them, so their edges are not split and no corner vertex moves onto them.
+///
+/// Where the grid cut a sharp crease, the chamfer it left runs from one face plane to the
+/// other: at least one end of nearly every chamfer edge lies on its own plane (a red vertex,
+/// or a gray one the grid put on the face). Across a blend a few cells wide (a fillet) the
+/// gray vertices lie on the arc, inside both face planes, and the edges between them join
+/// two such vertices. The planes' line lies 0.41 radii above the arc at a right angle, about
+/// as far as a cut crease lies from its chamfer at these resolutions, so the support test
+/// cannot tell the two apart. Measured per label pair with `sharpen_diag` (2026-12-03): the
+/// fraction of chamfer edges with both ends inside their own planes is 0.48-0.72 on 11 of the
+/// 16 creases of the synth blend (radius 0.04) at 64 cells r0 (0.38 over the mesh), and at
+/// most 0.07 on every crease of five edges or more of cube, pyramid, fandisk and cylinder at
+/// 32-128 cells (generic rotations, grid-aligned and slightly turned). A fillet under about
+/// 1.5 cells in radius looks like a cut crease (blend at 32 cells: 0-0.26) and is sharpened.
+#[inline(never)] // one call per run; kept out of line so profiles show it
+fn blend_creases(run: &mut Run) {
+    // (smaller label, larger label, edge has both ends inside)
+    let mut counts: Vec<(u32, u32, bool)> = Vec::new();
+    let nc = run.mesh.triangles.len() * 3;
+    for c in 0..nc {
+        let Some(o) = run.table.opposite(CornerId(c as u32)) else {
+            continue;
+        };
+        if o.index() < c || run.s.cflags[c] & C_RED != 0 {
+            continue;
+        }
+        let (a, b) = (run.cv(next(c)), run.cv(crate::edge_sharpener::prev(c)));
+        if !is_chamfer_edge(run, a, b) {
+            continue;
+        }
+        let (pa, pb) = (run.positions[a as usize], run.positions[b as usize]);
+        let depth = BLEND_DEPTH * pa.distance(pb);
+        let inside = |p: DVec3, lp: &LabelPlane| (p - lp.plane.point).dot(lp.plane.normal) < -depth;
+        for x in planes_of(run, a) {
+            for y in planes_of(run, b) {
+                let key = (x.label.min(y.label), x.label.max(y.label));
+                counts.push((key.0, key.1, inside(pa, x) && inside(pb, y)));
+            }
+        }
+    }
+    // The whole mesh's fraction, over the chamfer edges.
+    let total_inside = counts.iter().filter(|e| e.2).count();
+    let global = total_inside as f64 / counts.len().max(1) as f64;
+    // Vertices on two surfaces (step 4's crease vertices) count as edges with an end on its
+    // plane: the crease passes through the input there, as it does all along a sharp edge the
+    // grid cut, and seldom across a blend. Where most of a crease's vertices move onto it,
+    // few chamfer edges remain to count (the stand-in of cad_box_hole at 1x: a crease of two
+    // such edges, both ends inside, was refused without them and RMS went 0.0108 -> 0.0149 %).
+    for v in 0..run.mesh.positions.len() as u32 {
+        let planes = planes_of(run, v);
+        for (i, x) in planes.iter().enumerate() {
+            for y in &planes[i + 1..] {
+                if !same_surface(run, x, y) {
+                    counts.push((x.label.min(y.label), x.label.max(y.label), false));
+                }
+            }
+        }
+    }
+    counts.sort_unstable();
+    for group in counts.chunk_by(|p, q| (p.0, p.1) == (q.0, q.1)) {
+        let inside = group.iter().filter(|e| e.2).count();
+        let (n, k) = (group.len() as f64, BLEND_PRIOR_EDGES);
+        if inside as f64 + k * global > BLEND_FRACTION * (n + k) {
+            run.s.blend_creases.push((group[0].0, group[0].1));
+        }
+    }
+}
+
+/// Whether labels `a` and `b` meet in a rounded blend ([`blend_creases`]).
+#[inline]
+fn is_blend(run: &Run, a: u32, b: u32) -> bool {
+    !run.s.blend_creases.is_empty()
+        && run
+            .s
+            .blend_creases
+            .binary_search(&(a.min(b), a.max(b)))
+            .is_ok()
 }
 
 /// An input is a *surface sampling* when fewer than this fraction of its triangles have an
@@ -175,6 +283,14 @@ fn snap_chamfer_vertices(run: &mut Run) {
             if kept.iter().all(|k| !same_surface(run, k, lp)) {
                 kept.push(*lp);
             }
+        }
+        let blend = kept.iter().enumerate().any(|(i, x)| {
+            kept[i + 1..]
+                .iter()
+                .any(|y| is_blend(run, x.label, y.label))
+        });
+        if blend {
+            continue;
         }
         surfaces.clear();
         surfaces.extend(kept.iter().map(|k| k.plane));
@@ -1193,6 +1309,11 @@ pub(crate) const CONSISTENCY_MISSES: usize = 1;
 fn consistent(run: &Run, p: DVec3, sources: &[(u32, u32)], scale: f64) -> bool {
     if run.surface_samples {
         return true;
+    }
+    for (i, &(_, x)) in sources.iter().enumerate() {
+        if sources[i + 1..].iter().any(|&(_, y)| is_blend(run, x, y)) {
+            return false;
+        }
     }
     let tol = CURVED_TOLERANCE * scale;
     let mut misses = 0usize;
