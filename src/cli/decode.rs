@@ -161,8 +161,9 @@ pub fn run(args: &DecodeArgs) -> CliResult {
             if let Some(h) = &header {
                 whet_codec::SurfaceFilter::after_sharpening_of(h)
                     .apply_after_sharpening(&mesh, &mut s.mesh);
-                // Then the flat faces onto their planes, when the stream says so.
-                super::sharpen::flatten_stated_planes(h, &mut s.mesh);
+                // Then the flat faces onto their planes and the curved ones onto local
+                // quadrics, when the stream says so.
+                super::sharpen::project_as_stated(h, &mut s.mesh);
             }
         }
         match args.bend {

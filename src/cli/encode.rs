@@ -403,8 +403,10 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh) -> CliResult {
                 "rms_error_pct": t.rms_pct,
                 "max_error_pct": t.max_pct,
                 "planar": t.planar,
+                "quadric": t.quadric,
             })).collect::<Vec<_>>(),
             "planar_tolerance": out.planar_factor,
+            "quadric_projection": out.quadric_factor,
             "sharpen_input_max_error_pct": out.sharpen_input_max_pct,
             "search": out.search.iter().map(|&(f, b)| json!([f, b])).collect::<Vec<_>>(),
             "angle_trials": out.angle_trials.iter().map(|t| json!({

@@ -231,7 +231,7 @@ fn sharpened_from_stream(mesh: &Mesh, bytes: &[u8]) -> Result<(Mesh, Vec<[u32; 2
     let mut s = sharpened(mesh, method, smooth_factor, curved_walls, passes)?;
     if let Some(h) = &header {
         whet_codec::SurfaceFilter::after_sharpening_of(h).apply_after_sharpening(mesh, &mut s.mesh);
-        super::sharpen::flatten_stated_planes(h, &mut s.mesh);
+        super::sharpen::project_as_stated(h, &mut s.mesh);
     }
     let tags = super::sharpen::tag_edges(&s.tags);
     Ok((s.mesh, tags))

@@ -87,16 +87,23 @@ pub fn run_sharpen(mesh: &Mesh, opts: &SharpenOptions) -> CliResult<Sharpened> {
     }
 }
 
-/// A swing stream's planar-region projection after sharpening (optional header field 25),
-/// applied to `sharpened`: the output of the sharpening and of the stream's filter for after
-/// sharpening (docs/swing.md section 2). A mesh the projection refuses (it needs an oriented
-/// manifold, which sharpening gives) is kept unprojected with a warning, as the encoder's
-/// measurement keeps it: the field is an optional refinement, not part of the decoded mesh.
-pub fn flatten_stated_planes(header: &whet_format::Header, sharpened: &mut Mesh) {
+/// A swing stream's projections after sharpening, applied to `sharpened`: the output of the
+/// sharpening and of the stream's filter for after sharpening (docs/swing.md section 2).
+/// First the planar-region projection (optional header field 25), then the local quadric
+/// projection (field 31). A mesh a projection refuses (it needs an oriented manifold, which
+/// sharpening gives) is kept as it is with a warning, as the encoder's measurement keeps
+/// it: the fields are optional refinements, not part of the decoded mesh.
+pub fn project_as_stated(header: &whet_format::Header, sharpened: &mut Mesh) {
     if let Some((factor, bits)) = whet_codec::SharpenHint::planar_of(header) {
         let opts = whet_sharpen::PlanarOptions::for_swing(bits, factor);
         if let Err(e) = whet_sharpen::flatten_planar_regions(sharpened, &opts) {
             eprintln!("whet: the planar-region projection was skipped: {e}");
+        }
+    }
+    if let Some((factor, bits)) = whet_codec::SharpenHint::quadric_of(header) {
+        let opts = whet_sharpen::QuadricOptions::for_swing(bits, factor);
+        if let Err(e) = whet_sharpen::project_onto_local_quadrics(sharpened, &opts) {
+            eprintln!("whet: the local quadric projection was skipped: {e}");
         }
     }
 }

@@ -369,13 +369,21 @@ fn decode_sharpen_follows_the_streams_hint() {
     // The encoder measured 25 candidates (both methods at three factors without and with
     // curved walls, every sharpening in one pass and in two, and none) and kept the lowest
     // error; then the chosen sharpening once more with the planar-region projection, kept
-    // when it beat it.
+    // when it beat it, and once more with the local quadric projection on top.
     let all = j["sharpen_trials"].as_array().unwrap();
-    let trials: Vec<_> = all.iter().filter(|t| t["planar"] == false).collect();
-    let planar: Vec<_> = all.iter().filter(|t| t["planar"] == true).collect();
+    let trials: Vec<_> = all
+        .iter()
+        .filter(|t| t["planar"] == false && t["quadric"] == false)
+        .collect();
+    let planar: Vec<_> = all
+        .iter()
+        .filter(|t| t["planar"] == true && t["quadric"] == false)
+        .collect();
+    let quadric: Vec<_> = all.iter().filter(|t| t["quadric"] == true).collect();
     assert_eq!(trials.len(), 25, "{j}");
     let chosen = j["sharpen_method"].as_str().unwrap();
     assert_eq!(planar.len(), usize::from(chosen != "none"), "{j}");
+    assert_eq!(quadric.len(), planar.len(), "{j}");
     // The stream states curved walls only where they are on.
     let chosen_walls = j["sharpen_curved_walls"].as_f64().unwrap_or(0.0);
     let chosen_error = trials
@@ -389,7 +397,16 @@ fn decode_sharpen_follows_the_streams_hint() {
         })
         .map(|t| t["rms_error_pct"].as_f64().unwrap())
         .unwrap();
-    let reported = j["rms_error_pct"].as_f64().unwrap();
+    let mut reported = j["rms_error_pct"].as_f64().unwrap();
+    if !j["quadric_projection"].is_null() {
+        // The reported error is the quadric trial's; what it refined is checked below.
+        assert_eq!(j["quadric_projection"].as_f64(), Some(0.25), "{j}");
+        assert_eq!(Some(reported), quadric[0]["rms_error_pct"].as_f64(), "{j}");
+        reported = match planar.first() {
+            Some(p) if !j["planar_tolerance"].is_null() => p["rms_error_pct"].as_f64().unwrap(),
+            _ => chosen_error,
+        };
+    }
     match planar.first() {
         Some(p) if !j["planar_tolerance"].is_null() => {
             assert_eq!(j["planar_tolerance"].as_f64(), Some(2.0), "{j}");
@@ -536,6 +553,25 @@ fn decode_sharpen_follows_the_streams_hint() {
     assert!(sharpened_on != sharpened_off, "field 25 moved nothing");
     let raw = ["--sharpen", "--no-surface-filter"];
     assert!(decode(&off, &raw, "ro.off").0 == decode(&on, &raw, "rn.off").0);
+    // Header field 31 turns the local quadric projection on after them: the faces' bent
+    // strips near the rounded corners (the cube at 20 cells) are curved regions.
+    for (factor, name) in [(None, "off"), (Some(25u64), "on")] {
+        let mut c = fine_container.clone();
+        c.header.remove(whet_format::tag::QUADRIC_PROJECTION);
+        if let Some(f) = factor {
+            c.header = c
+                .header
+                .clone()
+                .with(whet_format::tag::QUADRIC_PROJECTION, f);
+        }
+        let path = dir.join(format!("quadric-{name}.whet"));
+        std::fs::write(&path, c.to_bytes().unwrap()).unwrap();
+    }
+    let (off, on) = (dir.join("quadric-off.whet"), dir.join("quadric-on.whet"));
+    let sharpened_off = decode(&off, &["--sharpen"], "qo.off").0;
+    let sharpened_on = decode(&on, &["--sharpen"], "qn.off").0;
+    assert!(sharpened_on != sharpened_off, "field 31 moved nothing");
+    assert!(decode(&off, &raw, "qro.off").0 == decode(&on, &raw, "qrn.off").0);
 }
 
 #[test]

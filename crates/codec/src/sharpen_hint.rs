@@ -133,11 +133,25 @@ impl SharpenHint {
     /// without the field, for other modes, or with a value outside
     /// [`Self::SMOOTH_FACTOR_HUNDREDTHS`] (the same 0.01 to 10 range).
     pub fn planar_of(header: &whet_format::Header) -> Option<(f64, u32)> {
+        Self::angle_step_factor(header, whet_format::tag::PLANAR_TOLERANCE)
+    }
+
+    /// The local quadric projection a swing stream's header states for after sharpening
+    /// and the planar-region projection (field 31): its move limit (the field's hundredths
+    /// over 100, in angle steps) and the stream's angle bits, for
+    /// `whet_sharpen::QuadricOptions::for_swing`; `None` as for [`Self::planar_of`].
+    pub fn quadric_of(header: &whet_format::Header) -> Option<(f64, u32)> {
+        Self::angle_step_factor(header, whet_format::tag::QUADRIC_PROJECTION)
+    }
+
+    /// A swing header's field `tag` as a factor in hundredths of the angle step, with the
+    /// stream's angle bits.
+    fn angle_step_factor(header: &whet_format::Header, tag: u64) -> Option<(f64, u32)> {
         if header.mode != whet_format::Mode::Swing {
             return None;
         }
         let factor = header
-            .get_u64(whet_format::tag::PLANAR_TOLERANCE)
+            .get_u64(tag)
             .filter(|h| Self::SMOOTH_FACTOR_HUNDREDTHS.contains(h))?;
         let bits = header
             .get_u64(whet_format::tag::ANGLE_BITS)
@@ -178,6 +192,29 @@ mod tests {
             .with(whet_format::tag::ANGLE_BITS, 6u64)
             .with(whet_format::tag::PLANAR_TOLERANCE, 100u64);
         assert_eq!(SharpenHint::planar_of(&exact), None);
+    }
+
+    #[test]
+    fn quadric_projection_is_read_from_swing_headers_only_and_in_range() {
+        let swing = whet_format::Header::new(whet_format::Mode::Swing, 3, 1)
+            .with(whet_format::tag::ANGLE_BITS, 7u64);
+        assert_eq!(SharpenHint::quadric_of(&swing), None);
+        let on = swing
+            .clone()
+            .with(whet_format::tag::QUADRIC_PROJECTION, 50u64);
+        assert_eq!(SharpenHint::quadric_of(&on), Some((0.5, 7)));
+        // Field 25 and field 31 are read apart.
+        assert_eq!(SharpenHint::planar_of(&on), None);
+        for bad in [0u64, 1001] {
+            let h = swing
+                .clone()
+                .with(whet_format::tag::QUADRIC_PROJECTION, bad);
+            assert_eq!(SharpenHint::quadric_of(&h), None);
+        }
+        let exact = whet_format::Header::new(whet_format::Mode::Exact, 3, 1)
+            .with(whet_format::tag::ANGLE_BITS, 6u64)
+            .with(whet_format::tag::QUADRIC_PROJECTION, 50u64);
+        assert_eq!(SharpenHint::quadric_of(&exact), None);
     }
 
     #[test]

@@ -174,9 +174,13 @@ pub mod tag {
     /// u64 (format 1.2, optional): how many EdgeSharpener passes go with
     /// [`SHARPEN_METHOD`] (swing; absent, or outside 1..=4: one).
     pub const SHARPEN_PASSES: u64 = 29;
+    /// u64 (format 1.2, optional): the local quadric projection a decoder applies after
+    /// sharpening and the planar-region projection, its move limit in hundredths of the
+    /// angle step (swing; absent, or outside 1..=1000: none).
+    pub const QUADRIC_PROJECTION: u64 = 31;
 
     /// Every tag this crate knows, with its name and value type.
-    pub const KNOWN: [(u64, &str, ValueType); 16] = [
+    pub const KNOWN: [(u64, &str, ValueType); 17] = [
         (ENCODER, "encoder", ValueType::Bytes),
         (COMPONENT_COUNT, "component_count", ValueType::U64),
         (QUANT_BITS, "quant_bits", ValueType::U64),
@@ -205,6 +209,7 @@ pub mod tag {
         (PLANAR_TOLERANCE, "planar_tolerance", ValueType::U64),
         (SHARPEN_CURVED_WALLS, "sharpen_curved_walls", ValueType::U64),
         (SHARPEN_PASSES, "sharpen_passes", ValueType::U64),
+        (QUADRIC_PROJECTION, "quadric_projection", ValueType::U64),
     ];
 
     /// Name and type of a known tag.

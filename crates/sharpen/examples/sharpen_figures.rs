@@ -169,7 +169,7 @@ fn swing(only: Option<String>) {
                 let name = match s.sharpen_hint {
                     Some(SharpenHint::Unsharpened) => "none".to_string(),
                     h => format!(
-                        "{} {}{}{}{}",
+                        "{} {}{}{}{}{}",
                         h.map_or("extended", SharpenHint::name),
                         s.smooth_factor,
                         match s.curved_walls {
@@ -181,7 +181,8 @@ fn swing(only: Option<String>) {
                         } else {
                             String::new()
                         },
-                        if s.planar { " + planes" } else { "" }
+                        if s.planar { " + planes" } else { "" },
+                        if s.quadric { " + quadrics" } else { "" }
                     ),
                 };
                 let d = error(&s.original, &s.decode_sharpen(), samples());

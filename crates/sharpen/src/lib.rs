@@ -9,7 +9,8 @@
 //! [`Method::NormalFilter`] is the normal-filtering sharpener of seed 002 (fillets, chamfers
 //! with samples, noisy creases; [`sharpen_region`] limits it to a [`VertexSelection`]).
 //! [`flatten_planar_regions`] moves the vertices inside a decoded mesh's flat faces onto
-//! their fitted planes (the swing decoder's quantization noise, which sharpening leaves).
+//! their fitted planes (the swing decoder's quantization noise, which sharpening leaves);
+//! [`project_onto_local_quadrics`] does the same for curved faces, vertex by vertex.
 //! See `docs/sharpen.md` for the rules and the degenerate cases.
 //!
 //! ```
@@ -34,6 +35,7 @@ mod extended;
 mod normal_filter;
 mod options;
 mod planar;
+mod quadric;
 mod report;
 mod slivers;
 mod snap;
@@ -52,6 +54,7 @@ pub const PEAK_BYTES_PER_TRIANGLE: u64 = 200;
 pub use normal_filter::VertexSelection;
 pub use options::{Method, SharpenOptions, DEFAULT_CURVED_WALL_FACTOR, MAX_PASSES};
 pub use planar::{flatten_planar_regions, PlanarOptions, PlanarReport};
+pub use quadric::{project_onto_local_quadrics, QuadricOptions, QuadricReport};
 pub use report::{SharpenReport, UnmovedReason};
 pub use tags::SharpTags;
 

@@ -113,12 +113,7 @@ pub fn flatten_planar_regions(
     opts: &PlanarOptions,
 ) -> Result<PlanarReport, Error> {
     opts.validate()?;
-    if let Some(v) = mesh.positions.iter().position(|p| !p.is_finite()) {
-        return Err(Error::InvalidInput(
-            whet_mesh::MeshError::NonFiniteCoordinate { vertex: v as u32 },
-        ));
-    }
-    let table = CornerTable::new(mesh).map_err(Error::InvalidInput)?;
+    let table = checked_table(mesh)?;
     let p = &mesh.positions;
     let nt = mesh.triangles.len();
     let (normals, area): (Vec<DVec3>, Vec<f64>) = (0..nt)
@@ -249,6 +244,17 @@ pub fn flatten_planar_regions(
     Ok(report)
 }
 
+/// The corner table of `mesh` for the post-sharpening passes, which need finite
+/// coordinates and an oriented manifold: [`Error::InvalidInput`] otherwise.
+pub(crate) fn checked_table(mesh: &Mesh) -> Result<CornerTable, Error> {
+    if let Some(v) = mesh.positions.iter().position(|p| !p.is_finite()) {
+        return Err(Error::InvalidInput(
+            whet_mesh::MeshError::NonFiniteCoordinate { vertex: v as u32 },
+        ));
+    }
+    CornerTable::new(mesh).map_err(Error::InvalidInput)
+}
+
 /// A plane fit of a region's vertices.
 struct PlaneFit {
     /// `normal . x = offset` on the least-squares plane.
@@ -341,7 +347,7 @@ fn fit_plane(pts: &[DVec3], normal: DVec3) -> Option<PlaneFit> {
 
 /// Solves the 6x6 system of augmented matrix `m` by Gaussian elimination with partial
 /// pivoting; `None` when it is singular.
-fn solve6(mut m: [[f64; 7]; 6]) -> Option<[f64; 6]> {
+pub(crate) fn solve6(mut m: [[f64; 7]; 6]) -> Option<[f64; 6]> {
     let norm = m
         .iter()
         .flat_map(|r| r[..6].iter())

@@ -72,6 +72,10 @@ pub struct SharpenTrial {
     /// With the planar-region projection after sharpening (optional header field 25, at
     /// [`PLANAR_FACTOR`]): tried on the best sharpening only.
     pub planar: bool,
+    /// With the local quadric projection after that (optional header field 31, at
+    /// [`QUADRIC_FACTOR`]): tried on the best sharpening, with the planar projection when
+    /// that was kept.
+    pub quadric: bool,
 }
 
 impl SharpenTrial {
@@ -95,6 +99,16 @@ pub const MAX_ERROR_WEIGHT: f64 = 0.25;
 /// in whet-sharpen), 2 and 3 gained the most, and below 1 the 6-bit rows gained less
 /// (docs/results.md).
 pub const PLANAR_FACTOR: f64 = 2.0;
+
+/// The local quadric projection's move limit, in angle steps, that the encoder tries after
+/// the best sharpening and the planar projection (`whet_sharpen::QuadricOptions::for_swing`;
+/// docs/swing.md section 2): a quarter step, about the RMS of the angle quantization's
+/// offset of a swing tip (a uniform error over one step has an RMS of 0.29 steps), so that
+/// a fit never moves a vertex much farther than its noise. Of 0.125, 0.25, 0.35, 0.5, 1 and
+/// 2 steps on the 42 sharpened swing rows of the sharpening figures (`quadric_sweep` in
+/// whet-sharpen), 0.25 gained the most where it was kept (docs/results.md, "Local quadric
+/// projection").
+pub const QUADRIC_FACTOR: f64 = 0.25;
 
 /// Options of [`SwingEncoder`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -274,6 +288,9 @@ pub struct SwingOutput {
     /// The planar-region projection after sharpening the stream states (optional header
     /// field 25: its tolerance in angle steps), when the encoder measured it better.
     pub planar_factor: Option<f64>,
+    /// The local quadric projection after those the stream states (optional header field
+    /// 31: its move limit in angle steps), when the encoder measured it better.
+    pub quadric_factor: Option<f64>,
     /// The candidates of that choice with their measured symmetric RMS error (% of the
     /// diagonal; empty when no choice was made).
     pub sharpen_trials: Vec<SharpenTrial>,
@@ -480,6 +497,7 @@ impl SwingEncoder {
             rms_pct: decoded,
             max_pct: decoded_max,
             planar: false,
+            quadric: false,
         };
         // Candidates whose output is the same mesh (curved walls that turn no edge smooth, a
         // second pass that changes nothing) are measured once.
@@ -506,6 +524,7 @@ impl SwingEncoder {
                 rms_pct: rms,
                 max_pct: max,
                 planar: false,
+                quadric: false,
             };
             trials.push(trial);
             if max <= input_max
@@ -536,9 +555,6 @@ impl SwingEncoder {
         };
         chosen.rms_pct = Some(chosen_trial.rms_pct);
         if chosen_trial.hint != SharpenHint::Unsharpened {
-            // The planar-region projection after the chosen sharpening: the flat faces'
-            // quantization noise, which the sharpener leaves (docs/swing.md section 2).
-            let planar = restate_planar(chosen.clone(), PLANAR_FACTOR)?;
             let opts = Candidate {
                 hint: Some(chosen_trial.hint),
                 smooth_factor: chosen_trial.smooth_factor,
@@ -546,21 +562,36 @@ impl SwingEncoder {
                 passes: chosen_trial.passes,
             }
             .sharpen_options();
-            let (rms, max) =
-                self.measure_sharpened(prep, &planar, &input, &opts, &mut Vec::new())?;
-            let projected = SharpenTrial {
-                rms_pct: rms,
-                max_pct: max,
-                planar: true,
-                ..chosen_trial
-            };
-            trials.push(projected);
-            if projected.score() < MARGIN * chosen_trial.score()
-                && max <= input_max.max(chosen_trial.max_pct)
-                && rms <= none.rms_pct
-            {
-                chosen = planar;
-                chosen.rms_pct = Some(rms);
+            // The projections after the chosen sharpening, each kept when it beats what it
+            // refines by the margin without raising the max or the RMS over their bounds:
+            // first the planar one (the flat faces' quantization noise, which the sharpener
+            // leaves), then the local quadric one (that of the curved faces; docs/swing.md
+            // section 2).
+            let mut current = chosen_trial;
+            let restated: [fn(SwingOutput) -> Result<SwingOutput, Error>; 2] = [
+                |o| restate_planar(o, PLANAR_FACTOR),
+                |o| restate_quadric(o, QUADRIC_FACTOR),
+            ];
+            for (k, restate) in restated.iter().enumerate() {
+                let projected = restate(chosen.clone())?;
+                let (rms, max) =
+                    self.measure_sharpened(prep, &projected, &input, &opts, &mut Vec::new())?;
+                let trial = SharpenTrial {
+                    rms_pct: rms,
+                    max_pct: max,
+                    planar: current.planar || k == 0,
+                    quadric: k == 1,
+                    ..current
+                };
+                trials.push(trial);
+                if trial.score() < MARGIN * current.score()
+                    && max <= input_max.max(chosen_trial.max_pct)
+                    && rms <= none.rms_pct
+                {
+                    chosen = projected;
+                    chosen.rms_pct = Some(rms);
+                    current = trial;
+                }
             }
         }
         chosen.sharpen_trials = trials;
@@ -800,6 +831,7 @@ impl SwingEncoder {
                 sharpen_curved_walls: info.sharpen_curved_walls,
                 sharpen_passes: info.sharpen_passes,
                 planar_factor: None,
+                quadric_factor: None,
                 sharpen_trials: Vec::new(),
                 sharpen_input_max_pct: None,
             });
@@ -1005,7 +1037,7 @@ impl SwingEncoder {
 
     /// [`Self::measure_figures`] of `whet decode --sharpen`'s output: `input`, `out`'s decoded
     /// mesh without its surface filter, sharpened, then the stream's filter for after
-    /// sharpening and its planar projection.
+    /// sharpening and its planar and quadric projections.
     fn measure_sharpened(
         &self,
         prep: &Prepared,
@@ -1023,6 +1055,11 @@ impl SwingEncoder {
                     // The sharpened mesh is a manifold; were it refused, the decoder keeps it
                     // unprojected too (with a warning).
                     let _ = whet_sharpen::flatten_planar_regions(&mut m, &opts);
+                }
+                if let Some(f) = out.quadric_factor {
+                    let opts = whet_sharpen::QuadricOptions::for_swing(out.angle_bits, f);
+                    // As above: a refused mesh is kept as it is, by the decoder too.
+                    let _ = whet_sharpen::project_onto_local_quadrics(&mut m, &opts);
                 }
                 Some(m)
             }
@@ -1323,6 +1360,17 @@ fn restate_planar(mut out: SwingOutput, factor: f64) -> Result<SwingOutput, Erro
         .ok_or_else(|| Error::Internal(format!("planar factor {factor} out of range")))?;
     out.bytes = with_header_field(&out.bytes, whet_format::tag::PLANAR_TOLERANCE, code)?;
     out.planar_factor = Some(code as f64 / 100.0);
+    Ok(out)
+}
+
+/// `out` with header field 31 stating the local quadric projection at a move limit of
+/// `factor` angle steps (rounded to the field's hundredths). Like field 25, its bytes come
+/// after the size search.
+fn restate_quadric(mut out: SwingOutput, factor: f64) -> Result<SwingOutput, Error> {
+    let code = SharpenHint::smooth_factor_code(factor)
+        .ok_or_else(|| Error::Internal(format!("quadric factor {factor} out of range")))?;
+    out.bytes = with_header_field(&out.bytes, whet_format::tag::QUADRIC_PROJECTION, code)?;
+    out.quadric_factor = Some(code as f64 / 100.0);
     Ok(out)
 }
 

@@ -72,6 +72,8 @@ pub struct SwingInput {
     pub passes: u32,
     /// The stream states the planar-region projection after sharpening (field 25).
     pub planar: bool,
+    /// The stream states the local quadric projection after sharpening (field 31).
+    pub quadric: bool,
     /// The stream.
     pub bytes: Vec<u8>,
 }
@@ -92,6 +94,11 @@ impl SwingInput {
         if let Some((factor, bits)) = whet_codec::SharpenHint::planar_of(&header) {
             let opts = whet_sharpen::PlanarOptions::for_swing(bits, factor);
             whet_sharpen::flatten_planar_regions(&mut m, &opts).unwrap_or_else(|e| panic!("{e}"));
+        }
+        if let Some((factor, bits)) = whet_codec::SharpenHint::quadric_of(&header) {
+            let opts = whet_sharpen::QuadricOptions::for_swing(bits, factor);
+            whet_sharpen::project_onto_local_quadrics(&mut m, &opts)
+                .unwrap_or_else(|e| panic!("{e}"));
         }
         m
     }
@@ -131,7 +138,7 @@ pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
         .unwrap_or_else(|e| panic!("{name}: {e}"));
     let dir = whet_testkit::workspace_root().join("target/sharpen-swing");
     let _ = std::fs::create_dir_all(&dir);
-    let path = dir.join(format!("v22-{name}-{bpv}-{}.whet", angles.tag()));
+    let path = dir.join(format!("v24-{name}-{bpv}-{}.whet", angles.tag()));
     let bytes = match std::fs::read(&path) {
         Ok(b) => b,
         Err(_) => {
@@ -166,6 +173,7 @@ pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
         curved_walls: whet_codec::SharpenHint::curved_walls_of(&header),
         passes: whet_codec::SharpenHint::passes_of(&header).unwrap_or(1),
         planar: whet_codec::SharpenHint::planar_of(&header).is_some(),
+        quadric: whet_codec::SharpenHint::quadric_of(&header).is_some(),
         original,
         decoded,
         bytes,

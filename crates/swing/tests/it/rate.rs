@@ -209,10 +209,14 @@ fn automatic_angle_bits_climb_on_flat_parts_and_stay_low_on_smooth_ones() {
     assert_eq!(decoded, out.retiled);
     // The sharpening choice retiled its candidates at the chosen bits (twelve methods,
     // factors and curved walls, in one pass and in two, each the same retiling, and none),
-    // then tried the chosen one with the planar-region projection.
-    let unprojected = out.sharpen_trials.iter().filter(|t| !t.planar).count();
+    // then tried the chosen one with the planar-region projection and the local quadric one.
+    let unprojected = out
+        .sharpen_trials
+        .iter()
+        .filter(|t| !t.planar && !t.quadric)
+        .count();
     assert_eq!(unprojected, 25, "{:?}", out.sharpen_trials);
-    assert!(out.sharpen_trials.len() <= 26, "{:?}", out.sharpen_trials);
+    assert!(out.sharpen_trials.len() <= 27, "{:?}", out.sharpen_trials);
 
     // spot, smooth: every bit is paid for on curved patches (measured: 5-6 bits best).
     let out = encode(
@@ -276,17 +280,65 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
         let hint = out.sharpen_hint.unwrap();
         assert_ne!(hint, not, "{name}: {:?}", out.sharpen_trials);
         assert_eq!(SharpenHint::of(&header(&out.bytes)), Some(hint));
-        // 25 candidates, then the chosen sharpening with the planar-region projection.
-        let (planar, trials): (Vec<&whet_swing::SharpenTrial>, Vec<_>) =
-            out.sharpen_trials.iter().partition(|t| t.planar);
+        // 25 candidates, then the chosen sharpening with the planar-region projection, then
+        // with the local quadric projection (on top of the planar one when that was kept).
+        let (projected, trials): (Vec<&whet_swing::SharpenTrial>, Vec<_>) = out
+            .sharpen_trials
+            .iter()
+            .partition(|t| t.planar || t.quadric);
+        let (quadric, planar): (Vec<&whet_swing::SharpenTrial>, Vec<_>) =
+            projected.into_iter().partition(|t| t.quadric);
         assert_eq!(trials.len(), 25, "{name}");
-        assert_eq!(planar.len(), usize::from(hint != SharpenHint::Unsharpened));
+        let sharpened = usize::from(hint != SharpenHint::Unsharpened);
+        assert_eq!(planar.len(), sharpened, "{name}");
+        assert_eq!(quadric.len(), sharpened, "{name}");
         let h = header(&out.bytes);
         let stated = SharpenHint::planar_of(&h);
         assert_eq!(stated.map(|s| s.0), out.planar_factor, "{name}");
-        // The reported error is the chosen candidate's (with the projection when its score
-        // won by the margin), the lowest score of the 25 but for the margin.
-        let chosen = out.rms_pct.unwrap();
+        let stated = SharpenHint::quadric_of(&h);
+        assert_eq!(stated.map(|s| s.0), out.quadric_factor, "{name}");
+        // The candidate a projection trial refines: the same sharpening unprojected.
+        let same_sharpening = |p: &whet_swing::SharpenTrial| {
+            **trials
+                .iter()
+                .find(|t| {
+                    t.hint == p.hint
+                        && t.smooth_factor == p.smooth_factor
+                        && t.curved_walls == p.curved_walls
+                        && t.passes == p.passes
+                })
+                .unwrap()
+        };
+        // The quadric trial refines the planar one when that was kept, else the chosen
+        // sharpening; it is stated when its score won by the margin.
+        if let Some(q) = quadric.first() {
+            assert_eq!(q.planar, out.planar_factor.is_some(), "{name}");
+            let refined = if q.planar {
+                planar[0].score()
+            } else {
+                same_sharpening(q).score()
+            };
+            assert_eq!(
+                out.quadric_factor.is_some(),
+                q.score() < 0.995 * refined,
+                "{name}: {:?}",
+                out.sharpen_trials
+            );
+        }
+        // The reported error is the chosen candidate's (with the projections when their
+        // scores won by the margin), the lowest score of the 25 but for the margin.
+        let chosen = match (out.quadric_factor, quadric.first()) {
+            (Some(f), Some(q)) => {
+                assert_eq!(f, whet_swing::QUADRIC_FACTOR);
+                assert_eq!(q.rms_pct, out.rms_pct.unwrap(), "{name}");
+                match out.planar_factor {
+                    Some(_) => planar[0].rms_pct,
+                    None => same_sharpening(q).rms_pct,
+                }
+            }
+            (None, _) => out.rms_pct.unwrap(),
+            (Some(_), None) => panic!("{name}: quadric projection stated without its trial"),
+        };
         let unprojected = match (out.planar_factor, planar.first()) {
             (Some(f), Some(p)) => {
                 assert_eq!(f, whet_swing::PLANAR_FACTOR);
