@@ -21,8 +21,10 @@
 #![forbid(unsafe_code)]
 
 mod bender;
+mod fuzz;
 
 pub use bender::{bend, bend_levels, zorin_weights, Bent};
+pub use fuzz::fuzz_bend;
 
 /// Most triangles [`bend_levels`] produces: the codec's default triangle limit, 2^28
 /// (Bender needs about 46 bytes per output triangle at peak, measured on three levels of

@@ -32,6 +32,7 @@
 
 mod edge_sharpener;
 mod extended;
+mod fuzz;
 mod normal_filter;
 mod options;
 mod planar;
@@ -51,6 +52,7 @@ pub use edge_sharpener::EdgeSharpener;
 /// memory budget with (`whet decode --sharpen --max-memory`).
 pub const PEAK_BYTES_PER_TRIANGLE: u64 = 200;
 
+pub use fuzz::{fuzz_input, fuzz_seed, fuzz_sharpen};
 pub use normal_filter::VertexSelection;
 pub use options::{Method, SharpenOptions, DEFAULT_CURVED_WALL_FACTOR, MAX_PASSES};
 pub use planar::{flatten_planar_regions, PlanarOptions, PlanarReport};
@@ -66,7 +68,8 @@ use whet_mesh::{FaceId, Mesh, MeshError};
 pub struct Sharpened {
     /// The sharpened mesh: the input vertices at their input indices (those the extended
     /// method welded into a near-coincident neighbour are used by no triangle), then the new
-    /// vertices.
+    /// vertices. The normal-filter method instead keeps the vertices its needle collapses
+    /// leave, in input order, and adds none.
     pub mesh: Mesh,
     /// For each triangle of `mesh`, the input triangle it was cut from (or is): lets callers
     /// carry per-face attributes over, and is what the orientation guarantee refers to.

@@ -1,0 +1,69 @@
+//! The Bender half of the `sharpen` cargo-fuzz target (`fuzz/`): one level over whatever
+//! the sharpener and the projections made of an arbitrary small mesh, as `whet decode
+//! --sharpen --bend 1` runs it. Shared with the stable replay test of the target's corpus.
+
+use crate::{bend, Error};
+use whet_mesh::Mesh;
+
+/// Bends `mesh` one level with its sharp edges `sharp_edges` and checks the result: a clean
+/// refusal of a mesh Bender cannot take (not an oriented manifold: the extended sharpener's
+/// welded vertices stay in the mesh unused), or four triangles for each, the old vertices
+/// unchanged and first, finite new vertices, an oriented manifold, and sharp edges in range
+/// (pillows, two triangles back to back, pass through whole).
+/// Panics only on a bug.
+pub fn fuzz_bend(mesh: &Mesh, sharp_edges: &[[u32; 2]]) {
+    let bent = match bend(mesh, sharp_edges) {
+        Ok(b) => b,
+        Err(Error::Mesh(_)) => return,
+        Err(e) => panic!("bend refused a sharpened mesh: {e}"),
+    };
+    let out = &bent.mesh;
+    let n = mesh.positions.len();
+    // Four triangles for one, except pillows (two triangles back to back over the same
+    // three vertices), which pass through whole.
+    assert_eq!(
+        out.triangles.len(),
+        4 * mesh.triangles.len() - 3 * pillow_triangles(mesh),
+        "four triangles for one"
+    );
+    assert_eq!(
+        &out.positions[..n],
+        &mesh.positions[..],
+        "old vertices moved"
+    );
+    assert!(
+        out.positions.iter().all(|p| p.is_finite()),
+        "non-finite vertex"
+    );
+    let m = out.positions.len() as u32;
+    assert!(
+        out.triangles.iter().flatten().all(|&v| v < m),
+        "index out of range"
+    );
+    assert!(
+        bent.sharp_edges.iter().flatten().all(|&v| v < m),
+        "sharp edge out of range"
+    );
+    let report = out.topology_report();
+    assert!(
+        report.manifold && report.oriented,
+        "not an oriented manifold"
+    );
+}
+
+/// Triangles that have a twin over the same three vertices (the halves of pillows).
+fn pillow_triangles(mesh: &Mesh) -> usize {
+    let mut keys: Vec<[u32; 3]> = mesh
+        .triangles
+        .iter()
+        .map(|t| {
+            let mut k = *t;
+            k.sort_unstable();
+            k
+        })
+        .collect();
+    keys.sort_unstable();
+    (0..keys.len())
+        .filter(|&i| (i > 0 && keys[i - 1] == keys[i]) || keys.get(i + 1) == Some(&keys[i]))
+        .count()
+}

@@ -1,0 +1,233 @@
+//! The entry point of the `sharpen` cargo-fuzz target (`fuzz/`), shared with the stable
+//! replay test of its corpus, so a crasher the fuzzer finds is re-checked by `cargo test`.
+//!
+//! `whet decode --sharpen` runs the sharpener and the projections on whatever mesh a stream
+//! decodes to, and `whet sharpen` on any file: tiny, folded, coplanar, with coincident
+//! vertices and zero-area triangles. The marching-cubes property test covers noisy samplings
+//! of solids; this target covers arbitrary small topology on a coarse grid, where exact
+//! coincidences and exact coplanarity are common.
+
+use crate::{
+    flatten_planar_regions, project_onto_local_quadrics, sharpen, Error, Method, PlanarOptions,
+    QuadricOptions, SharpenOptions,
+};
+use whet_mesh::{DVec3, Mesh};
+
+/// Most vertices an input can have (small meshes keep each run short).
+const MAX_VERTICES: usize = 48;
+/// Most triangles an input can have.
+const MAX_TRIANGLES: usize = 160;
+/// The smooth factors bits 5-7 of the first byte pick (0: the default).
+const SMOOTH_FACTORS: [f64; 8] = [2.0, 0.5, 1.0, 1.5, 2.5, 3.0, 3.5, 4.0];
+
+/// The mesh and options an input describes, or `None` when it is too short.
+///
+/// Byte 0 picks the options (bits 0-1 the method: extended, papers, normal filter; bit 2
+/// turns the welding off; bit 3 a second pass; bit 4 the curved walls; bits 5-7 the smooth
+/// factor: 2 by default, else 0.5 to 4). Byte 1 the angle bits (3 to 14) and byte 2 the move factor of the two
+/// projections after sharpening, as a swing stream states them. Byte 3 the vertex count
+/// (4 to 48), then three bytes per vertex (a grid of sixteenths: coincidences and
+/// coplanarity are common), then three bytes per triangle (vertex indices modulo the count).
+pub fn fuzz_input(data: &[u8]) -> Option<(Mesh, SharpenOptions, PlanarOptions, QuadricOptions)> {
+    let (&flags, rest) = data.split_first()?;
+    let (&bits, rest) = rest.split_first()?;
+    let (&factor, rest) = rest.split_first()?;
+    let (&count, rest) = rest.split_first()?;
+    let n = 4 + count as usize % (MAX_VERTICES - 3);
+    if rest.len() < 3 * n {
+        return None;
+    }
+    let (coords, tris) = rest.split_at(3 * n);
+    let positions: Vec<DVec3> = coords
+        .chunks_exact(3)
+        .map(|c| DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64) / 16.0)
+        .collect();
+    let triangles: Vec<[u32; 3]> = tris
+        .chunks_exact(3)
+        .take(MAX_TRIANGLES)
+        .map(|t| [t[0], t[1], t[2]].map(|i| (i as usize % n) as u32))
+        .collect();
+    let method = match flags & 3 {
+        0 | 3 => Method::Extended,
+        1 => Method::Papers,
+        _ => Method::NormalFilter,
+    };
+    let mut opts = SharpenOptions::DEFAULT
+        .with_method(method)
+        .with_smooth_factor(SMOOTH_FACTORS[usize::from(flags >> 5)])
+        .with_weld_clusters(flags & 4 == 0)
+        .with_passes(1 + u32::from(flags & 8 != 0));
+    if flags & 16 != 0 {
+        opts = opts.with_curved_wall_factor(crate::DEFAULT_CURVED_WALL_FACTOR);
+    }
+    let angle_bits = 3 + u32::from(bits) % 12;
+    let move_factor = f64::from(factor) / 100.0;
+    Some((
+        Mesh::new(positions, triangles),
+        opts,
+        PlanarOptions::for_swing(angle_bits, move_factor),
+        QuadricOptions::for_swing(angle_bits, move_factor),
+    ))
+}
+
+/// Sharpens the mesh `data` describes ([`fuzz_input`]) as `whet sharpen` does (cut to a
+/// manifold first when it is not one), then runs the two projections after sharpening.
+/// Panics only on a bug: a panic inside, an internal error, or an output that breaks the
+/// guarantees (indices in range, finite positions, an oriented manifold with the input's
+/// boundary, one parent per triangle, the input's vertices first). Returns the projected
+/// mesh and its sharp-edge tags (for Bender, as `whet decode --sharpen --bend` runs it), or
+/// `None` when the input is refused.
+pub fn fuzz_sharpen(data: &[u8]) -> Option<(Mesh, Vec<[u32; 2]>)> {
+    let (mut mesh, opts, planar, quadric) = fuzz_input(data)?;
+    let report = mesh.topology_report();
+    if !(report.manifold && report.oriented && report.problems.is_empty()) {
+        mesh.make_manifold();
+    }
+    let out = match sharpen(&mesh, &opts) {
+        Ok(out) => out,
+        Err(Error::Internal(e)) => panic!("internal error: {e}"),
+        // make_manifold's output is accepted; anything else refused is refused cleanly.
+        Err(_) => return None,
+    };
+    let mut sharp = out.mesh;
+    check_output(&mesh, &sharp, opts.method != Method::NormalFilter);
+    assert_eq!(
+        out.parents.len(),
+        sharp.triangles.len(),
+        "one parent per triangle"
+    );
+    assert!(
+        out.parents.iter().all(|f| f.index() < mesh.triangles.len()),
+        "parent out of range"
+    );
+    if opts.method == Method::Papers {
+        assert_eq!(
+            &sharp.positions[..mesh.positions.len()],
+            &mesh.positions[..],
+            "the papers' method moved an input vertex"
+        );
+    }
+    let before = sharp.clone();
+    match flatten_planar_regions(&mut sharp, &planar) {
+        Ok(_) | Err(Error::InvalidInput(_)) => {}
+        Err(e) => panic!("planar projection: {e}"),
+    }
+    check_moved_only(&before, &sharp, "planar projection");
+    let before = sharp.clone();
+    match project_onto_local_quadrics(&mut sharp, &quadric) {
+        Ok(_) | Err(Error::InvalidInput(_)) => {}
+        Err(e) => panic!("quadric projection: {e}"),
+    }
+    check_moved_only(&before, &sharp, "quadric projection");
+    let edges = out.tags.edges.iter().map(|e| [e[0].0, e[1].0]).collect();
+    Some((sharp, edges))
+}
+
+/// The [`fuzz_sharpen`] input describing `mesh` (scaled into the byte grid) with option
+/// bytes `flags`, `bits` and `factor`; `None` when the mesh has under 4 or over 48 vertices
+/// or over 160 triangles. Builds the seeds of the target's corpus.
+pub fn fuzz_seed(mesh: &Mesh, flags: u8, bits: u8, factor: u8) -> Option<Vec<u8>> {
+    let n = mesh.positions.len();
+    if !(4..=MAX_VERTICES).contains(&n) || mesh.triangles.len() > MAX_TRIANGLES {
+        return None;
+    }
+    let bbox = mesh.bounding_box();
+    let extent = (bbox.max - bbox.min).max_element();
+    let scale = if extent > 0.0 { 255.0 / extent } else { 0.0 };
+    let mut out = vec![flags, bits, factor, (n - 4) as u8];
+    for p in &mesh.positions {
+        let g = ((*p - bbox.min) * scale).round();
+        out.extend([g.x, g.y, g.z].map(|c| c.clamp(0.0, 255.0) as u8));
+    }
+    for t in &mesh.triangles {
+        out.extend(t.map(|v| v as u8));
+    }
+    Some(out)
+}
+
+/// `output` is a valid sharpening of `input`: indices in range, finite positions, an
+/// oriented manifold with the same boundary edge count and, when `keeps_vertices` (the
+/// EdgeSharpener methods; the normal filter's needle collapses remove vertices), at least
+/// the input's vertices.
+fn check_output(input: &Mesh, output: &Mesh, keeps_vertices: bool) {
+    let stage = "sharpen";
+    let n = output.positions.len();
+    assert!(
+        !keeps_vertices || n >= input.positions.len(),
+        "{stage}: vertices lost"
+    );
+    assert!(
+        output.triangles.iter().flatten().all(|&v| (v as usize) < n),
+        "{stage}: index out of range"
+    );
+    assert!(
+        output.positions.iter().all(|p| p.is_finite()),
+        "{stage}: non-finite position"
+    );
+    let (a, b) = (input.topology_report(), output.topology_report());
+    assert!(
+        b.manifold && b.oriented,
+        "{stage}: output not an oriented manifold"
+    );
+    assert_eq!(
+        a.boundary_edges, b.boundary_edges,
+        "{stage}: boundary changed"
+    );
+}
+
+/// A projection moved vertices only, to finite places.
+fn check_moved_only(before: &Mesh, after: &Mesh, stage: &str) {
+    assert_eq!(
+        before.triangles, after.triangles,
+        "{stage}: triangles changed"
+    );
+    assert_eq!(
+        before.positions.len(),
+        after.positions.len(),
+        "{stage}: vertex count changed"
+    );
+    assert!(
+        after.positions.iter().all(|p| p.is_finite()),
+        "{stage}: non-finite position"
+    );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A closed tetrahedron (4 vertices, 4 triangles) with every option byte zero.
+    fn tetrahedron(flags: u8) -> Vec<u8> {
+        let mut d = vec![flags, 3, 50, 0];
+        d.extend_from_slice(&[0, 0, 0, 32, 0, 0, 0, 32, 0, 0, 0, 32]);
+        d.extend_from_slice(&[0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3]);
+        d
+    }
+
+    #[test]
+    fn input_layout_is_as_documented() {
+        let (mesh, opts, _, _) = fuzz_input(&tetrahedron(0b0011_1101)).unwrap();
+        assert_eq!(mesh.positions.len(), 4);
+        assert_eq!(mesh.positions[1], DVec3::new(2.0, 0.0, 0.0));
+        assert_eq!(
+            mesh.triangles,
+            vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]
+        );
+        assert_eq!(opts.method, Method::Papers);
+        assert!(!opts.weld_clusters);
+        assert_eq!(opts.passes, 2);
+        assert_eq!(opts.smooth_factor, 0.5);
+        assert!(opts.curved_wall_factor.is_some());
+        assert!(
+            fuzz_input(&tetrahedron(0)[..15]).is_none(),
+            "too short for 4 vertices"
+        );
+    }
+
+    #[test]
+    fn every_method_keeps_a_tetrahedron_valid() {
+        for flags in 0..=255u8 {
+            fuzz_sharpen(&tetrahedron(flags));
+        }
+    }
+}
