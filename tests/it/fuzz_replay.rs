@@ -187,16 +187,13 @@ fn sharpen_seed_inputs() -> Vec<(String, Vec<u8>)> {
             (p.x, p.z) = (6.0, p.x - 5.0);
         }
     }
-    let mut channel = grid(8, 3);
-    for p in &mut channel.positions {
-        // A U: walls at x = 2 and x = 6 joined to the floor by 45-degree chamfers.
-        if p.x < 3.0 {
-            (p.x, p.z) = (2.0, 3.0 - p.x);
-        } else if p.x > 5.0 {
-            (p.x, p.z) = (6.0, p.x - 5.0);
-        }
+    let mut bent = grid(5, 5);
+    for p in &mut bent.positions {
+        // A shallow cylinder-like bend with a little deterministic noise: curved, no crease.
+        p.z = 0.08 * (p.x - 2.5) * (p.x - 2.5) + 0.02 * ((p.x * 3.0 + p.y * 5.0) % 3.0 - 1.0);
     }
     let cases = [
+        ("bent_grid", bent, 0b0000_0001),
         ("chamfered_cube_extended", cube.clone(), 0b0100_0000u8),
         ("chamfered_cube_papers", cube.clone(), 0b0010_0001),
         ("chamfered_cube_normal_filter", cube, 2),
@@ -218,26 +215,39 @@ fn sharpen_seed_inputs() -> Vec<(String, Vec<u8>)> {
         .collect()
 }
 
-/// The folded grid and the channel are sharpened (their chamfers found and cut), so the
-/// corpus starts where the sharpener does real work; the chamfered cube, its faces only two
-/// triangles each, has no smooth region to start from at this size. `WHET_WRITE_FUZZ_SEEDS=1` (re)writes
-/// the seed files.
+/// The folded grid and the channel are sharpened (their chamfers found and cut) and the
+/// bent grid gets quadric fits, so the corpus starts where the sharpener and the projection
+/// do real work; the chamfered cube, its faces only two triangles each, has no smooth region
+/// to start from at this size. The committed seed files are these inputs;
+/// `WHET_WRITE_FUZZ_SEEDS=1` (re)writes them.
 #[test]
 fn sharpen_seeds_exercise_the_sharpener() {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fuzz/corpus/sharpen");
     for (name, seed) in sharpen_seed_inputs() {
+        let (mesh, opts, _, quadric) = whet_sharpen::fuzz_input(&seed).unwrap();
+        let out = whet_sharpen::sharpen(&mesh, &opts).unwrap();
         if name.starts_with("folded") || name == "channel" {
-            let (mesh, opts, _, _) = whet_sharpen::fuzz_input(&seed).unwrap();
-            let out = whet_sharpen::sharpen(&mesh, &opts).unwrap();
             assert!(out.report.chamfer_edges > 0, "{name}: {:?}", out.report);
             assert!(out.mesh.positions.len() > mesh.positions.len(), "{name}");
         }
+        if name == "bent_grid" {
+            let mut m = out.mesh.clone();
+            let rep = whet_sharpen::project_onto_local_quadrics(&mut m, &quadric).unwrap();
+            assert!(rep.moved_vertices > 0, "{name}: {rep:?}");
+        }
         let (sharp, edges) = whet_sharpen::fuzz_sharpen(&seed).unwrap();
         whet_bend::fuzz_bend(&sharp, &edges);
+        let path = dir.join(format!("seed-{name}"));
         if std::env::var_os("WHET_WRITE_FUZZ_SEEDS").is_some() {
             std::fs::create_dir_all(&dir).unwrap();
-            std::fs::write(dir.join(format!("seed-{name}")), &seed).unwrap();
+            std::fs::write(&path, &seed).unwrap();
         }
+        assert_eq!(
+            std::fs::read(&path).ok().as_ref(),
+            Some(&seed),
+            "{} is stale: WHET_WRITE_FUZZ_SEEDS=1 rewrites it",
+            path.display()
+        );
     }
 }
 

@@ -11,7 +11,7 @@ use crate::{
     flatten_planar_regions, project_onto_local_quadrics, sharpen, Error, Method, PlanarOptions,
     QuadricOptions, SharpenOptions,
 };
-use whet_mesh::{DVec3, Mesh};
+use whet_mesh::{CornerTable, DVec3, Mesh, MeshError, VertexId};
 
 /// Most vertices an input can have (small meshes keep each run short).
 const MAX_VERTICES: usize = 48;
@@ -24,10 +24,11 @@ const SMOOTH_FACTORS: [f64; 8] = [2.0, 0.5, 1.0, 1.5, 2.5, 3.0, 3.5, 4.0];
 ///
 /// Byte 0 picks the options (bits 0-1 the method: extended, papers, normal filter; bit 2
 /// turns the welding off; bit 3 a second pass; bit 4 the curved walls; bits 5-7 the smooth
-/// factor: 2 by default, else 0.5 to 4). Byte 1 the angle bits (3 to 14) and byte 2 the move factor of the two
-/// projections after sharpening, as a swing stream states them. Byte 3 the vertex count
-/// (4 to 48), then three bytes per vertex (a grid of sixteenths: coincidences and
-/// coplanarity are common), then three bytes per triangle (vertex indices modulo the count).
+/// factor: 2 by default, else 0.5 to 4). Byte 1 the angle bits (3 to 14) and byte 2 the
+/// move factor of the two projections after sharpening (0.01 to 10 angle steps), as a
+/// swing stream states them. Byte 3 the vertex count (4 to 48), then three bytes per vertex
+/// (a grid of sixteenths: coincidences and coplanarity are common), then three bytes per
+/// triangle (vertex indices modulo the count).
 pub fn fuzz_input(data: &[u8]) -> Option<(Mesh, SharpenOptions, PlanarOptions, QuadricOptions)> {
     let (&flags, rest) = data.split_first()?;
     let (&bits, rest) = rest.split_first()?;
@@ -61,7 +62,8 @@ pub fn fuzz_input(data: &[u8]) -> Option<(Mesh, SharpenOptions, PlanarOptions, Q
         opts = opts.with_curved_wall_factor(crate::DEFAULT_CURVED_WALL_FACTOR);
     }
     let angle_bits = 3 + u32::from(bits) % 12;
-    let move_factor = f64::from(factor) / 100.0;
+    // The range a stream's header allows: 0.01 to 10 angle steps.
+    let move_factor = f64::from(1 + u32::from(factor) * 999 / 255) / 100.0;
     Some((
         Mesh::new(positions, triangles),
         opts,
@@ -85,9 +87,14 @@ pub fn fuzz_sharpen(data: &[u8]) -> Option<(Mesh, Vec<[u32; 2]>)> {
     }
     let out = match sharpen(&mesh, &opts) {
         Ok(out) => out,
-        Err(Error::Internal(e)) => panic!("internal error: {e}"),
-        // make_manifold's output is accepted; anything else refused is refused cleanly.
-        Err(_) => return None,
+        // The normal filter alone refuses triangles of zero area (make_manifold keeps them)
+        // and non-uniform samplings; the EdgeSharpener methods take any make_manifold output.
+        Err(Error::InvalidInput(MeshError::ZeroAreaTriangle { .. }) | Error::Parameter(_))
+            if opts.method == Method::NormalFilter =>
+        {
+            return None
+        }
+        Err(e) => panic!("{:?} refused a make_manifold output: {e}", opts.method),
     };
     let mut sharp = out.mesh;
     check_output(&mesh, &sharp, opts.method != Method::NormalFilter);
@@ -107,18 +114,19 @@ pub fn fuzz_sharpen(data: &[u8]) -> Option<(Mesh, Vec<[u32; 2]>)> {
             "the papers' method moved an input vertex"
         );
     }
+    // Both projections take every sharpened mesh (an oriented manifold, finite), move only
+    // interior vertices and by at most their limits in mean edge lengths: the planar
+    // projection half an edge, the quadric one its option.
     let before = sharp.clone();
-    match flatten_planar_regions(&mut sharp, &planar) {
-        Ok(_) | Err(Error::InvalidInput(_)) => {}
-        Err(e) => panic!("planar projection: {e}"),
+    if let Err(e) = flatten_planar_regions(&mut sharp, &planar) {
+        panic!("planar projection refused a sharpened mesh: {e}");
     }
-    check_moved_only(&before, &sharp, "planar projection");
+    check_moves(&before, &sharp, 0.5, "planar projection");
     let before = sharp.clone();
-    match project_onto_local_quadrics(&mut sharp, &quadric) {
-        Ok(_) | Err(Error::InvalidInput(_)) => {}
-        Err(e) => panic!("quadric projection: {e}"),
+    if let Err(e) = project_onto_local_quadrics(&mut sharp, &quadric) {
+        panic!("quadric projection refused a sharpened mesh: {e}");
     }
-    check_moved_only(&before, &sharp, "quadric projection");
+    check_moves(&before, &sharp, quadric.max_move, "quadric projection");
     let edges = out.tags.edges.iter().map(|e| [e[0].0, e[1].0]).collect();
     Some((sharp, edges))
 }
@@ -175,8 +183,9 @@ fn check_output(input: &Mesh, output: &Mesh, keeps_vertices: bool) {
     );
 }
 
-/// A projection moved vertices only, to finite places.
-fn check_moved_only(before: &Mesh, after: &Mesh, stage: &str) {
+/// A projection moved vertices only, to finite places: interior vertices, each by at most
+/// `limit` mean edge lengths of `before`.
+fn check_moves(before: &Mesh, after: &Mesh, limit: f64, stage: &str) {
     assert_eq!(
         before.triangles, after.triangles,
         "{stage}: triangles changed"
@@ -190,13 +199,31 @@ fn check_moved_only(before: &Mesh, after: &Mesh, stage: &str) {
         after.positions.iter().all(|p| p.is_finite()),
         "{stage}: non-finite position"
     );
+    let table = CornerTable::new(before).expect("checked before");
+    let bound = limit * table.mean_edge_length(&before.positions) * (1.0 + 1e-9);
+    for (v, (a, b)) in before.positions.iter().zip(&after.positions).enumerate() {
+        if a == b {
+            continue;
+        }
+        let vid = VertexId(v as u32);
+        assert!(
+            table.vertex_corner(vid).is_some() && !table.is_boundary_vertex(vid),
+            "{stage}: unused or boundary vertex {v} moved"
+        );
+        assert!(
+            a.distance(*b) <= bound,
+            "{stage}: vertex {v} moved {} past {bound}",
+            a.distance(*b)
+        );
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// A closed tetrahedron (4 vertices, 4 triangles) with every option byte zero.
+    /// A closed tetrahedron (4 vertices, 4 triangles) with option byte `flags`, 3 angle bits
+    /// and a move factor of about 2 steps.
     fn tetrahedron(flags: u8) -> Vec<u8> {
         let mut d = vec![flags, 3, 50, 0];
         d.extend_from_slice(&[0, 0, 0, 32, 0, 0, 0, 32, 0, 0, 0, 32]);

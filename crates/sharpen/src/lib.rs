@@ -86,7 +86,7 @@ pub struct Sharpened {
 pub enum Error {
     /// The mesh is not an oriented manifold with valid indices and finite coordinates. The
     /// error names the first offender; run `Mesh::make_manifold` first to accept any input.
-    #[error("the mesh cannot be sharpened: {0} (run make_manifold first)")]
+    #[error("the mesh cannot be sharpened: {0}{hint}", hint = repair_hint(.0))]
     InvalidInput(MeshError),
     /// An option out of range (API misuse).
     #[error("bad sharpen option: {0}")]
@@ -105,6 +105,19 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
+}
+
+/// What a caller can do about an [`Error::InvalidInput`]: `make_manifold` repairs the
+/// structure, not a zero-area triangle (which only the normal-filter method refuses).
+fn repair_hint(e: &MeshError) -> &'static str {
+    match e {
+        MeshError::ZeroAreaTriangle { .. } => {
+            " (the normal-filter method needs triangles of nonzero area; the extended and \
+             papers methods take them)"
+        }
+        e if e.is_structural() => " (run make_manifold first)",
+        _ => "",
+    }
 }
 
 impl Error {

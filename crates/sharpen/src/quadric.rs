@@ -13,12 +13,17 @@ use whet_mesh::{Mesh, VertexId};
 use crate::planar::{checked_table, solve6};
 use crate::Error;
 
+/// Most points a fit gathers, per square of its ring count: 144 for three rings, about four
+/// times what a regular mesh's three rings hold (37). A vertex whose rings hold more stays.
+const MAX_POINTS_PER_SQUARED_RING: usize = 16;
+
 /// Options of [`project_onto_local_quadrics`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct QuadricOptions {
     /// How many rings of neighbours each fit takes (the vertex's own position included):
-    /// 1 to 4.
+    /// 1 to 4. A fit needs 12 points, so one ring fits only around vertices of valence 11
+    /// or more: on regular meshes it moves nothing.
     pub rings: usize,
     /// Largest angle, in degrees, between a vertex's normal and that of any vertex of its
     /// rings: past it the rings cross a crease or a bend too tight for a quadric, and the
@@ -132,6 +137,10 @@ pub fn project_onto_local_quadrics(
         return Ok(QuadricReport::default());
     }
     const NONE: u32 = u32::MAX;
+    // Rings that hold more points than this have a vertex of high valence: such a vertex is
+    // no regular surface sample, and without the cap each of its neighbours would walk
+    // its whole fan, quadratic in its valence (a hostile stream can decode to one).
+    let max_points = MAX_POINTS_PER_SQUARED_RING * opts.rings * opts.rings;
     // The vertex whose rings last gathered each vertex.
     let mut stamp = vec![NONE; nv];
     let mut ring: Vec<u32> = Vec::new();
@@ -155,7 +164,7 @@ pub fn project_onto_local_quadrics(
                     let w = table.vertex(table.next(c)).0;
                     if stamp[w as usize] != v as u32 {
                         stamp[w as usize] = v as u32;
-                        if normals[w as usize].dot(n) < cos_max {
+                        if normals[w as usize].dot(n) < cos_max || ring.len() >= max_points {
                             continue 'vertices;
                         }
                         ring.push(w);
@@ -319,6 +328,47 @@ mod tests {
         for (a, b) in before.positions.iter().zip(&m.positions) {
             assert!(a.distance(*b) <= 0.01 * edge * (1.0 + 1e-9));
         }
+    }
+
+    /// A nearly flat disk of `spokes` spokes and `rings` rings of `spokes` vertices around
+    /// one centre (valence `spokes`), every vertex lifted by a deterministic noise.
+    fn hub_disk(spokes: usize, rings: usize) -> Mesh {
+        let mut positions = vec![DVec3::ZERO];
+        for j in 1..=rings {
+            for i in 0..spokes {
+                let a = std::f64::consts::TAU * i as f64 / spokes as f64;
+                let z = 0.003 * (((i * 7 + j * 13) % 11) as f64 - 5.0);
+                positions.push(DVec3::new(j as f64 * a.cos(), j as f64 * a.sin(), z));
+            }
+        }
+        let at = |j: usize, i: usize| (1 + (j - 1) * spokes + i % spokes) as u32;
+        let mut triangles = Vec::new();
+        for i in 0..spokes {
+            triangles.push([0, at(1, i), at(1, i + 1)]);
+            for j in 1..rings {
+                triangles.push([at(j, i), at(j + 1, i), at(j + 1, i + 1)]);
+                triangles.push([at(j, i), at(j + 1, i + 1), at(j, i + 1)]);
+            }
+        }
+        Mesh::new(positions, triangles)
+    }
+
+    #[test]
+    fn a_vertex_of_high_valence_keeps_its_neighbourhood_in_place() {
+        // Every interior vertex has the centre (valence 3000) within three rings: gathering
+        // it would take 3000 steps per neighbour; past 144 points the vertex stays.
+        let before = hub_disk(3000, 3);
+        let mut m = before.clone();
+        let rep = project_onto_local_quadrics(&mut m, &QuadricOptions::DEFAULT.with_max_move(1.0))
+            .expect("a manifold");
+        assert_eq!(rep.fitted_vertices, 0, "{rep:?}");
+        assert_eq!(m.positions, before.positions);
+        // The same disk with a centre of valence 12: its rings stay small, and fits happen.
+        let mut small = hub_disk(12, 5);
+        let rep =
+            project_onto_local_quadrics(&mut small, &QuadricOptions::DEFAULT.with_max_move(1.0))
+                .expect("a manifold");
+        assert!(rep.fitted_vertices > 0, "{rep:?}");
     }
 
     #[test]

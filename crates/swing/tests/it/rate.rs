@@ -310,7 +310,9 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
                 .unwrap()
         };
         // The quadric trial refines the planar one when that was kept, else the chosen
-        // sharpening; it is stated when its score won by the margin.
+        // sharpening; it is stated when its score won by the margin without raising the max
+        // over the input's or the sharpening's, nor the RMS over no sharpening's (the
+        // encoder's three conditions).
         if let Some(q) = quadric.first() {
             assert_eq!(q.planar, out.planar_factor.is_some(), "{name}");
             let refined = if q.planar {
@@ -318,9 +320,19 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
             } else {
                 same_sharpening(q).score()
             };
+            let unsharpened = trials
+                .iter()
+                .find(|t| t.hint == SharpenHint::Unsharpened)
+                .unwrap();
+            let max_bound = out
+                .sharpen_input_max_pct
+                .unwrap()
+                .max(same_sharpening(q).max_pct);
             assert_eq!(
                 out.quadric_factor.is_some(),
-                q.score() < 0.995 * refined,
+                q.score() < 0.995 * refined
+                    && q.max_pct <= max_bound
+                    && q.rms_pct <= unsharpened.rms_pct,
                 "{name}: {:?}",
                 out.sharpen_trials
             );
@@ -357,8 +369,20 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
             }
             (None, p) => {
                 if let Some(p) = p {
+                    // Not kept: its score lost, or it raised the max or the RMS over their
+                    // bounds.
                     let t = trials.iter().find(|t| t.rms_pct == chosen).unwrap();
-                    assert!(p.score() >= 0.995 * t.score(), "{name}");
+                    let unsharpened = trials
+                        .iter()
+                        .find(|t| t.hint == SharpenHint::Unsharpened)
+                        .unwrap();
+                    let max_bound = out.sharpen_input_max_pct.unwrap().max(t.max_pct);
+                    assert!(
+                        p.score() >= 0.995 * t.score()
+                            || p.max_pct > max_bound
+                            || p.rms_pct > unsharpened.rms_pct,
+                        "{name}"
+                    );
                 }
                 chosen
             }
