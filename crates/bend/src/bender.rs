@@ -26,7 +26,9 @@
 //! boundaries and tags work. Tags propagate: a sharp edge's two halves are sharp, so levels
 //! can be repeated. Invariants: weights always sum to one (affine invariance: planar regions
 //! stay planar), and nothing reads across a cut except wings at a chain end (a vertex with one
-//! sharp edge is smooth by the paper's rule).
+//! sharp edge is smooth by the paper's rule). An end of valence over 64 takes the edge's
+//! butterfly in place of its Zorin stencil: that stencil reads the whole ring, once per
+//! edge, which is quadratic in the valence (a stream can decode to such a vertex).
 //!
 //! Not handled: non-manifold input (refused with the corner table's error); the exact
 //! Zorin-2003 boundary-sector coefficients of S&B Figure 13 (lost; algorithms.md 4.4 gives the
@@ -46,6 +48,10 @@ pub struct Bent {
     /// input sharp edge.
     pub sharp_edges: Vec<[u32; 2]>,
 }
+
+/// Largest valence whose vertices get Zorin's stencil; past it an edge takes the butterfly
+/// (`Context::zorin_or_butterfly`).
+const MAX_STENCIL_VALENCE: usize = 64;
 
 /// Zorin's modified-butterfly weights `s_0..s_{k-1}` for an extraordinary vertex of valence `k`
 /// (Zorin, Schröder, Sweldens 1996; the centre gets 3/4). `libm`'s cosine keeps the results
@@ -157,19 +163,40 @@ impl Context<'_> {
         p
     }
 
-    /// Valence (triangles around the vertex) from one of its corners.
+    /// Valence (triangles around the vertex) from one of its corners, counted up to
+    /// `MAX_STENCIL_VALENCE + 1` (any valence past the stencils' reads as that).
     fn valence(&self, c: CornerId) -> usize {
         let t = self.table;
         let mut k = 1usize;
         let mut cur = c;
         while let Some(s) = t.swing(cur) {
-            if s == c || k > t.corner_count() {
+            if s == c || k > MAX_STENCIL_VALENCE {
                 break;
             }
             k += 1;
             cur = s;
         }
         k
+    }
+
+    /// Zorin's stencil at the vertex of corner `c` (valence `k`) for the edge facing `e`
+    /// (opposite `o`); past `MAX_STENCIL_VALENCE` the butterfly of the edge instead (with
+    /// ghost wings across sharp edges when `ghosts`): the stencil of such a vertex reads its
+    /// whole ring, once for each of its edges, quadratic in its valence, and such a vertex
+    /// is no surface sample a smooth limit is expected from.
+    fn zorin_or_butterfly(
+        &self,
+        c: CornerId,
+        k: usize,
+        e: CornerId,
+        o: CornerId,
+        ghosts: bool,
+    ) -> DVec3 {
+        if k > MAX_STENCIL_VALENCE {
+            self.butterfly(e, o, ghosts)
+        } else {
+            self.zorin_at(c)
+        }
     }
 
     /// New point of the smooth interior edge facing corner `c` (it has an opposite).
@@ -191,13 +218,20 @@ impl Context<'_> {
                 let (ka, kb) = (self.valence(at_a), self.valence(at_b));
                 match (ka == 6, kb == 6) {
                     (true, true) => self.butterfly(c, o, false),
-                    (false, true) => self.zorin_at(at_a),
-                    (true, false) => self.zorin_at(at_b),
-                    (false, false) => (self.zorin_at(at_a) + self.zorin_at(at_b)) * 0.5,
+                    (false, true) => self.zorin_or_butterfly(at_a, ka, c, o, false),
+                    (true, false) => self.zorin_or_butterfly(at_b, kb, c, o, false),
+                    (false, false) => {
+                        (self.zorin_or_butterfly(at_a, ka, c, o, false)
+                            + self.zorin_or_butterfly(at_b, kb, c, o, false))
+                            * 0.5
+                    }
                 }
             }
-            (true, false) => self.zorin_at(t.next(o)),
-            (false, true) => self.zorin_at(ca),
+            (true, false) => {
+                let at_b = t.next(o);
+                self.zorin_or_butterfly(at_b, self.valence(at_b), c, o, true)
+            }
+            (false, true) => self.zorin_or_butterfly(ca, self.valence(ca), c, o, true),
             (true, true) => self.butterfly(c, o, true),
         }
     }
@@ -290,13 +324,12 @@ pub fn bend(mesh: &Mesh, sharp_edges: &[[u32; 2]]) -> Result<Bent, Error> {
             sharp_nbrs[b as usize].push(a);
         }
     }
-    let max_valence = 64;
     let ctx = Context {
         table: &table,
         pos: &mesh.positions,
         sharp_corner,
         sharp_nbrs,
-        weights: (0..=max_valence).map(zorin_weights).collect(),
+        weights: (0..=MAX_STENCIL_VALENCE).map(zorin_weights).collect(),
     };
 
     let ne = edge_corner.len();

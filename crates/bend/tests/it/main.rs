@@ -295,3 +295,46 @@ fn levels_past_the_output_limit_are_refused_before_any_work() {
     }
     assert_eq!(bend_levels(&ico, &[], 2).unwrap().mesh.triangles.len(), 320);
 }
+
+/// A disk of `spokes` spokes and `rings` rings around one centre of valence `spokes`.
+fn hub_disk(spokes: usize, rings: usize) -> Mesh {
+    let mut positions = vec![DVec3::ZERO];
+    for j in 1..=rings {
+        for i in 0..spokes {
+            let a = std::f64::consts::TAU * i as f64 / spokes as f64;
+            positions.push(DVec3::new(j as f64 * a.cos(), j as f64 * a.sin(), 0.1 * j as f64));
+        }
+    }
+    let at = |j: usize, i: usize| (1 + (j - 1) * spokes + i % spokes) as u32;
+    let mut triangles = Vec::new();
+    for i in 0..spokes {
+        triangles.push([0, at(1, i), at(1, i + 1)]);
+        for j in 1..rings {
+            triangles.push([at(j, i), at(j + 1, i), at(j + 1, i + 1)]);
+            triangles.push([at(j, i), at(j + 1, i + 1), at(j, i + 1)]);
+        }
+    }
+    Mesh::new(positions, triangles)
+}
+
+/// A vertex of valence 20 000 (a stream can decode to one): its edges take the butterfly
+/// instead of Zorin's stencil, which would read the whole ring once per edge (4e8 reads);
+/// the result is a valid refinement with the hub's edge points on the cone.
+#[test]
+fn a_vertex_of_very_high_valence_is_refined_with_local_stencils() {
+    let m = hub_disk(20_000, 3);
+    let bent = bend(&m, &[]).unwrap();
+    assert_eq!(bent.mesh.triangles.len(), 4 * m.triangles.len());
+    let report = bent.mesh.topology_report();
+    assert!(report.manifold && report.oriented);
+    assert!(bent.mesh.positions.iter().all(|p| p.is_finite()));
+    // The spoke from the centre to ring 1 is straight and its butterfly wings lie on the
+    // same cone, so its new point stays within a spoke's length of its midpoint.
+    let spoke_mid = DVec3::new(0.5, 0.0, 0.05);
+    assert!(
+        bent.mesh.positions[m.positions.len()..]
+            .iter()
+            .any(|p| p.distance(spoke_mid) < 0.1),
+        "no edge point near the first spoke's midpoint"
+    );
+}
