@@ -729,6 +729,10 @@ fn set_flag(flags: &mut u8, bit: u8, on: bool) {
     }
 }
 
+/// Most corners of a neighbour's fan that [`neighbour_plane_distance`] reads: far above the
+/// valences of the samplings sharpened (retilings, marching cubes: under 20).
+const NEIGHBOUR_FAN_CORNERS: usize = 64;
+
 /// Distance of vertex `v` from the nearest plane of a red triangle of another region than `r`
 /// around it or around a neighbour, in units of its mean edge length.
 fn neighbour_plane_distance(run: &Run, v: u32, r: u32) -> f64 {
@@ -736,8 +740,8 @@ fn neighbour_plane_distance(run: &Run, v: u32, r: u32) -> f64 {
     let mut len = 0.0;
     let mut k = 0usize;
     let mut best = f64::INFINITY;
-    let mut nearest_in_fan = |x: u32| {
-        for cc in run.table.vertex_corners(VertexId(x)) {
+    let mut nearest_in_fan = |x: u32, most: usize| {
+        for cc in run.table.vertex_corners(VertexId(x)).take(most) {
             let t = cc.index() / 3;
             let rt = run.s.region[t];
             if rt == NONE || rt == r {
@@ -748,13 +752,15 @@ fn neighbour_plane_distance(run: &Run, v: u32, r: u32) -> f64 {
             best = best.min((p - q).dot(n).abs());
         }
     };
-    // The vertex's own fan once, then each neighbour's (a minimum: the order is free).
-    nearest_in_fan(v);
+    // The vertex's own fan once, then each neighbour's (a minimum: the order is free), the
+    // first `NEIGHBOUR_FAN_CORNERS` corners of it: walking a neighbour of high valence whole
+    // from each of its neighbours was quadratic in its valence.
+    nearest_in_fan(v, usize::MAX);
     for c in run.table.vertex_corners(VertexId(v)) {
         let u = run.cv(next(c.index()));
         len += (run.mesh.positions[u as usize] - p).length();
         k += 1;
-        nearest_in_fan(u);
+        nearest_in_fan(u, NEIGHBOUR_FAN_CORNERS);
     }
     best / (len / k.max(1) as f64)
 }
@@ -874,14 +880,19 @@ fn border_planes(run: &mut Run) {
                 continue;
             }
             let w = run.s.normals[t] * run.corner_angle(c.index());
+            // At most 255 labels per vertex (`lp_len` is a byte): past them a new label is
+            // dropped here rather than after summing, so the search stays bounded around a
+            // vertex of high valence (the same labels and sums as dropping them after).
+            let full = acc.len() >= u8::MAX as usize;
             match acc.iter_mut().find(|(l, _)| *l == r) {
                 Some((_, n)) => *n += w,
-                None => acc.push((r, w)),
+                None if !full => acc.push((r, w)),
+                None => {}
             }
         }
         run.s.lp_start[v] = run.s.lps.len() as u32;
         let point = run.mesh.positions[v];
-        for &(label, n) in acc.iter().take(u8::MAX as usize) {
+        for &(label, n) in &acc {
             let normal = n.normalize_or_zero();
             if normal != DVec3::ZERO {
                 run.s.lps.push(LabelPlane {

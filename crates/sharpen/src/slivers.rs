@@ -128,28 +128,55 @@ struct SlotLists {
     /// Per vertex: first and last node, `NONE` when empty.
     head: Vec<u32>,
     tail: Vec<u32>,
+    /// Per vertex: nodes in its list.
+    len: Vec<u32>,
     /// Per node: its slot and the next node.
     slot: Vec<u32>,
     next: Vec<u32>,
+    /// `(vertex, slot)` keys of the lists longer than [`Self::SCAN`]: their membership test
+    /// is a lookup, not a walk (a vertex of high valence gathers as many slots as it has
+    /// triangles, and walking its list at each push was quadratic in its valence).
+    long: std::collections::HashSet<u64>,
 }
 
 impl SlotLists {
+    /// Longest list whose membership test walks it.
+    const SCAN: u32 = 32;
+
     fn new(vertex_count: usize) -> SlotLists {
         SlotLists {
             head: vec![NONE; vertex_count],
             tail: vec![NONE; vertex_count],
+            len: vec![0; vertex_count],
             slot: Vec::new(),
             next: Vec::new(),
+            long: Default::default(),
         }
+    }
+    fn key(v: u32, s: u32) -> u64 {
+        (u64::from(v) << 32) | u64::from(s)
     }
     /// Lists slot `s` at `v`, once: a slot can come back to a vertex (a re-cut triangle, a
     /// flip, a collapse into a vertex the slot held before), and a slot listed twice would be
     /// seen twice by a collapse, which kills a triangle holding both of its ends: the second
     /// visit found the first one's result and opened a hole.
     fn push(&mut self, v: u32, s: u32) {
-        if self.iter(v).any(|x| x == s) {
-            return;
+        let len = self.len[v as usize];
+        if len < Self::SCAN {
+            if self.iter(v).any(|x| x == s) {
+                return;
+            }
+        } else {
+            if len == Self::SCAN {
+                // The list becomes long: its keys move into the set.
+                let keys: Vec<u64> = self.iter(v).map(|x| Self::key(v, x)).collect();
+                self.long.extend(keys);
+            }
+            if !self.long.insert(Self::key(v, s)) {
+                return;
+            }
         }
+        self.len[v as usize] = len + 1;
         let node = self.slot.len() as u32;
         self.slot.push(s);
         self.next.push(NONE);
@@ -161,8 +188,15 @@ impl SlotLists {
         self.tail[v] = node;
     }
     fn clear(&mut self, v: u32) {
+        if self.len[v as usize] > Self::SCAN {
+            let keys: Vec<u64> = self.iter(v).map(|x| Self::key(v, x)).collect();
+            for k in keys {
+                self.long.remove(&k);
+            }
+        }
         self.head[v as usize] = NONE;
         self.tail[v as usize] = NONE;
+        self.len[v as usize] = 0;
     }
     fn iter(&self, v: u32) -> impl Iterator<Item = u32> + '_ {
         let mut node = self.head[v as usize];
