@@ -118,8 +118,17 @@ pub fn decode_container(container: &Container, opts: &DecodeOptions) -> Result<M
             let geom = container
                 .section(SectionKind::GEOMETRY)
                 .ok_or(Error::MissingSection("geometry"))?;
-            let limits = ConnectivityLimits::DEFAULT
-                .with_max_triangles(h.triangle_count.saturating_mul(2).saturating_add(64));
+            // The coded triangles are the mesh's plus one dummy per boundary edge (each
+            // hole is closed by a fan), and a triangle has at most three boundary edges: a
+            // triangle soup codes four times its count. Also held to what the byte limit
+            // allows at the decoders' peak per triangle (the check above counted the
+            // header's triangles only).
+            let limits = ConnectivityLimits::DEFAULT.with_max_triangles(
+                h.triangle_count
+                    .saturating_mul(4)
+                    .saturating_add(64)
+                    .min(opts.limits.max_alloc_bytes / DECODE_BYTES_PER_TRIANGLE),
+            );
             decode_exact(conn, geom, &quantizer, &limits)?
         }
         Mode::Swing => {

@@ -302,7 +302,11 @@ fn hub_disk(spokes: usize, rings: usize) -> Mesh {
     for j in 1..=rings {
         for i in 0..spokes {
             let a = std::f64::consts::TAU * i as f64 / spokes as f64;
-            positions.push(DVec3::new(j as f64 * a.cos(), j as f64 * a.sin(), 0.1 * j as f64));
+            positions.push(DVec3::new(
+                j as f64 * a.cos(),
+                j as f64 * a.sin(),
+                0.1 * j as f64,
+            ));
         }
     }
     let at = |j: usize, i: usize| (1 + (j - 1) * spokes + i % spokes) as u32;

@@ -76,6 +76,35 @@ fn holes_handles_components() {
     }
 }
 
+/// Meshes made mostly of boundary: 200 separate triangles (an unwelded STL's soup) and 150
+/// separate quads. The connectivity codes one dummy triangle per boundary edge, four
+/// times a soup's triangle count; the decoder once allowed only twice the header's count
+/// plus 64, so every soup of over 32 triangles failed to decode.
+#[test]
+fn triangle_soups_and_separate_quads_round_trip() {
+    let mut soup = Mesh::default();
+    for i in 0..200u32 {
+        let o = DVec3::new((i % 13) as f64, (i / 13) as f64, (i % 7) as f64 * 0.5);
+        soup.positions
+            .extend([o, o + DVec3::X * 0.4, o + DVec3::new(0.1, 0.4, 0.2)]);
+        soup.triangles.push([3 * i, 3 * i + 1, 3 * i + 2]);
+    }
+    check_round_trip(&soup, 12);
+    let mut quads = Mesh::default();
+    for i in 0..150u32 {
+        let o = DVec3::new((i % 11) as f64, (i / 11) as f64, 0.0);
+        quads.positions.extend([
+            o,
+            o + DVec3::X * 0.5,
+            o + DVec3::new(0.5, 0.5, 0.1),
+            o + DVec3::Y * 0.5,
+        ]);
+        quads.triangles.push([4 * i, 4 * i + 1, 4 * i + 2]);
+        quads.triangles.push([4 * i, 4 * i + 2, 4 * i + 3]);
+    }
+    check_round_trip(&quads, 12);
+}
+
 #[test]
 fn non_manifold_input_is_repaired_and_unused_vertices_dropped() {
     let mut m = icosphere(1);
