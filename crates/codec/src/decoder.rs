@@ -111,6 +111,11 @@ pub fn decode_container(container: &Container, opts: &DecodeOptions) -> Result<M
             if !bbox.min.is_finite() || !bbox.max.is_finite() {
                 return Err(Error::Corrupt("bounding box is not finite".into()));
             }
+            if !bbox.size().max_element().is_finite() {
+                return Err(Error::Corrupt(
+                    "bounding box extent overflows (no encoder writes one)".into(),
+                ));
+            }
             let quantizer = Quantizer::new(&bbox, bits as u32);
             let conn = container
                 .section(SectionKind::CONNECTIVITY)

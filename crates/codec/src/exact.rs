@@ -781,6 +781,12 @@ fn encode_exact_with(
     early: bool,
 ) -> Result<(ExactPayloads, Option<bool>), crate::Error> {
     let bbox = mesh.bounding_box();
+    if !bbox.is_empty() && !bbox.size().max_element().is_finite() {
+        // The grid's step would be infinite: every position would land on one corner.
+        return Err(crate::Error::InvalidInput(
+            whet_mesh::MeshError::ExtentOverflow,
+        ));
+    }
     let quantizer = crate::Quantizer::new(&bbox, bits);
     let mut enc = whet_edgebreaker::encode_connectivity_with_table(
         table,

@@ -373,9 +373,15 @@ impl SwingParams {
                 "the swing edge length must be positive and finite, got {edge_length}"
             )));
         }
-        if bbox.is_empty() || !bbox.min.is_finite() || !bbox.max.is_finite() {
+        if bbox.is_empty()
+            || !bbox.min.is_finite()
+            || !bbox.max.is_finite()
+            || !bbox.size().max_element().is_finite()
+        {
             return Err(Error::Parameter(
-                "the swing mode needs a non-empty, finite bounding box".into(),
+                "the swing mode needs a non-empty, finite bounding box whose extent does not \
+                 overflow"
+                    .into(),
             ));
         }
         if !(1..=30).contains(&quant_bits) {

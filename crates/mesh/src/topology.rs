@@ -102,6 +102,13 @@ pub enum MeshError {
         /// Its value.
         count: usize,
     },
+    /// The coordinates are finite but span more than an f64 holds: the bounding box's
+    /// extent overflows, and no grid or length relative to it can be formed.
+    #[error(
+        "the bounding box's extent overflows (coordinates span more than 1.8e308 on an \
+         axis): scale the mesh down"
+    )]
+    ExtentOverflow,
 }
 
 impl MeshError {
@@ -119,6 +126,7 @@ impl MeshError {
             MeshError::NonManifoldVertex { .. } => "non_manifold_vertex",
             MeshError::UnreferencedVertices { .. } => "unreferenced_vertices",
             MeshError::TooLarge { .. } => "too_large",
+            MeshError::ExtentOverflow => "extent_overflow",
         }
     }
 

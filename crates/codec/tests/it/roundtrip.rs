@@ -105,6 +105,35 @@ fn triangle_soups_and_separate_quads_round_trip() {
     check_round_trip(&quads, 12);
 }
 
+/// Finite coordinates whose span overflows an f64 (-1e308 to 1e308): no grid over them
+/// exists, so encoding is refused with a named error instead of writing a stream that
+/// decodes every vertex to one corner (what it did before); a stream stating such a box is
+/// corrupt.
+#[test]
+fn coordinates_whose_span_overflows_are_refused() {
+    let m = Mesh::new(
+        vec![
+            DVec3::new(-1e308, 0.0, 0.0),
+            DVec3::new(1e308, 0.0, 0.0),
+            DVec3::new(0.0, 1e308, 0.0),
+        ],
+        vec![[0, 1, 2]],
+    );
+    let e = encode(&m, &EncodeOptions::DEFAULT).unwrap_err();
+    assert!(e.to_string().contains("extent overflows"), "{e}");
+    // The same triangle scaled into range encodes; its stream with the box widened past the
+    // f64 range is refused by the decoder.
+    let ok = Mesh::new(
+        m.positions.iter().map(|p| *p * 1e-10).collect(),
+        m.triangles.clone(),
+    );
+    let enc = encode(&ok, &EncodeOptions::DEFAULT).unwrap();
+    let mut c = whet_format::parse(&enc.bytes, &whet_format::Limits::DEFAULT).unwrap();
+    c.header.set_bbox([-1e308, 0.0, 0.0], [1e308, 1e308, 0.0]);
+    let e = decode(&c.to_bytes().unwrap(), &DecodeOptions::DEFAULT).unwrap_err();
+    assert!(e.to_string().contains("extent overflows"), "{e}");
+}
+
 #[test]
 fn non_manifold_input_is_repaired_and_unused_vertices_dropped() {
     let mut m = icosphere(1);
