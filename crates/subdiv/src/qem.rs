@@ -218,6 +218,16 @@ pub fn simplify(mesh: &Mesh, opts: &SimplifyOptions) -> Result<Simplified, Error
             vfaces[v as usize].push(t as u32);
         }
     }
+    // Each collapse at a vertex reads and requeues its whole neighbourhood, so a vertex of
+    // valence k costs k^2 in time and heap entries: past MAX_VALENCE the mesh is refused
+    // (a fan of that many triangles is no surface sample to simplify).
+    if let Some(f) = vfaces.iter().find(|f| f.len() > MAX_VALENCE) {
+        return Err(Error::LimitExceeded {
+            what: "triangles around one vertex for the subdiv mode's simplification",
+            limit: MAX_VALENCE as u64,
+            value: f.len() as u64,
+        });
+    }
     let mut used = vec![false; nv];
     for f in &faces {
         for &v in f {
@@ -327,6 +337,7 @@ pub fn simplify(mesh: &Mesh, opts: &SimplifyOptions) -> Result<Simplified, Error
     let mut max_error: f64 = 0.0;
     let mut nbrs_u: Vec<u32> = Vec::new();
     let mut nbrs_v: Vec<u32> = Vec::new();
+    let mut marks = Marks::new(nv);
     // A refused collapse leaves the heap; it comes back only when one of its endpoints
     // changes, although a collapse next to it can make it valid. So when the heap runs dry
     // above the target, every live edge is queued again, until a pass collapses nothing.
@@ -354,15 +365,16 @@ pub fn simplify(mesh: &Mesh, opts: &SimplifyOptions) -> Result<Simplified, Error
             continue;
         }
         // Neighbour sets.
-        neighbours(u, &vfaces, &faces, &mut nbrs_u);
+        neighbours(u, &vfaces, &faces, &mut nbrs_u, &mut marks);
         if !nbrs_u.contains(&(v as u32)) {
             continue;
         }
-        neighbours(v, &vfaces, &faces, &mut nbrs_v);
+        neighbours(v, &vfaces, &faces, &mut nbrs_v, &mut marks);
+        // `nbrs_v` is the last set marked.
         let shared: Vec<u32> = nbrs_u
             .iter()
             .copied()
-            .filter(|x| nbrs_v.contains(x))
+            .filter(|&x| marks.is_current(x))
             .collect();
         let edge_faces: Vec<u32> = vfaces[u]
             .iter()
@@ -382,7 +394,7 @@ pub fn simplify(mesh: &Mesh, opts: &SimplifyOptions) -> Result<Simplified, Error
             && shared.iter().all(|&x| {
                 // Each shared vertex loses one neighbour.
                 let mut n = Vec::new();
-                neighbours(x as usize, &vfaces, &faces, &mut n);
+                neighbours(x as usize, &vfaces, &faces, &mut n, &mut marks);
                 n.len() > 3
             });
         if !(ok_link
@@ -419,7 +431,7 @@ pub fn simplify(mesh: &Mesh, opts: &SimplifyOptions) -> Result<Simplified, Error
         collapsed_this_pass += 1;
         stamp[u] = stamp[u].wrapping_add(1);
         stamp[v] = stamp[v].wrapping_add(1);
-        neighbours(u, &vfaces, &faces, &mut nbrs_u);
+        neighbours(u, &vfaces, &faces, &mut nbrs_u, &mut marks);
         for &x in &nbrs_u {
             heap.push(candidate(u as u32, x, &quad, &pos, &stamp));
         }
@@ -518,12 +530,56 @@ fn faces_have_edge(b_faces: &[u32], faces: &[[u32; 3]], b: u32, a: u32) -> bool 
     })
 }
 
-/// The distinct neighbours of `v` through its live triangles.
-fn neighbours(v: usize, vfaces: &[Vec<u32>], faces: &[[u32; 3]], out: &mut Vec<u32>) {
+/// Most triangles around one vertex that [`simplify`] takes.
+const MAX_VALENCE: usize = 1024;
+
+/// Per-vertex marks of the last set gathered, cleared in O(1) by a new generation.
+struct Marks {
+    mark: Vec<u32>,
+    generation: u32,
+}
+
+impl Marks {
+    fn new(n: usize) -> Marks {
+        Marks {
+            mark: vec![0; n],
+            generation: 0,
+        }
+    }
+    /// Starts a new set.
+    fn start(&mut self) {
+        self.generation = self.generation.wrapping_add(1);
+        if self.generation == 0 {
+            self.mark.fill(0);
+            self.generation = 1;
+        }
+    }
+    /// Marks `x`; false when it was marked in this set already.
+    fn insert(&mut self, x: u32) -> bool {
+        let m = &mut self.mark[x as usize];
+        let new = *m != self.generation;
+        *m = self.generation;
+        new
+    }
+    fn is_current(&self, x: u32) -> bool {
+        self.mark[x as usize] == self.generation
+    }
+}
+
+/// The distinct neighbours of `v` through its live triangles, in the order first met
+/// (marked in `marks` as the current set: a membership test per neighbour, not a search).
+fn neighbours(
+    v: usize,
+    vfaces: &[Vec<u32>],
+    faces: &[[u32; 3]],
+    out: &mut Vec<u32>,
+    marks: &mut Marks,
+) {
     out.clear();
+    marks.start();
     for &t in &vfaces[v] {
         for &x in &faces[t as usize] {
-            if x as usize != v && !out.contains(&x) {
+            if x as usize != v && marks.insert(x) {
                 out.push(x);
             }
         }
@@ -583,5 +639,47 @@ mod tests {
     fn refuses_bad_targets() {
         let m = grid_sphere(4);
         assert!(simplify(&m, &SimplifyOptions::DEFAULT.with_target_vertices(3)).is_err());
+    }
+
+    /// A disk of `spokes` triangles around one centre and a ring of quads around them.
+    fn fan_disk(spokes: u32) -> Mesh {
+        let mut p = vec![DVec3::ZERO];
+        for j in 1..=2 {
+            for i in 0..spokes {
+                let a = core::f64::consts::TAU * i as f64 / spokes as f64;
+                p.push(DVec3::new(
+                    j as f64 * a.cos(),
+                    j as f64 * a.sin(),
+                    0.1 * j as f64,
+                ));
+            }
+        }
+        let at = |j: u32, i: u32| 1 + (j - 1) * spokes + i % spokes;
+        let mut t = Vec::new();
+        for i in 0..spokes {
+            t.push([0, at(1, i), at(1, i + 1)]);
+            t.push([at(1, i), at(2, i), at(2, i + 1)]);
+            t.push([at(1, i), at(2, i + 1), at(1, i + 1)]);
+        }
+        Mesh::new(p, t)
+    }
+
+    /// Collapses at a vertex of valence k read and requeue its k neighbours: 20 000 took
+    /// minutes; past 1024 the mesh is refused with a named limit, at once.
+    #[test]
+    fn a_vertex_of_very_high_valence_is_refused() {
+        let opts = SimplifyOptions::DEFAULT.with_target_vertices(40);
+        match simplify(&fan_disk(2000), &opts) {
+            Err(Error::LimitExceeded { limit, value, .. }) => {
+                assert_eq!((limit, value), (1024, 2000));
+            }
+            other => panic!("{other:?}"),
+        }
+        let s = simplify(&fan_disk(300), &opts).unwrap();
+        assert!(
+            s.mesh.positions.len() <= 40 + 1,
+            "{}",
+            s.mesh.positions.len()
+        );
     }
 }
