@@ -330,41 +330,18 @@ mod tests {
         }
     }
 
-    /// A nearly flat disk of `spokes` spokes and `rings` rings of `spokes` vertices around
-    /// one centre (valence `spokes`), every vertex lifted by a deterministic noise.
-    fn hub_disk(spokes: usize, rings: usize) -> Mesh {
-        let mut positions = vec![DVec3::ZERO];
-        for j in 1..=rings {
-            for i in 0..spokes {
-                let a = std::f64::consts::TAU * i as f64 / spokes as f64;
-                let z = 0.003 * (((i * 7 + j * 13) % 11) as f64 - 5.0);
-                positions.push(DVec3::new(j as f64 * a.cos(), j as f64 * a.sin(), z));
-            }
-        }
-        let at = |j: usize, i: usize| (1 + (j - 1) * spokes + i % spokes) as u32;
-        let mut triangles = Vec::new();
-        for i in 0..spokes {
-            triangles.push([0, at(1, i), at(1, i + 1)]);
-            for j in 1..rings {
-                triangles.push([at(j, i), at(j + 1, i), at(j + 1, i + 1)]);
-                triangles.push([at(j, i), at(j + 1, i + 1), at(j, i + 1)]);
-            }
-        }
-        Mesh::new(positions, triangles)
-    }
-
     #[test]
     fn a_vertex_of_high_valence_keeps_its_neighbourhood_in_place() {
         // Every interior vertex has the centre (valence 3000) within three rings: gathering
         // it would take 3000 steps per neighbour; past 144 points the vertex stays.
-        let before = hub_disk(3000, 3);
+        let before = whet_testkit::meshes::hub_disk(3000, 3);
         let mut m = before.clone();
         let rep = project_onto_local_quadrics(&mut m, &QuadricOptions::DEFAULT.with_max_move(1.0))
             .expect("a manifold");
         assert_eq!(rep.fitted_vertices, 0, "{rep:?}");
         assert_eq!(m.positions, before.positions);
         // The same disk with a centre of valence 12: its rings stay small, and fits happen.
-        let mut small = hub_disk(12, 5);
+        let mut small = whet_testkit::meshes::hub_disk(12, 5);
         let rep =
             project_onto_local_quadrics(&mut small, &QuadricOptions::DEFAULT.with_max_move(1.0))
                 .expect("a manifold");

@@ -641,41 +641,18 @@ mod tests {
         assert!(simplify(&m, &SimplifyOptions::DEFAULT.with_target_vertices(3)).is_err());
     }
 
-    /// A disk of `spokes` triangles around one centre and a ring of quads around them.
-    fn fan_disk(spokes: u32) -> Mesh {
-        let mut p = vec![DVec3::ZERO];
-        for j in 1..=2 {
-            for i in 0..spokes {
-                let a = core::f64::consts::TAU * i as f64 / spokes as f64;
-                p.push(DVec3::new(
-                    j as f64 * a.cos(),
-                    j as f64 * a.sin(),
-                    0.1 * j as f64,
-                ));
-            }
-        }
-        let at = |j: u32, i: u32| 1 + (j - 1) * spokes + i % spokes;
-        let mut t = Vec::new();
-        for i in 0..spokes {
-            t.push([0, at(1, i), at(1, i + 1)]);
-            t.push([at(1, i), at(2, i), at(2, i + 1)]);
-            t.push([at(1, i), at(2, i + 1), at(1, i + 1)]);
-        }
-        Mesh::new(p, t)
-    }
-
     /// Collapses at a vertex of valence k read and requeue its k neighbours: 20 000 took
     /// minutes; past 1024 the mesh is refused with a named limit, at once.
     #[test]
     fn a_vertex_of_very_high_valence_is_refused() {
         let opts = SimplifyOptions::DEFAULT.with_target_vertices(40);
-        match simplify(&fan_disk(2000), &opts) {
+        match simplify(&whet_testkit::meshes::hub_disk(2000, 2), &opts) {
             Err(Error::LimitExceeded { limit, value, .. }) => {
                 assert_eq!((limit, value), (1024, 2000));
             }
             other => panic!("{other:?}"),
         }
-        let s = simplify(&fan_disk(300), &opts).unwrap();
+        let s = simplify(&whet_testkit::meshes::hub_disk(300, 2), &opts).unwrap();
         assert!(
             s.mesh.positions.len() <= 40 + 1,
             "{}",

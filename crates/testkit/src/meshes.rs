@@ -113,6 +113,32 @@ pub fn torus(n: u32, m: u32) -> Mesh {
     Mesh::new(p, t)
 }
 
+/// A shallow cone of `spokes` spokes and `rings` rings of `spokes` vertices around one
+/// centre of valence `spokes` (one boundary loop): the heights of ring `j` are `0.1 j`,
+/// jittered by 1-2 % from spoke to spoke so that the fan's triangles are not all coplanar.
+/// With thousands of spokes, it is the vertex of very high valence that tests of bounded
+/// work need.
+pub fn hub_disk(spokes: u32, rings: u32) -> Mesh {
+    let mut p = vec![DVec3::ZERO];
+    for j in 1..=rings {
+        for i in 0..spokes {
+            let a = std::f64::consts::TAU * i as f64 / spokes as f64;
+            let z = 0.1 * j as f64 * (1.0 + 0.01 * (i % 3) as f64);
+            p.push(DVec3::new(j as f64 * a.cos(), j as f64 * a.sin(), z));
+        }
+    }
+    let at = |j: u32, i: u32| 1 + (j - 1) * spokes + i % spokes;
+    let mut t = Vec::new();
+    for i in 0..spokes {
+        t.push([0, at(1, i), at(1, i + 1)]);
+        for j in 1..rings {
+            t.push([at(j, i), at(j + 1, i), at(j + 1, i + 1)]);
+            t.push([at(j, i), at(j + 1, i + 1), at(j, i + 1)]);
+        }
+    }
+    Mesh::new(p, t)
+}
+
 /// Open `n x m` grid in the xy plane (one boundary loop).
 pub fn grid(n: u32, m: u32) -> Mesh {
     let mut p = Vec::new();

@@ -4,7 +4,7 @@
 
 use whet_bend::{bend, bend_levels, zorin_weights};
 use whet_mesh::{DVec3, Mesh};
-use whet_testkit::meshes::{grid, icosphere};
+use whet_testkit::meshes::{grid, hub_disk, icosphere};
 
 #[test]
 fn zorin_weights_sum_to_a_quarter() {
@@ -294,31 +294,6 @@ fn levels_past_the_output_limit_are_refused_before_any_work() {
         other => panic!("{:?}", other.map(|b| b.mesh.triangles.len())),
     }
     assert_eq!(bend_levels(&ico, &[], 2).unwrap().mesh.triangles.len(), 320);
-}
-
-/// A disk of `spokes` spokes and `rings` rings around one centre of valence `spokes`.
-fn hub_disk(spokes: usize, rings: usize) -> Mesh {
-    let mut positions = vec![DVec3::ZERO];
-    for j in 1..=rings {
-        for i in 0..spokes {
-            let a = std::f64::consts::TAU * i as f64 / spokes as f64;
-            positions.push(DVec3::new(
-                j as f64 * a.cos(),
-                j as f64 * a.sin(),
-                0.1 * j as f64,
-            ));
-        }
-    }
-    let at = |j: usize, i: usize| (1 + (j - 1) * spokes + i % spokes) as u32;
-    let mut triangles = Vec::new();
-    for i in 0..spokes {
-        triangles.push([0, at(1, i), at(1, i + 1)]);
-        for j in 1..rings {
-            triangles.push([at(j, i), at(j + 1, i), at(j + 1, i + 1)]);
-            triangles.push([at(j, i), at(j + 1, i + 1), at(j, i + 1)]);
-        }
-    }
-    Mesh::new(positions, triangles)
 }
 
 /// A vertex of valence 20 000 (a stream can decode to one): its edges take the butterfly

@@ -252,29 +252,6 @@ fn extreme_scales_do_not_break_anything() {
     }
 }
 
-/// A cone of `spokes` spokes and three rings around one centre of valence `spokes`, the
-/// rings' heights jittered so that the spokes' triangles do not all lie in one smooth region.
-fn hub_cone(spokes: usize) -> Mesh {
-    let mut positions = vec![DVec3::ZERO];
-    for j in 1..=3 {
-        for i in 0..spokes {
-            let a = std::f64::consts::TAU * i as f64 / spokes as f64;
-            let z = 0.1 * j as f64 * (1.0 + 0.01 * (i % 3) as f64);
-            positions.push(DVec3::new(j as f64 * a.cos(), j as f64 * a.sin(), z));
-        }
-    }
-    let at = |j: usize, i: usize| (1 + (j - 1) * spokes + i % spokes) as u32;
-    let mut triangles = Vec::new();
-    for i in 0..spokes {
-        triangles.push([0, at(1, i), at(1, i + 1)]);
-        for j in 1..3 {
-            triangles.push([at(j, i), at(j + 1, i), at(j + 1, i + 1)]);
-            triangles.push([at(j, i), at(j + 1, i + 1), at(j, i + 1)]);
-        }
-    }
-    Mesh::new(positions, triangles)
-}
-
 /// A vertex of valence 30 000 (a stream can decode to one, a file can hold one): work that
 /// walked a neighbour's whole fan from each of its neighbours, or searched a list that
 /// grows with its fan at each addition, was quadratic in the valence (1M triangles around
@@ -282,7 +259,7 @@ fn hub_cone(spokes: usize) -> Mesh {
 /// extended one; 1.2 s and 1.1 s since). Both methods return a valid mesh.
 #[test]
 fn a_vertex_of_very_high_valence_is_sharpened_in_bounded_work() {
-    let mesh = hub_cone(30_000);
+    let mesh = meshes::hub_disk(30_000, 3);
     for method in [Method::Extended, Method::Papers] {
         let out = sharpen(&mesh, &SharpenOptions::DEFAULT.with_method(method)).unwrap();
         let report = out.mesh.topology_report();
