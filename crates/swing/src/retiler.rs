@@ -272,6 +272,12 @@ fn angle3(a: DVec3, b: DVec3) -> f64 {
 
 struct Retiler<'s, 'm> {
     surf: &'s mut Surface<'m>,
+    /// The triangles of each component in increasing order: component `c` holds
+    /// `comp_tris[comp_start[c]..comp_start[c + 1]]` (one counting sort, so a component's
+    /// seed and pillow read its own triangles instead of scanning the whole mesh, which was
+    /// quadratic in the component count: a soup of 300k triangles did not finish).
+    comp_start: Vec<u32>,
+    comp_tris: Vec<u32>,
     /// Per original triangle (after capping): part of a hole's cap. Seeds avoid caps.
     filler: &'s [bool],
     params: &'s SwingParams,
@@ -381,7 +387,10 @@ pub(crate) fn retile_fitted(
     }
     let mut surf = Surface::new(mesh, l);
     let bbox = mesh.bounding_box();
+    let (comp_start, comp_tris) = component_triangles(&surf.component, surf.component_count);
     let mut r = Retiler {
+        comp_start,
+        comp_tris,
         params,
         tune: *tune,
         l,
@@ -864,17 +873,20 @@ impl Retiler<'_, '_> {
 
     /// A component smaller than about `L`: its three most spread-out vertices as a seed and
     /// the seed's back face (label E), a flat closed pillow.
+    /// The triangles of component `comp`, in increasing order.
+    fn component_tris(&self, comp: u32) -> &[u32] {
+        let c = comp as usize;
+        &self.comp_tris[self.comp_start[c] as usize..self.comp_start[c + 1] as usize]
+    }
+
     fn pillow(&mut self, first_tri: u32) -> Result<(), Error> {
         let mesh = self.surf.mesh;
         let comp = self.comp;
         let verts: Vec<u32> = {
             let mut vs: Vec<u32> = self
-                .surf
-                .component
+                .component_tris(comp)
                 .iter()
-                .enumerate()
-                .filter(|(_, &c)| c == comp)
-                .flat_map(|(t, _)| mesh.triangles[t])
+                .flat_map(|&t| mesh.triangles[t as usize])
                 .collect();
             vs.sort_unstable();
             vs.dedup();
@@ -1027,16 +1039,15 @@ impl Retiler<'_, '_> {
         for (avoid_caps, lo, hi) in [(true, 0.7, 1.4), (false, 0.3, 1.8)] {
             // Candidates spread over the component, flattest first: a seed on a crease or a
             // corner starts the spiral badly.
+            // (`first_tri` is the component's first triangle: all of its triangles.)
             let tris: Vec<usize> = self
-                .surf
-                .component
+                .component_tris(comp)
                 .iter()
-                .enumerate()
-                .skip(first_tri as usize)
-                .filter(|&(t, &c)| {
-                    c == comp && !(avoid_caps && self.filler.get(t).copied().unwrap_or(false))
+                .map(|&t| t as usize)
+                .filter(|&t| {
+                    t >= first_tri as usize
+                        && !(avoid_caps && self.filler.get(t).copied().unwrap_or(false))
                 })
-                .map(|(t, _)| t)
                 .collect();
             let stride = (tris.len() / 96).max(1);
             // Candidate points are triangle centroids: on coarse CAD meshes the vertices all
@@ -1994,4 +2005,23 @@ mod tests {
         assert!((ccw(n, DVec3::Y, DVec3::X) - 1.5 * PI).abs() < 1e-12);
         assert!((ccw(n, DVec3::X, -DVec3::X) - PI).abs() < 1e-12);
     }
+}
+
+/// The triangles of each component, by a counting sort of `component` (`count` components):
+/// offsets (`count + 1`) and the triangles, increasing within each component.
+fn component_triangles(component: &[u32], count: usize) -> (Vec<u32>, Vec<u32>) {
+    let mut start = vec![0u32; count + 1];
+    for &c in component {
+        start[c as usize + 1] += 1;
+    }
+    for c in 0..count {
+        start[c + 1] += start[c];
+    }
+    let mut next = start.clone();
+    let mut tris = vec![0u32; component.len()];
+    for (t, &c) in component.iter().enumerate() {
+        tris[next[c as usize] as usize] = t as u32;
+        next[c as usize] += 1;
+    }
+    (start, tris)
 }
