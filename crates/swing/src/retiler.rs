@@ -1987,6 +1987,25 @@ impl Retiler<'_, '_> {
     }
 }
 
+/// The triangles of each component, by a counting sort of `component` (`count` components):
+/// offsets (`count + 1`) and the triangles, increasing within each component.
+fn component_triangles(component: &[u32], count: usize) -> (Vec<u32>, Vec<u32>) {
+    let mut start = vec![0u32; count + 1];
+    for &c in component {
+        start[c as usize + 1] += 1;
+    }
+    for c in 0..count {
+        start[c + 1] += start[c];
+    }
+    let mut next = start.clone();
+    let mut tris = vec![0u32; component.len()];
+    for (t, &c) in component.iter().enumerate() {
+        tris[next[c as usize] as usize] = t as u32;
+        next[c as usize] += 1;
+    }
+    (start, tris)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -2005,23 +2024,4 @@ mod tests {
         assert!((ccw(n, DVec3::Y, DVec3::X) - 1.5 * PI).abs() < 1e-12);
         assert!((ccw(n, DVec3::X, -DVec3::X) - PI).abs() < 1e-12);
     }
-}
-
-/// The triangles of each component, by a counting sort of `component` (`count` components):
-/// offsets (`count + 1`) and the triangles, increasing within each component.
-fn component_triangles(component: &[u32], count: usize) -> (Vec<u32>, Vec<u32>) {
-    let mut start = vec![0u32; count + 1];
-    for &c in component {
-        start[c as usize + 1] += 1;
-    }
-    for c in 0..count {
-        start[c + 1] += start[c];
-    }
-    let mut next = start.clone();
-    let mut tris = vec![0u32; component.len()];
-    for (t, &c) in component.iter().enumerate() {
-        tris[next[c as usize] as usize] = t as u32;
-        next[c as usize] += 1;
-    }
-    (start, tris)
 }
