@@ -1172,6 +1172,12 @@ impl SwingEncoder {
                 break;
             }
             let next = next.clamp(1e-5, 0.7);
+            // The longest length allowed met the target: nothing coarser (and cheaper) is
+            // left to try. (Without this a loose target re-encoded and re-measured the
+            // same length until the iterations ran out: 12 s for `--max-error 50`.)
+            if ok && next <= fr {
+                break;
+            }
             // Past the size limit: the target is out of reach (the law puts it well past
             // the limit, or the shortest length allowed was tried).
             if next < 0.5 * floor || (next < floor && f <= floor) {

@@ -70,6 +70,23 @@ fn max_error_is_met_by_the_stream_returned() {
     assert!(rms >= 0.6 * target, "{rms}");
 }
 
+/// A target every length meets stops at the longest length allowed (0.7 of the diagonal):
+/// the search once re-encoded and re-measured that length until its iterations ran out.
+#[test]
+fn a_loose_error_target_stops_at_the_longest_length() {
+    let out = encode(
+        &spot(),
+        &SwingOptions::DEFAULT
+            .with_rate(Rate::MaxError(50.0))
+            .with_metro_samples(100_000),
+    )
+    .unwrap();
+    assert!(out.rms_pct.unwrap() <= 50.0);
+    let at_longest = out.search.iter().filter(|s| s.0 == 0.7).count();
+    assert_eq!(at_longest, 1, "{:?}", out.search);
+    assert!(out.search.len() <= 4, "{:?}", out.search);
+}
+
 #[test]
 fn bad_rates_are_parameter_errors() {
     let mesh = spot();
