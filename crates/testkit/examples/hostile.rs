@@ -42,7 +42,13 @@ fn main() {
         _ => panic!("{usage}"),
     };
     let mut out = std::io::BufWriter::new(std::fs::File::create(&args[2]).unwrap());
-    writeln!(out, "OFF\n{} {} 0", mesh.positions.len(), mesh.triangles.len()).unwrap();
+    writeln!(
+        out,
+        "OFF\n{} {} 0",
+        mesh.positions.len(),
+        mesh.triangles.len()
+    )
+    .unwrap();
     for p in &mesh.positions {
         writeln!(out, "{} {} {}", p.x, p.y, p.z).unwrap();
     }
