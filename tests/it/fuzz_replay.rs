@@ -266,3 +266,17 @@ fn sharpen_regressions_and_seeds() {
         }
     }
 }
+
+/// The swing encoder's target starts from the sharpen target's seeds (the same mesh layout;
+/// bytes 1 and 2 pick the angle bits and the edge length).
+#[test]
+fn swing_encode_regressions_and_seeds() {
+    let f = files("swing_encode");
+    assert!(
+        !f.is_empty(),
+        "fuzz/corpus/swing_encode has the seed inputs"
+    );
+    for p in f {
+        whet_swing::fuzz_encode(&std::fs::read(&p).unwrap());
+    }
+}

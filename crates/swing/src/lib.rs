@@ -20,6 +20,7 @@
 
 mod encoder;
 mod filter_fit;
+mod fuzz;
 mod grid;
 mod holes;
 mod retiler;
@@ -31,6 +32,7 @@ pub use encoder::{
     QUADRIC_FACTOR, TWO_PASSES,
 };
 pub use filter_fit::{fit_displacements, fit_surface_filter};
+pub use fuzz::fuzz_encode;
 pub use retiler::{retile, RetileStats, RetileTuning, Retiled};
 
 /// Why a mesh could not be encoded in the swing mode.
