@@ -51,16 +51,7 @@ pub fn fuzz_bend(mesh: &Mesh, sharp_edges: &[[u32; 2]]) {
 
 /// Triangles that have a twin over the same three vertices (the halves of pillows).
 fn pillow_triangles(mesh: &Mesh) -> usize {
-    let mut keys: Vec<[u32; 3]> = mesh
-        .triangles
-        .iter()
-        .map(|t| {
-            let mut k = *t;
-            k.sort_unstable();
-            k
-        })
-        .collect();
-    keys.sort_unstable();
+    let keys = mesh.sorted_vertex_sets();
     (0..keys.len())
         .filter(|&i| (i > 0 && keys[i - 1] == keys[i]) || keys.get(i + 1) == Some(&keys[i]))
         .count()

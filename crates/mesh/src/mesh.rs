@@ -123,6 +123,23 @@ impl Mesh {
         ]
     }
 
+    /// Each triangle's vertex set (its indices in increasing order), the list sorted: what a
+    /// binary search answers "is there a triangle on these three vertices" from, whatever
+    /// its orientation or rotation.
+    pub fn sorted_vertex_sets(&self) -> Vec<[u32; 3]> {
+        let mut keys: Vec<[u32; 3]> = self
+            .triangles
+            .iter()
+            .map(|t| {
+                let mut k = *t;
+                k.sort_unstable();
+                k
+            })
+            .collect();
+        keys.sort_unstable();
+        keys
+    }
+
     /// Twice-area vector (unnormalised normal) of triangle `t`.
     #[inline]
     pub fn face_cross(&self, t: usize) -> DVec3 {

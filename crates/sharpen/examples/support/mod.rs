@@ -209,16 +209,7 @@ pub fn check(reference: &Mesh, input: &Mesh, out: &whet_sharpen::Sharpened) -> C
     let output = &out.mesh;
     let rin = input.topology_report();
     let rout = output.topology_report();
-    let mut keys: Vec<[u32; 3]> = input
-        .triangles
-        .iter()
-        .map(|t| {
-            let mut k = *t;
-            k.sort_unstable();
-            k
-        })
-        .collect();
-    keys.sort_unstable();
+    let keys = input.sorted_vertex_sets();
     let bvh = Bvh::new(reference);
     let normals = reference.face_normals();
     let mut c = Checks {

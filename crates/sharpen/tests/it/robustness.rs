@@ -41,8 +41,7 @@ proptest! {
             prop_assert_eq!(&out.mesh.positions[..mesh.positions.len()], &mesh.positions[..]);
         }
         // Smallest angle of the triangles that are not input triangles.
-        let mut keys: Vec<[u32; 3]> = mesh.triangles.iter().map(|t| { let mut k = *t; k.sort_unstable(); k }).collect();
-        keys.sort_unstable();
+        let keys = mesh.sorted_vertex_sets();
         for (t, tri) in out.mesh.triangles.iter().enumerate() {
             let mut k = *tri;
             k.sort_unstable();

@@ -78,16 +78,7 @@ fn fold_count(
 ) -> usize {
     let bvh = whet_metro::Bvh::new(truth);
     let normals = truth.face_normals();
-    let mut keys: Vec<[u32; 3]> = input
-        .triangles
-        .iter()
-        .map(|t| {
-            let mut k = *t;
-            k.sort_unstable();
-            k
-        })
-        .collect();
-    keys.sort_unstable();
+    let keys = input.sorted_vertex_sets();
     let nv = input.positions.len();
     let mut folds = 0;
     for (t, tri) in out.mesh.triangles.iter().enumerate() {
