@@ -1,7 +1,7 @@
 //! `whet demo`: the main job on a mesh whet makes itself — the synthetic fandisk, densely
 //! tessellated with its creases exact, swept through the codec at a default set of rates.
 
-use super::rd::{run_plan, Plan, DEFAULT_SWING_RATES};
+use super::rd::{check_samples, run_plan, Plan, DEFAULT_SWING_RATES};
 use super::{write_mesh, CliResult, Failure};
 use clap::Args;
 use std::path::PathBuf;
@@ -18,6 +18,8 @@ pub struct DemoArgs {
 }
 
 pub fn run(args: &DemoArgs) -> CliResult {
+    // Before the mesh is written.
+    check_samples(args.samples)?;
     let shape = Shape::new(ShapeKind::Fandisk, &ShapeParams::default())
         .map_err(|e| Failure::other(anyhow::Error::new(e)))?;
     // 674 truth triangles x 4^3 = 43k triangles, each vertex then jittered within its facet

@@ -11,6 +11,68 @@ use whet_rd::{
     to_json, to_markdown, Codec, CodecSweep, Point, Stage, SweepOptions,
 };
 
+/// Why `rate` is not a quantization of the exact mode.
+fn exact_rate_problem(rate: f64) -> Option<String> {
+    (rate.fract() != 0.0 || !(1.0..=30.0).contains(&rate))
+        .then(|| format!("exact mode rates are quantization bits 1..=30, got {rate}"))
+}
+
+/// Why `rate` is not a rate of the swing mode.
+fn swing_rate_problem(rate: f64) -> Option<String> {
+    (!(rate.is_finite() && rate > 0.0))
+        .then(|| format!("swing rates are bits per original vertex (> 0), got {rate}"))
+}
+
+/// Why `rate` is not a control vertex count of the subdiv mode.
+fn subdiv_rate_problem(rate: f64) -> Option<String> {
+    (rate.fract() != 0.0 || !(4.0..=1e15).contains(&rate))
+        .then(|| format!("subdiv rates are control vertex counts (>= 4), got {rate}"))
+}
+
+/// Says why a rate is not one its codec takes.
+type RateCheck = fn(f64) -> Option<String>;
+
+/// The first rate of a sweep its codec cannot take, named for the flag that set it: a
+/// sweep whose arguments are wrong is refused before it starts (exit 2), while a row that
+/// fails on one mesh (a rate too high for it, say) stays a row with its error.
+fn check_rates(plan: &Plan) -> CliResult {
+    let lists: [(&str, &str, &[f64], RateCheck); 3] = [
+        ("swing", "--rates", &plan.rates, swing_rate_problem),
+        (
+            "exact",
+            "--exact-bits",
+            &plan.exact_bits,
+            exact_rate_problem,
+        ),
+        (
+            "subdiv",
+            "--subdiv-control",
+            &plan.subdiv_control,
+            subdiv_rate_problem,
+        ),
+    ];
+    for (mode, flag, rates, problem) in lists {
+        if !plan.modes.iter().any(|m| m == mode) {
+            continue;
+        }
+        if let Some(p) = rates.iter().find_map(|&r| problem(r)) {
+            return Err(Failure::input(anyhow::anyhow!("{flag}: {p}")));
+        }
+    }
+    check_samples(plan.samples)
+}
+
+/// Refuses a Metro sample count of zero or past [`whet_metro::MAX_FACE_SAMPLES`].
+pub fn check_samples(samples: usize) -> CliResult {
+    if !(1..=whet_metro::MAX_FACE_SAMPLES).contains(&samples) {
+        return Err(Failure::input(anyhow::anyhow!(
+            "--samples must be between 1 and {}, got {samples}",
+            whet_metro::MAX_FACE_SAMPLES
+        )));
+    }
+    Ok(())
+}
+
 /// The exact mode as an rd codec; the rate is the quantization bits.
 struct ExactCodec;
 
@@ -19,10 +81,8 @@ impl Codec for ExactCodec {
         "exact".into()
     }
     fn encode(&self, mesh: &Mesh, rate: f64) -> Result<Vec<u8>, String> {
-        if rate.fract() != 0.0 || !(1.0..=30.0).contains(&rate) {
-            return Err(format!(
-                "exact mode rates are quantization bits 1..=30, got {rate}"
-            ));
+        if let Some(problem) = exact_rate_problem(rate) {
+            return Err(problem);
         }
         let opts = whet_codec::EncodeOptions::DEFAULT.with_quant_bits(rate as u32);
         whet_codec::encode(mesh, &opts)
@@ -46,10 +106,8 @@ impl Codec for SwingCodec {
         "swing".into()
     }
     fn encode(&self, mesh: &Mesh, rate: f64) -> Result<Vec<u8>, String> {
-        if !(rate.is_finite() && rate > 0.0) {
-            return Err(format!(
-                "swing rates are bits per original vertex (> 0), got {rate}"
-            ));
+        if let Some(problem) = swing_rate_problem(rate) {
+            return Err(problem);
         }
         let opts = self.angle_bits.apply(
             whet_swing::SwingOptions::DEFAULT
@@ -158,10 +216,8 @@ impl Codec for SubdivCodec {
         "subdiv".into()
     }
     fn encode(&self, mesh: &Mesh, rate: f64) -> Result<Vec<u8>, String> {
-        if rate.fract() != 0.0 || rate < 4.0 {
-            return Err(format!(
-                "subdiv rates are control vertex counts (>= 4), got {rate}"
-            ));
+        if let Some(problem) = subdiv_rate_problem(rate) {
+            return Err(problem);
         }
         let opts = whet_subdiv::SubdivEncodeOptions::DEFAULT.with_control_vertices(rate as usize);
         whet::encode_subdiv(mesh, &opts)
@@ -287,6 +343,7 @@ pub fn run_plan(meshes: Vec<(String, Mesh)>, plan: &Plan) -> CliResult<(Vec<Poin
             }
         }
     }
+    check_rates(plan)?;
     let stages: Vec<Stage> = plan
         .stages
         .iter()

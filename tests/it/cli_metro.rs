@@ -84,4 +84,8 @@ fn identical_meshes_measure_zero_and_bad_input_exits_2() {
     std::fs::write(&garbage, b"ply\nformat nonsense\n").unwrap();
     let o = whet(&["metro", s(&garbage), s(&cube)]);
     assert_eq!(o.status.code(), Some(2));
+    // An absurd sample count is refused at once, not sampled for hours.
+    let o = whet(&["metro", s(&cube), s(&cube), "--samples", "100000000000"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("more than the limit"));
 }

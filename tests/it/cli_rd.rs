@@ -136,3 +136,52 @@ fn rd_reports_unknown_modes_and_stages() {
     let o = whet(&["rd", s(&shared_fixture("cube.off")), "--stages", "nonsense"]);
     assert_eq!(o.status.code(), Some(2));
 }
+
+/// Rates no codec can take and a sample count of zero are refused before the sweep starts,
+/// naming the flag, with exit 2 (they used to become rows of errors and exit 0).
+#[test]
+fn rd_refuses_impossible_rates_up_front() {
+    let cube = shared_fixture("cube.off");
+    let dir = scratch_dir("cli-rd-bad-rates");
+    let out = s(&dir);
+    for (args, flag) in [
+        (vec!["--rates", "1,NaN"], "--rates"),
+        (vec!["--rates", "0"], "--rates"),
+        (
+            vec!["--modes", "exact", "--exact-bits", "8,40"],
+            "--exact-bits",
+        ),
+        (
+            vec!["--modes", "exact", "--exact-bits", "10.5"],
+            "--exact-bits",
+        ),
+        (
+            vec!["--modes", "subdiv", "--subdiv-control", "2"],
+            "--subdiv-control",
+        ),
+        (vec!["--samples", "0"], "--samples"),
+    ] {
+        let mut all = vec!["rd", s(&cube), "--out", out];
+        all.extend(args.iter().copied());
+        let o = whet(&all);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(flag), "{args:?}: {err}");
+    }
+    // A swing rate is only checked when the swing mode runs.
+    let o = whet(&[
+        "rd",
+        s(&cube),
+        "--out",
+        out,
+        "--modes",
+        "exact",
+        "--exact-bits",
+        "8",
+        "--rates",
+        "NaN",
+        "--samples",
+        "1000",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}

@@ -39,7 +39,8 @@ mod triangle_distance;
 
 pub use bvh::{Bvh, ClosestPoint, CoherentQuery};
 pub use metro::{
-    error_ramp, metro, one_sided, vertex_distances, Directional, Figures, MetroOptions, MetroReport,
+    error_ramp, metro, one_sided, vertex_distances, Directional, Figures, MetroOptions,
+    MetroReport, MAX_FACE_SAMPLES,
 };
 pub use triangle_distance::{
     closest_point_on_segment, closest_point_on_triangle, point_triangle_distance_squared,
@@ -90,6 +91,14 @@ pub enum Error {
     /// [`one_sided`] was given a [`Bvh`] without triangles.
     #[error("the target BVH holds no triangles: there is no surface to measure against")]
     EmptyTarget,
+    /// More face samples were asked for than [`MAX_FACE_SAMPLES`].
+    #[error("{samples} face samples per direction are more than the limit of {limit}")]
+    TooManySamples {
+        /// The samples asked for.
+        samples: usize,
+        /// [`MAX_FACE_SAMPLES`].
+        limit: usize,
+    },
     /// Distances overflowed `f64` (coordinates near the limits of the type).
     #[error("distances overflow f64: the coordinates are too large to measure")]
     Overflow,

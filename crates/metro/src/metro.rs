@@ -19,6 +19,11 @@ use crate::sampling::{
 };
 use crate::Error;
 
+/// Most face samples per direction [`metro`] and [`one_sided`] take: about a billion, some
+/// minutes per direction on one core. Memory does not grow with the samples (they are
+/// streamed), but time does, and a count past this is a typo rather than a measurement.
+pub const MAX_FACE_SAMPLES: usize = 1 << 30;
+
 /// Options of [`metro`].
 #[non_exhaustive]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -50,14 +55,14 @@ impl MetroOptions {
     }
 
     /// The default number of face samples per direction for a pair of meshes: at least ten
-    /// per face of the larger mesh and at least one million.
+    /// per face of the larger mesh and at least one million, at most [`MAX_FACE_SAMPLES`].
     pub fn default_samples(reference: &Mesh, test: &Mesh) -> usize {
         reference
             .triangles
             .len()
             .max(test.triangles.len())
             .saturating_mul(10)
-            .max(1_000_000)
+            .clamp(1_000_000, MAX_FACE_SAMPLES)
     }
 
     /// The number of face samples per direction these options give for a pair of meshes.
@@ -239,7 +244,7 @@ pub fn metro(reference: &Mesh, test: &Mesh, opts: &MetroOptions) -> Result<Metro
     validate(test, "test")?;
     let diagonal = reference.diagonal();
     check_diagonal(diagonal)?;
-    let n = opts.face_samples(reference, test).max(1);
+    let n = check_samples(opts.face_samples(reference, test))?;
     let (ref_bvh, test_bvh) = rayon::join(|| Bvh::new(reference), || Bvh::new(test));
     let (forward, backward) = rayon::join(
         || one_sided(test, &ref_bvh, n, derive_seed(opts.seed, 1), diagonal),
@@ -253,6 +258,17 @@ pub fn metro(reference: &Mesh, test: &Mesh, opts: &MetroOptions) -> Result<Metro
         forward,
         backward,
     })
+}
+
+/// The face samples to draw for a request: at least one, at most [`MAX_FACE_SAMPLES`].
+fn check_samples(requested: usize) -> Result<usize, Error> {
+    if requested > MAX_FACE_SAMPLES {
+        return Err(Error::TooManySamples {
+            samples: requested,
+            limit: MAX_FACE_SAMPLES,
+        });
+    }
+    Ok(requested.max(1))
 }
 
 fn check_diagonal(diagonal: f64) -> Result<(), Error> {
@@ -282,7 +298,7 @@ pub fn one_sided(
         return Err(Error::EmptyTarget);
     }
     check_diagonal(diagonal)?;
-    let n = n_face_samples.max(1);
+    let n = check_samples(n_face_samples)?;
 
     // Face samples: systematic area-proportional counts, one random stream per chunk.
     let offsets = face_sample_offsets(sampled, n, seed);

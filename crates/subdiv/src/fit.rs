@@ -228,6 +228,27 @@ impl Default for FitOptions {
     }
 }
 
+/// Most triangles of the fitted level (control triangles x 4^levels) a fit takes on. The fit
+/// holds about 1.1 KB per fitted triangle (the composed subdivision-and-limit map, its
+/// normal equations, the correspondences: 450 MB for 3200 control vertices at 3 levels,
+/// measured on fandisk), so this bounds it near 2.3 GB; a mesh that needs more control
+/// vertices than this is better coded by the swing or exact mode.
+pub const MAX_FITTED_TRIANGLES: u64 = 1 << 21;
+
+/// Refuses a fit whose fitted level would have more than [`MAX_FITTED_TRIANGLES`]
+/// triangles, before anything of that size is allocated.
+fn check_fitted_size(control_triangles: u64, levels: u32) -> Result<(), Error> {
+    let fitted = control_triangles.saturating_mul(1u64 << (2 * levels.min(31)));
+    if fitted > MAX_FITTED_TRIANGLES {
+        return Err(Error::LimitExceeded {
+            what: "fitted triangles (control triangles x 4^levels)",
+            limit: MAX_FITTED_TRIANGLES,
+            value: fitted,
+        });
+    }
+    Ok(())
+}
+
 /// What a fit did and how well it fits.
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
@@ -379,6 +400,14 @@ pub struct Fitted {
 pub fn fit(input: &Mesh, opts: &FitOptions) -> Result<Fitted, Error> {
     opts.check()?;
     check_input(input)?;
+    // A closed control mesh has about twice as many triangles as vertices; a target above
+    // the input's vertex count keeps the input's own triangles.
+    let control_triangles = if opts.control_vertices >= input.positions.len() {
+        input.triangles.len() as u64
+    } else {
+        2 * opts.control_vertices as u64
+    };
+    check_fitted_size(control_triangles, opts.levels)?;
     let start = Instant::now();
     let denoised;
     let source = if opts.denoise_iterations > 0 {
@@ -438,6 +467,7 @@ pub fn fit_control(
 ) -> Result<Fitted, Error> {
     opts.check()?;
     check_input(input)?;
+    check_fitted_size(control.triangles.len() as u64, opts.levels)?;
     let (hier, _) = crate::surface::prepare(control, initial, opts.levels)?;
     let start = Instant::now();
     let bbox = input.bounding_box();
@@ -841,5 +871,39 @@ mod tests {
         assert!((w - DVec3::new(0.25, 0.25, 0.5)).length() < 1e-12);
         // Degenerate triangle: no NaN.
         assert!(barycentric(DVec3::X, a, a, a).is_finite());
+    }
+
+    /// A control vertex target whose fitted level would pass the limit is refused before
+    /// the simplification, by the limit's own error; one the input caps is measured by the
+    /// input's triangles.
+    #[test]
+    fn an_oversized_fit_is_refused_up_front() {
+        let mesh = whet_testkit::meshes::icosphere(2);
+        let huge = FitOptions::DEFAULT.with_control_vertices(1 << 20);
+        // The icosphere has 162 vertices: the target is capped by them, so it fits.
+        assert!(check_fitted_size(mesh.triangles.len() as u64, huge.levels).is_ok());
+        // 163 842 vertices, 327 680 triangles: a target under the vertex count is priced at
+        // two triangles per vertex, one over it at the input's triangles.
+        let big = whet_testkit::meshes::icosphere(7);
+        let under = FitOptions::DEFAULT.with_control_vertices(100_000);
+        for (opts, triangles) in [(under, 200_000), (huge, 327_680)] {
+            match fit(&big, &opts) {
+                Err(Error::LimitExceeded { what, limit, value }) => {
+                    assert!(what.contains("fitted triangles"));
+                    assert_eq!(limit, MAX_FITTED_TRIANGLES);
+                    assert_eq!(value, triangles * 64);
+                }
+                other => panic!("expected the fitted-size limit, got {other:?}"),
+            }
+        }
+        assert!(matches!(
+            fit_control(
+                &big,
+                &big,
+                &EdgeSharpness::zeros(&big),
+                &FitOptions::DEFAULT
+            ),
+            Err(Error::LimitExceeded { .. })
+        ));
     }
 }

@@ -40,7 +40,7 @@ mod topology;
 pub use denoise::bilateral_denoise;
 pub use fit::{
     fit, fit_control, initial_sharpness, FitFallback, FitOptions, FitReport, Fitted, SharpnessMode,
-    SharpnessSolver,
+    SharpnessSolver, MAX_FITTED_TRIANGLES,
 };
 pub use qem::{simplify, Simplified, SimplifyOptions};
 pub use sharpness::EdgeSharpness;

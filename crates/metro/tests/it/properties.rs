@@ -5,6 +5,7 @@ use serde_json::Value;
 use whet_mesh::{DVec3, Mesh};
 use whet_metro::{
     error_ramp, metro, one_sided, vertex_distances, Bvh, Error, Figures, MetroOptions, MetroReport,
+    MAX_FACE_SAMPLES,
 };
 
 use crate::common::{cube, grid, sphere, translated};
@@ -250,6 +251,21 @@ fn bad_input_is_an_error_not_a_panic() {
     // Coordinates whose squares overflow.
     let huge = translated(&good, DVec3::X * 1e200);
     assert_eq!(metro(&good, &huge, &o), Err(Error::Overflow));
+    // A sample count past the limit is refused before any sampling, both ways in.
+    let too_many = MAX_FACE_SAMPLES + 1;
+    let e = metro(&good, &good, &opts(too_many)).unwrap_err();
+    assert_eq!(
+        e,
+        Error::TooManySamples {
+            samples: too_many,
+            limit: MAX_FACE_SAMPLES
+        }
+    );
+    assert!(e.to_string().contains("more than the limit"), "{e}");
+    assert!(matches!(
+        one_sided(&good, &target, usize::MAX, 0, 1.0),
+        Err(Error::TooManySamples { .. })
+    ));
 }
 
 #[test]
