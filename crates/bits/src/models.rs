@@ -221,6 +221,22 @@ impl SymbolModel {
         (last, self.total - self.freq[last], self.freq[last])
     }
 
+    /// [`Self::find`] of `min(code / r, total - 1)`, by multiplication: the first symbol
+    /// whose scaled upper end `r (cum + freq)` lies above `code`, else the last one. `r` is at
+    /// most `u32::MAX / total` (a range coder's `range / total`), so no product overflows.
+    #[inline]
+    pub fn find_scaled(&self, code: u32, r: u32) -> (usize, u32, u32) {
+        let mut cum = 0;
+        for (s, &f) in self.freq.iter().enumerate() {
+            if code < r * (cum + f) {
+                return (s, cum, f);
+            }
+            cum += f;
+        }
+        let last = self.freq.len() - 1;
+        (last, self.total - self.freq[last], self.freq[last])
+    }
+
     /// Counts one more occurrence of `symbol`.
     #[inline]
     pub fn update(&mut self, symbol: usize) {

@@ -248,10 +248,12 @@ impl<'a> RangeDecoder<'a> {
     pub fn decode_symbol(&mut self, model: &mut SymbolModel) -> usize {
         let total = model.total();
         let r = self.range / total;
-        // A corrupt stream can put `code` past the last interval; clamp so the decoder stays
-        // in range (the symbol is garbage, which a CRC or a later check catches).
-        let target = (self.code / r).min(total - 1);
-        let (symbol, cum, freq) = model.find(target);
+        // The symbol whose scaled interval holds `code`: the same as finding
+        // `min(code / r, total - 1)` among the counts (`code / r < k` exactly when
+        // `code < r k`), without the second division on the chain from symbol to symbol. A
+        // corrupt stream can put `code` past the last interval: that reads as the last
+        // symbol, as the clamp did (garbage, which a CRC or a later check catches).
+        let (symbol, cum, freq) = model.find_scaled(self.code, r);
         self.code = self.code.wrapping_sub(r * cum);
         self.range = r * freq;
         model.update(symbol);
@@ -466,6 +468,24 @@ mod tests {
                 }
             }
             prop_assert!(d.finish().is_ok());
+        }
+
+        /// The decoder's division-free search picks what dividing and clamping picked, for
+        /// any counts (updates included), any `code` (past the last interval too) and any
+        /// `range` a normalized decoder holds.
+        #[test]
+        fn scaled_search_is_the_divided_one(
+            updates in proptest::collection::vec(0usize..9, 0..3000),
+            code in any::<u32>(),
+            range in (1u32 << 24)..=u32::MAX,
+        ) {
+            let mut m = SymbolModel::new(9);
+            for u in updates {
+                m.update(u);
+            }
+            let r = range / m.total();
+            let target = (code / r).min(m.total() - 1);
+            prop_assert_eq!(m.find_scaled(code, r), m.find(target));
         }
 
         #[test]

@@ -456,19 +456,20 @@ impl DegreeOrder<'_> {
     }
 }
 
-/// Anchors unknown neighbour `x` of a known vertex (at corner `cx`) and raises its degree
-/// across the triangle whose third vertex is `y`. True when `x` is unknown, so must be
-/// queued.
+/// Anchors unknown neighbour `x` of a known vertex (at corner `cx`), whose state byte the
+/// caller loaded as `sx`, and raises its degree across the triangle whose third vertex is
+/// known when `y_known`. True when `x` is unknown, so must be queued.
 #[inline(always)]
-fn raise(anchor: &mut [u32], state: &mut [u8], x: usize, y: usize, cx: usize) -> bool {
+fn raise(anchor: &mut [u32], state: &mut [u8], x: usize, sx: u8, y_known: bool, cx: usize) -> bool {
+    if sx & STATE_MASK != UNKNOWN {
+        // A known vertex was anchored before it became known (only queued vertices are
+        // popped, and every queued one was anchored here), and a dummy is never walked.
+        return false;
+    }
     if anchor[x] == u32::MAX {
         anchor[x] = cx as u32;
     }
-    let sx = state[x];
-    if sx & STATE_MASK != UNKNOWN {
-        return false;
-    }
-    if state[y] & STATE_MASK == KNOWN && sx < FULL_DEGREE {
+    if y_known && sx < FULL_DEGREE {
         state[x] = sx + DEGREE_ONE;
     }
     true
@@ -520,11 +521,12 @@ fn walk_fan(
         };
         let a = cv[ca] as usize;
         let b = cv[cb] as usize;
+        // Both state bytes once per step: a raise changes only the degree bits of its own
+        // vertex (a != b in a checked table), never whether a vertex is known.
+        let (sa, sb) = (state[a], state[b]);
+        let (a_known, b_known) = (sa & STATE_MASK == KNOWN, sb & STATE_MASK == KNOWN);
         if let Some(out) = cands.as_deref_mut() {
-            if count < MAX_CANDIDATES
-                && state[a] & STATE_MASK == KNOWN
-                && state[b] & STATE_MASK == KNOWN
-            {
+            if count < MAX_CANDIDATES && a_known && b_known {
                 let o = opp[c] as usize;
                 if o < nc {
                     let w = cv[o] as usize;
@@ -545,10 +547,10 @@ fn walk_fan(
         if pending != a && pending != usize::MAX {
             push(state, buckets, pending);
         }
-        if raise(anchor, state, a, b, ca) && c != start {
+        if raise(anchor, state, a, sa, b_known, ca) && c != start {
             push(state, buckets, a);
         }
-        pending = if raise(anchor, state, b, a, cb) {
+        pending = if raise(anchor, state, b, sb, a_known, cb) {
             b
         } else {
             usize::MAX
