@@ -1,6 +1,6 @@
 //! `whet convert`: between OFF, OBJ, PLY and STL.
 
-use super::{read_mesh, write_mesh, CliResult};
+use super::{read_mesh_noting_skipped, write_mesh, CliResult};
 use clap::Args;
 use std::path::PathBuf;
 use whet::io::{Format, PlyEncoding, StlEncoding, WriteOptions};
@@ -30,7 +30,7 @@ pub struct ConvertArgs {
 }
 
 pub fn run(args: &ConvertArgs) -> CliResult {
-    let mut mesh = read_mesh(&args.input, args.format)?;
+    let (mut mesh, _) = read_mesh_noting_skipped(&args.input, args.format)?;
     if args.make_manifold {
         let rep = mesh.make_manifold();
         eprintln!("make_manifold: {rep}");

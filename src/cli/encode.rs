@@ -1,6 +1,6 @@
 //! `whet encode`: a mesh file to a `.whet` stream.
 
-use super::{print_json, read_mesh, write_mesh, CliResult, Failure};
+use super::{print_json, read_mesh_noting_skipped, skipped_json, write_mesh, CliResult, Failure};
 use clap::{ArgGroup, Args, ValueEnum};
 use serde_json::json;
 use std::path::PathBuf;
@@ -162,14 +162,15 @@ pub fn run(args: &EncodeArgs) -> CliResult {
              --mode swing only"
         )));
     }
-    let mesh = read_mesh(&args.input, args.format)?;
+    let (mesh, skipped) = read_mesh_noting_skipped(&args.input, args.format)?;
     match args.mode {
-        ModeArg::Exact => run_exact(args, &mesh),
-        ModeArg::Swing => run_swing(args, &mesh),
+        ModeArg::Exact => run_exact(args, &mesh, &skipped),
+        ModeArg::Swing => run_swing(args, &mesh, &skipped),
         ModeArg::Subdiv => super::encode_subdiv::run_subdiv(
             &args.input,
             &args.output,
             &mesh,
+            &skipped,
             args.control_vertices,
             args.levels,
             args.quant_bits,
@@ -222,7 +223,7 @@ fn repair_json(r: &whet_codec::EncodeReport) -> serde_json::Value {
     })
 }
 
-fn run_exact(args: &EncodeArgs, mesh: &whet::Mesh) -> CliResult {
+fn run_exact(args: &EncodeArgs, mesh: &whet::Mesh, skipped: &whet::io::ReadReport) -> CliResult {
     let quant_bits = args.quant_bits.unwrap_or(14);
     let opts = EncodeOptions::DEFAULT
         .with_mode(Mode::Exact)
@@ -256,6 +257,7 @@ fn run_exact(args: &EncodeArgs, mesh: &whet::Mesh) -> CliResult {
             "clers_histogram": { "C": h[0], "L": h[1], "E": h[2], "R": h[3], "S": h[4] },
             "repair": repair_json(r),
             "dropped_unused_vertices": r.dropped_unused_vertices,
+            "skipped_attributes": skipped_json(skipped),
         }));
     } else {
         outln!(
@@ -274,7 +276,7 @@ fn run_exact(args: &EncodeArgs, mesh: &whet::Mesh) -> CliResult {
     Ok(())
 }
 
-fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh) -> CliResult {
+fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh, skipped: &whet::io::ReadReport) -> CliResult {
     let rate = if let Some(l) = args.edge_length {
         Rate::EdgeLength(l)
     } else if let Some(r) = args.bpv {
@@ -417,6 +419,7 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh) -> CliResult {
             })).collect::<Vec<_>>(),
             "repair": repair_json(r),
             "dropped_unused_vertices": r.dropped_unused_vertices,
+            "skipped_attributes": skipped_json(skipped),
         }));
     } else {
         outln!(

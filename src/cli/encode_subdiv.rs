@@ -1,15 +1,18 @@
 //! `whet encode --mode subdiv`: fit a control mesh with continuous edge sharpness and write
 //! the subdiv stream.
 
-use super::{print_json, CliResult, Failure};
+use super::{print_json, skipped_json, CliResult, Failure};
 use serde_json::json;
 use std::path::Path;
 
-/// Encodes `mesh` in the subdiv mode and writes `output`.
+/// Encodes `mesh` in the subdiv mode and writes `output`; `skipped` is what reading `input`
+/// left out, for the JSON output.
+#[allow(clippy::too_many_arguments)]
 pub fn run_subdiv(
     input: &Path,
     output: &Path,
     mesh: &whet::Mesh,
+    skipped: &whet::io::ReadReport,
     control_vertices: usize,
     levels: Option<u32>,
     quant_bits: Option<u32>,
@@ -52,6 +55,7 @@ pub fn run_subdiv(
             "bits_per_original_vertex": bpov,
             "bits_per_vertex": bytes.len() as f64 * 8.0 / (r.decoded_vertices.max(1) as f64),
             "bits_per_triangle": bytes.len() as f64 * 8.0 / (r.decoded_triangles.max(1) as f64),
+            "skipped_attributes": skipped_json(skipped),
         }));
     } else {
         outln!(

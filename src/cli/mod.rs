@@ -192,17 +192,49 @@ pub fn split_triangles(triangles: usize, levels: u32) -> u64 {
 
 /// Reads a mesh file, mapping unreadable input to exit code 2 with the path in the message.
 pub fn read_mesh(path: &Path, format: Option<whet::io::Format>) -> CliResult<whet::Mesh> {
-    whet::io::read_path(path, format).map_err(|e| {
-        let code = if e.is_input_error() || path_missing(path) {
-            EXIT_BAD_INPUT
-        } else {
-            EXIT_FAILURE
-        };
-        Failure {
-            code,
-            error: anyhow::Error::new(e).context(format!("cannot read {}", path.display())),
-        }
-    })
+    whet::io::read_path(path, format).map_err(|e| read_failure(path, e))
+}
+
+/// Reads a mesh file as [`read_mesh`] does, and says on stderr what the file held that whet
+/// does not keep (one note line, none when nothing was skipped); returns the report too, for
+/// JSON output.
+pub fn read_mesh_noting_skipped(
+    path: &Path,
+    format: Option<whet::io::Format>,
+) -> CliResult<(whet::Mesh, whet::io::ReadReport)> {
+    let (mesh, report) =
+        whet::io::read_path_with_report(path, format).map_err(|e| read_failure(path, e))?;
+    if !report.is_empty() {
+        eprintln!(
+            "whet: note: {}: {report} not kept (whet codes positions and triangles only)",
+            path.display()
+        );
+    }
+    Ok((mesh, report))
+}
+
+/// The `skipped_attributes` array of `--json` output: one `{"what", "count"}` object per
+/// kind of data the reader skipped, empty when it skipped nothing.
+pub fn skipped_json(report: &whet::io::ReadReport) -> serde_json::Value {
+    report
+        .skipped
+        .iter()
+        .map(|s| serde_json::json!({ "what": s.what, "count": s.count }))
+        .collect()
+}
+
+/// A read error as a failure: exit code 2 for input that cannot be read as a mesh (or a
+/// missing file), 1 otherwise, with the path in the message.
+fn read_failure(path: &Path, e: whet::io::Error) -> Failure {
+    let code = if e.is_input_error() || path_missing(path) {
+        EXIT_BAD_INPUT
+    } else {
+        EXIT_FAILURE
+    };
+    Failure {
+        code,
+        error: anyhow::Error::new(e).context(format!("cannot read {}", path.display())),
+    }
 }
 
 /// Writes a mesh file; any failure is exit code 1.

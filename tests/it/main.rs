@@ -8,6 +8,7 @@ mod cli_info;
 mod cli_metro;
 mod cli_rd;
 mod cli_sharpen;
+mod cli_skipped;
 mod fixtures;
 mod fuzz_replay;
 

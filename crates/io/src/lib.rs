@@ -7,6 +7,11 @@
 //! round-trip form, so OFF, OBJ, ascii STL and every PLY encoding reproduce f64 positions bit
 //! for bit (binary STL stores f32).
 //!
+//! A mesh holds positions and triangles only: the readers skip texture coordinates, normals,
+//! colours and every other attribute a file carries. [`read_with_report`] and
+//! [`read_path_with_report`] also return a [`ReadReport`] that names what was skipped and how
+//! much of it, so that an application can tell its user what a conversion drops.
+//!
 //! ```
 //! use whet_io::{read, write, Format, WriteOptions};
 //! use whet_mesh::{DVec3, Mesh};
@@ -37,6 +42,7 @@ mod format;
 mod obj;
 mod off;
 mod ply;
+mod report;
 mod stl;
 mod text;
 
@@ -48,6 +54,7 @@ use whet_mesh::{DVec3, Mesh};
 
 pub use error::Error;
 pub use format::{Format, ParseFormatError, PlyEncoding, StlEncoding, WriteOptions};
+pub use report::{ReadReport, Skipped};
 
 /// Readers reserve at most this many vertices or triangles up front, whatever a header claims;
 /// beyond it vectors grow as data actually arrives.
@@ -61,8 +68,19 @@ const BUF_SIZE: usize = 1 << 16;
 /// With `format` `None` the format comes from the extension ([`Format::from_path`]); an
 /// unknown extension gives [`Error::UnknownFormat`]. The file is streamed through a
 /// `BufReader`. For STL the file size decides between ascii and binary when the header starts
-/// with `solid` (see [`read()`]).
+/// with `solid` (see [`read()`]). Attributes the file holds besides positions and polygons are
+/// skipped without a word; [`read_path_with_report`] says which.
 pub fn read_path(path: &Path, format: Option<Format>) -> Result<Mesh, Error> {
+    read_path_with_report(path, format).map(|(mesh, _)| mesh)
+}
+
+/// Reads the mesh file at `path` as [`read_path`] does, and reports what the file held that
+/// the mesh does not keep (texture coordinates, normals, colours, other PLY properties and
+/// elements...; see [`ReadReport`]).
+pub fn read_path_with_report(
+    path: &Path,
+    format: Option<Format>,
+) -> Result<(Mesh, ReadReport), Error> {
     let format = resolve_format(path, format)?;
     let file = File::open(path)?;
     let size = file
@@ -79,12 +97,27 @@ pub fn read_path(path: &Path, format: Option<Format>) -> Result<Mesh, Error> {
 /// piece. Polygons are fan-triangulated. STL vertices are welded exactly (identical
 /// coordinates become one vertex, in order of first appearance). An STL stream whose first
 /// bytes are `solid` is read as ascii when its first 84 bytes are all text and as binary
-/// otherwise; [`read_path`] decides by the file size instead.
+/// otherwise; [`read_path`] decides by the file size instead. Attributes besides positions and
+/// polygons are skipped without a word; [`read_with_report`] says which.
 pub fn read<R: BufRead>(reader: R, format: Format) -> Result<Mesh, Error> {
+    read_with_report(reader, format).map(|(mesh, _)| mesh)
+}
+
+/// Reads a mesh in `format` from a buffered reader as [`read()`] does, and reports what the
+/// file held that the mesh does not keep (see [`ReadReport`]). The report is made of counters:
+/// reading stays streaming and allocates nothing more for it as the input grows.
+pub fn read_with_report<R: BufRead>(
+    reader: R,
+    format: Format,
+) -> Result<(Mesh, ReadReport), Error> {
     read_impl(reader, format, None)
 }
 
-fn read_impl<R: BufRead>(reader: R, format: Format, size: Option<u64>) -> Result<Mesh, Error> {
+fn read_impl<R: BufRead>(
+    reader: R,
+    format: Format,
+    size: Option<u64>,
+) -> Result<(Mesh, ReadReport), Error> {
     match format {
         Format::Off => off::read(reader),
         Format::Obj => obj::read(reader),

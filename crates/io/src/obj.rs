@@ -7,8 +7,15 @@
 //! with a trailing `\`, and every other statement (`vt`, `vn`, `vp`, `g`, `o`, `s`, `usemtl`,
 //! `mtllib`, `l`, `p`, curves and surfaces...) are accepted and ignored.
 //!
-//! Does not read: texture coordinates, normals, groups or materials (they are skipped),
-//! free-form geometry (skipped), points and lines (skipped).
+//! Does not read: texture coordinates, normals, vertex colours, groups or materials (they are
+//! skipped), free-form geometry (skipped), points and lines (skipped). The read report
+//! ([`crate::ReadReport`]) counts, in this order: texture coordinates (`vt` lines), vertex
+//! normals (`vn`), vertex colours (`v` lines with three or more values after `x y z`),
+//! parameter-space vertices (`vp`), points (`p` statements), lines (`l` statements) and
+//! free-form curves/surfaces (`curv`, `curv2` and `surf` statements). Names (`g`, `o`, `s`,
+//! `usemtl`, `mtllib`), the `w` of `v x y z w` (a weight of rational curves, which does not
+//! move a polygon's vertex), display and rendering statements and the texture and normal
+//! references of `f` (their data is the `vt` and `vn` lines) are not counted.
 //!
 //! Writes `v` and `f` lines (1-based) with coordinates in shortest round-trip form, so a
 //! written mesh reads back bit for bit.
@@ -18,10 +25,10 @@ use std::io::{BufRead, Write};
 use whet_mesh::Mesh;
 
 use crate::text::{parse_f64, parse_i64, show, strip_comment, tokens, write_f64, LineReader};
-use crate::{finite_point, Error, Fan};
+use crate::{finite_point, Error, Fan, ReadReport, Skipped};
 
-/// Reads an OBJ file.
-pub(crate) fn read<R: BufRead>(reader: R) -> Result<Mesh, Error> {
+/// Reads an OBJ file and reports what it skipped.
+pub(crate) fn read<R: BufRead>(reader: R) -> Result<(Mesh, ReadReport), Error> {
     let mut lines = LineReader::new(reader);
     let mut state = State::default();
     let mut joined: Vec<u8> = Vec::new();
@@ -55,6 +62,61 @@ struct State {
     faces: usize,
     /// References past the vertices read so far, as (face, 0-based index), checked at the end.
     forward: Vec<(usize, i64)>,
+    /// Statements and values that hold data the mesh does not keep.
+    skipped: Counts,
+}
+
+/// Counts of what the reader skips, for the [`ReadReport`].
+#[derive(Default)]
+struct Counts {
+    /// `vt` lines.
+    texture_coordinates: u64,
+    /// `vn` lines.
+    normals: u64,
+    /// `v` lines with three or more values after `x y z`.
+    colours: u64,
+    /// `vp` lines.
+    parameter_vertices: u64,
+    /// `p` statements.
+    points: u64,
+    /// `l` statements.
+    lines: u64,
+    /// `curv`, `curv2` and `surf` statements.
+    free_form: u64,
+}
+
+impl Counts {
+    fn report(&self) -> ReadReport {
+        let mut r = ReadReport::default();
+        r.push(Skipped::items(
+            "texture coordinates",
+            "texture coordinate",
+            self.texture_coordinates,
+        ));
+        r.push(Skipped::items(
+            "vertex normals",
+            "vertex normal",
+            self.normals,
+        ));
+        r.push(Skipped::items(
+            "vertex colours",
+            "vertex colour",
+            self.colours,
+        ));
+        r.push(Skipped::items(
+            "parameter-space vertices (`vp`)",
+            "parameter-space vertex (`vp`)",
+            self.parameter_vertices,
+        ));
+        r.push(Skipped::items("points (`p`)", "point (`p`)", self.points));
+        r.push(Skipped::items("lines (`l`)", "line (`l`)", self.lines));
+        r.push(Skipped::items(
+            "free-form curves/surfaces",
+            "free-form curve/surface",
+            self.free_form,
+        ));
+        r
+    }
 }
 
 impl State {
@@ -66,6 +128,12 @@ impl State {
         match keyword {
             b"v" => self.vertex(toks, line_no),
             b"f" => self.face(toks, line_no),
+            b"vt" => Self::count(&mut self.skipped.texture_coordinates),
+            b"vn" => Self::count(&mut self.skipped.normals),
+            b"vp" => Self::count(&mut self.skipped.parameter_vertices),
+            b"p" => Self::count(&mut self.skipped.points),
+            b"l" => Self::count(&mut self.skipped.lines),
+            b"curv" | b"curv2" | b"surf" => Self::count(&mut self.skipped.free_form),
             _ if keyword
                 .iter()
                 .all(|&b| b.is_ascii_alphanumeric() || b == b'_') =>
@@ -77,6 +145,11 @@ impl State {
                 format!("not an OBJ statement: '{}'", show(keyword)),
             )),
         }
+    }
+
+    fn count(counter: &mut u64) -> Result<(), Error> {
+        *counter += 1;
+        Ok(())
     }
 
     fn vertex<'a>(
@@ -99,6 +172,10 @@ impl State {
                     format!("invalid coordinate '{}' in vertex {}", show(tok), index + 1),
                 )
             })?;
+        }
+        // `v x y z w` carries a weight, `v x y z r g b` a colour.
+        if toks.nth(2).is_some() {
+            self.skipped.colours += 1;
         }
         if self.positions.len() >= u32::MAX as usize {
             return Err(Error::TooLarge {
@@ -160,7 +237,7 @@ impl State {
         Ok(())
     }
 
-    fn finish(self) -> Result<Mesh, Error> {
+    fn finish(self) -> Result<(Mesh, ReadReport), Error> {
         let vertex_count = self.positions.len();
         if let Some(&(face, index)) = self
             .forward
@@ -173,7 +250,10 @@ impl State {
                 vertex_count,
             });
         }
-        Ok(Mesh::new(self.positions, self.triangles))
+        Ok((
+            Mesh::new(self.positions, self.triangles),
+            self.skipped.report(),
+        ))
     }
 }
 
@@ -206,6 +286,10 @@ mod tests {
     use super::*;
     use whet_mesh::DVec3;
 
+    fn read<R: BufRead>(reader: R) -> Result<Mesh, Error> {
+        super::read(reader).map(|(mesh, _)| mesh)
+    }
+
     fn read_str(s: &str) -> Result<Mesh, Error> {
         read(s.as_bytes())
     }
@@ -225,6 +309,41 @@ mod tests {
             m.triangles,
             vec![[0, 1, 2], [0, 2, 3], [0, 1, 2], [0, 1, 2], [0, 2, 3]]
         );
+    }
+
+    #[test]
+    fn report_counts_uvs_normals_colours_points_lines_and_curves() {
+        let text = "# a quad with texture coordinates and normals\nmtllib m.mtl\no quad\n\
+                    g top\ns 1\nusemtl red\n\
+                    v 0 0 0\nv 1 0 0 1.0\nv 1 1 0 0.5 0.5 0.5\nv 0 1 0\n\
+                    vt 0 0\nvt 1 0\nvt 1 \\\n 1\nvt 0 1\nvn 0 0 1\nvn 0 0 -1\n\
+                    f 1/1/1 2/2/1 3/3/2 4/4/2\nl 1 2 3\np 1\np 2\n\
+                    vp 0.5\ncstype bspline\ndeg 1\ncurv 0.0 1.0 1 2\nparm u 0 0 1 1\nend\n";
+        let (mesh, report) = super::read(text.as_bytes()).unwrap();
+        assert_eq!(mesh.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+        assert_eq!(
+            report.pairs(),
+            vec![
+                ("texture coordinates", 4),
+                ("vertex normals", 2),
+                ("vertex colours", 1),
+                ("parameter-space vertices (`vp`)", 1),
+                ("points (`p`)", 2),
+                ("lines (`l`)", 1),
+                ("free-form curves/surfaces", 1),
+            ]
+        );
+        assert_eq!(
+            report.to_string(),
+            "4 texture coordinates, 2 vertex normals, 1 vertex colour, \
+             1 parameter-space vertex (`vp`), 2 points (`p`), 1 line (`l`) and \
+             1 free-form curve/surface"
+        );
+        // Names, comments and `w` weights hold nothing a mesh user misses.
+        let names = "# c\nmtllib d.mtl\no a\ng b\ns off\nusemtl c\n\
+                     v 0 0 0 1\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+        let (_, report) = super::read(names.as_bytes()).unwrap();
+        assert!(report.is_empty(), "{report:?}");
     }
 
     #[test]

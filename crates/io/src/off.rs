@@ -10,6 +10,12 @@
 //! Does not read: binary OFF (`OFF BINARY`), 4D and n-dimensional OFF (`4OFF`, `nOFF`),
 //! vertices or faces split across several lines.
 //!
+//! The read report ([`crate::ReadReport`]) counts, in this order: vertex normals (`N` prefix),
+//! vertex colours (`C`) and texture coordinates (`ST`), each as the vertices whose line has
+//! columns after `x y z` when the keyword has that prefix; extra vertex values (the vertices
+//! with columns after `x y z` when the keyword has no prefix); face colours (the faces with
+//! values after their indices).
+//!
 //! Writes plain `OFF` with coordinates in shortest round-trip form, so a written mesh reads
 //! back bit for bit.
 
@@ -18,12 +24,26 @@ use std::io::{BufRead, Write};
 use whet_mesh::{DVec3, Mesh};
 
 use crate::text::{parse_f64, parse_i64, show, strip_comment, tokens, write_f64, LineReader};
-use crate::{capacity, check_index, finite_point, Error, Fan};
+use crate::{capacity, check_index, finite_point, Error, Fan, ReadReport, Skipped};
 
-/// Reads an OFF file.
-pub(crate) fn read<R: BufRead>(reader: R) -> Result<Mesh, Error> {
+/// The prefixes of the OFF keyword that announce per-vertex values after `x y z`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct Prefixes {
+    /// `ST`: texture coordinates.
+    st: bool,
+    /// `C`: colours.
+    c: bool,
+    /// `N`: normals.
+    n: bool,
+}
+
+/// Reads an OFF file and reports what it skipped.
+pub(crate) fn read<R: BufRead>(reader: R) -> Result<(Mesh, ReadReport), Error> {
     let mut lines = LineReader::new(reader);
-    let (vertex_count, face_count) = read_header(&mut lines)?;
+    let (vertex_count, face_count, prefixes) = read_header(&mut lines)?;
+    // Vertices with columns after `x y z`, and faces with values after their indices.
+    let mut extra_vertices: u64 = 0;
+    let mut extra_faces: u64 = 0;
 
     let mut positions = Vec::with_capacity(capacity(vertex_count));
     while (positions.len() as u64) < vertex_count {
@@ -34,8 +54,9 @@ pub(crate) fn read<R: BufRead>(reader: R) -> Result<Mesh, Error> {
             )));
         }
         let index = positions.len();
-        if let Some(p) = parse_vertex(lines.current(), lines.line(), index)? {
+        if let Some((p, extra)) = parse_vertex(lines.current(), lines.line(), index)? {
             positions.push(p);
+            extra_vertices += u64::from(extra);
         }
     }
 
@@ -50,7 +71,7 @@ pub(crate) fn read<R: BufRead>(reader: R) -> Result<Mesh, Error> {
         }
         // face < face_count <= u32::MAX, so it fits usize.
         let face_index = face as usize;
-        if parse_face(
+        if let Some(extra) = parse_face(
             lines.current(),
             lines.line(),
             face_index,
@@ -58,13 +79,52 @@ pub(crate) fn read<R: BufRead>(reader: R) -> Result<Mesh, Error> {
             &mut triangles,
         )? {
             face += 1;
+            extra_faces += u64::from(extra);
         }
     }
-    Ok(Mesh::new(positions, triangles))
+    let report = report(prefixes, extra_vertices, extra_faces);
+    Ok((Mesh::new(positions, triangles), report))
 }
 
-/// Parses the vertex line `line`; `None` for a blank or comment line.
-fn parse_vertex(line: &[u8], line_no: usize, index: usize) -> Result<Option<DVec3>, Error> {
+/// What the reader skipped: `extra_vertices` vertices with columns after `x y z`, whose
+/// meaning `prefixes` tells, and `extra_faces` faces with values after their indices.
+fn report(prefixes: Prefixes, extra_vertices: u64, extra_faces: u64) -> ReadReport {
+    let mut r = ReadReport::default();
+    let announced = |flag: bool| if flag { extra_vertices } else { 0 };
+    r.push(Skipped::items(
+        "vertex normals",
+        "vertex normal",
+        announced(prefixes.n),
+    ));
+    r.push(Skipped::items(
+        "vertex colours",
+        "vertex colour",
+        announced(prefixes.c),
+    ));
+    r.push(Skipped::items(
+        "texture coordinates",
+        "texture coordinate",
+        announced(prefixes.st),
+    ));
+    let unnamed = if prefixes == Prefixes::default() {
+        extra_vertices
+    } else {
+        0
+    };
+    r.push(Skipped::of(
+        "extra vertex values".to_owned(),
+        unnamed,
+        "on ",
+        "vertex",
+        "vertices",
+    ));
+    r.push(Skipped::items("face colours", "face colour", extra_faces));
+    r
+}
+
+/// Parses the vertex line `line` into the position and whether columns follow `x y z`; `None`
+/// for a blank or comment line.
+fn parse_vertex(line: &[u8], line_no: usize, index: usize) -> Result<Option<(DVec3, bool)>, Error> {
     let mut toks = tokens(strip_comment(line));
     let Some(first) = toks.next() else {
         return Ok(None);
@@ -87,20 +147,22 @@ fn parse_vertex(line: &[u8], line_no: usize, index: usize) -> Result<Option<DVec
             )
         })?;
     }
-    finite_point(xyz[0], xyz[1], xyz[2], index).map(Some)
+    let extra = toks.next().is_some();
+    finite_point(xyz[0], xyz[1], xyz[2], index).map(|p| Some((p, extra)))
 }
 
-/// Parses the face line `line` into `triangles`; false for a blank or comment line.
+/// Parses the face line `line` into `triangles`, and whether values (a colour) follow the
+/// indices; `None` for a blank or comment line.
 fn parse_face(
     line: &[u8],
     line_no: usize,
     face: usize,
     vertex_count: usize,
     triangles: &mut Vec<[u32; 3]>,
-) -> Result<bool, Error> {
+) -> Result<Option<bool>, Error> {
     let mut toks = tokens(strip_comment(line));
     let Some(count_tok) = toks.next() else {
-        return Ok(false);
+        return Ok(None);
     };
     let n = match parse_i64(count_tok) {
         Some(n) if n >= 3 => n,
@@ -133,12 +195,13 @@ fn parse_face(
         })?;
         fan.push(check_index(index, face, vertex_count)?, triangles);
     }
-    Ok(true)
+    Ok(Some(toks.next().is_some()))
 }
 
 /// Reads the keyword and the vertex and face counts.
-fn read_header<R: BufRead>(lines: &mut LineReader<R>) -> Result<(u64, u64), Error> {
+fn read_header<R: BufRead>(lines: &mut LineReader<R>) -> Result<(u64, u64, Prefixes), Error> {
     let mut seen_keyword = false;
+    let mut prefixes = Prefixes::default();
     let mut counts: Vec<u64> = Vec::with_capacity(3);
     loop {
         if !lines.advance()? {
@@ -152,7 +215,7 @@ fn read_header<R: BufRead>(lines: &mut LineReader<R>) -> Result<(u64, u64), Erro
         let mut toks = tokens(strip_comment(lines.current()));
         if !seen_keyword {
             let Some(keyword) = toks.next() else { continue };
-            check_keyword(keyword, line_no)?;
+            prefixes = check_keyword(keyword, line_no)?;
             seen_keyword = true;
         }
         for tok in toks {
@@ -177,13 +240,14 @@ fn read_header<R: BufRead>(lines: &mut LineReader<R>) -> Result<(u64, u64), Erro
             counts.push(count);
         }
         if counts.len() >= 2 {
-            return Ok((counts[0], counts[1]));
+            return Ok((counts[0], counts[1], prefixes));
         }
     }
 }
 
-/// Accepts `OFF` with the optional `ST`, `C`, `N` prefixes; refuses `4OFF` and `nOFF`.
-fn check_keyword(keyword: &[u8], line: usize) -> Result<(), Error> {
+/// Accepts `OFF` with the optional `ST`, `C`, `N` prefixes, and returns them; refuses `4OFF`
+/// and `nOFF`.
+fn check_keyword(keyword: &[u8], line: usize) -> Result<Prefixes, Error> {
     let not_off = || {
         Error::parse(
             line,
@@ -219,7 +283,8 @@ fn check_keyword(keyword: &[u8], line: usize) -> Result<(), Error> {
         }
     }
     if rest.is_empty() {
-        Ok(())
+        let [st, c, n] = seen;
+        Ok(Prefixes { st, c, n })
     } else {
         Err(not_off())
     }
@@ -247,8 +312,49 @@ pub(crate) fn write<W: Write>(w: &mut W, mesh: &Mesh) -> std::io::Result<()> {
 mod tests {
     use super::*;
 
+    fn read<R: BufRead>(reader: R) -> Result<Mesh, Error> {
+        super::read(reader).map(|(mesh, _)| mesh)
+    }
+
     fn read_str(s: &str) -> Result<Mesh, Error> {
         read(s.as_bytes())
+    }
+
+    fn report_of(s: &str) -> ReadReport {
+        super::read(s.as_bytes()).unwrap().1
+    }
+
+    #[test]
+    fn report_names_what_the_prefixes_announce() {
+        // COFF: RGBA per vertex (one vertex without), RGB per face (one face without).
+        let coff = "COFF\n4 2 0\n0 0 0 255 0 0 255\n1 0 0 0 255 0 255\n\
+                    1 1 0 0 0 255 255 # blue\n0 1 0\n\
+                    3 0 1 2 255 255 255\n3 0 2 3\n";
+        let r = report_of(coff);
+        assert_eq!(r.pairs(), vec![("vertex colours", 3), ("face colours", 1)]);
+        assert_eq!(r.to_string(), "3 vertex colours and 1 face colour");
+        // NOFF on the keyword line with the counts, comments between the vertices.
+        let noff = "NOFF 3 1 0\n0 0 0 0 0 1\n# normal up\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2\n";
+        let r = report_of(noff);
+        assert_eq!(r.pairs(), vec![("vertex normals", 3)]);
+        assert_eq!(r.to_string(), "3 vertex normals");
+        // STCNOFF names every kind for each vertex with extra columns.
+        let stcnoff = "STCNOFF\n3 1 0\n0 0 0 0 0 1 1 0 0 1 0 0\n\
+                       1 0 0 0 0 1 0 1 0 1 1 0\n0 1 0 0 0 1 0 0 1 1 0 1\n3 0 1 2\n";
+        assert_eq!(
+            report_of(stcnoff).pairs(),
+            vec![
+                ("vertex normals", 3),
+                ("vertex colours", 3),
+                ("texture coordinates", 3),
+            ]
+        );
+        // Plain OFF with stray columns: values the file does not name.
+        let r = report_of("OFF\n3 1 0\n0 0 0 7\n1 0 0\n0 1 0\n3 0 1 2\n");
+        assert_eq!(r.pairs(), vec![("extra vertex values", 1)]);
+        assert_eq!(r.to_string(), "extra vertex values (on 1 vertex)");
+        // A prefix whose values are missing, and comments after the data, skip nothing.
+        assert!(report_of("COFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0 # c\n3 0 1 2 # c\n").is_empty());
     }
 
     #[test]
@@ -283,6 +389,15 @@ mod tests {
         ] {
             assert!(check_keyword(kw.as_bytes(), 1).is_ok(), "{kw}");
         }
+        assert_eq!(
+            check_keyword(b"NCOFF", 1).unwrap(),
+            Prefixes {
+                st: false,
+                c: true,
+                n: true
+            }
+        );
+        assert_eq!(check_keyword(b"OFF", 1).unwrap(), Prefixes::default());
         assert!(matches!(
             check_keyword(b"4OFF", 1),
             Err(Error::Unsupported { .. })

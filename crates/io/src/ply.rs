@@ -15,6 +15,16 @@
 //! face indices, triangle strips (`tristrips`), and a face element without an index list (all
 //! [`Error::Unsupported`]). Vertex normals, colours and other attributes are skipped.
 //!
+//! The read report ([`crate::ReadReport`]) lists what the header declares besides `x y z` and
+//! the face index list, in header order, each with the element count from the header: on the
+//! vertex and face elements, normals (`nx ny nz`: "vertex normals", "face normals"), colours
+//! (`red green blue alpha`, also `diffuse_*`: "vertex colours", "face colours") and texture
+//! coordinates (`u v`, `s t`, `texture_u`...: "texture coordinates"; a face `texcoord` list:
+//! "per-corner texture coordinates"), one entry per kind, and every other property by name
+//! ("vertex property `confidence`", "face property `flags`"); every other element with at
+//! least one property by name ("element `edge`"). Elements with no entries or no properties
+//! hold nothing and are not listed.
+//!
 //! Writes `double x y z` (exact round trip), optionally `double quality` and `uchar red green
 //! blue`, and faces as `list uchar uint vertex_indices`, in any of the three encodings.
 
@@ -26,7 +36,7 @@ use crate::binary::{ended, BinReader, Decode};
 use crate::text::{
     parse_f64, parse_i64, show, tokens, write_f64, LineReader, TokenReader, MAX_LINE,
 };
-use crate::{capacity, check_index, finite_point, Error, Fan, PlyEncoding};
+use crate::{capacity, check_index, finite_point, Error, Fan, PlyEncoding, ReadReport, Skipped};
 
 /// Longest header the reader accepts, in bytes.
 const MAX_HEADER: usize = 1 << 20;
@@ -165,12 +175,12 @@ struct Plan {
     vertex_count: usize,
 }
 
-/// Reads a PLY file.
-pub(crate) fn read<R: BufRead>(reader: R) -> Result<Mesh, Error> {
+/// Reads a PLY file and reports what it skipped.
+pub(crate) fn read<R: BufRead>(reader: R) -> Result<(Mesh, ReadReport), Error> {
     let mut lines = LineReader::with_max_len(reader, MAX_HEADER_LINE);
     let header = read_header(&mut lines)?;
     let plan = plan(&header)?;
-    match header.encoding {
+    let mesh = match header.encoding {
         Encoding::Ascii => {
             lines.set_max_len(MAX_LINE);
             read_ascii(&mut TokenReader::new(lines), &header, &plan)
@@ -179,7 +189,112 @@ pub(crate) fn read<R: BufRead>(reader: R) -> Result<Mesh, Error> {
             let mut bin = BinReader::new(lines.into_inner());
             read_binary(&mut bin, &header, &plan, big_endian)
         }
+    }?;
+    Ok((mesh, report(&header, &plan)))
+}
+
+/// A kind of attribute PLY files name by convention.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Kind {
+    Normals,
+    Colours,
+    TextureCoordinates,
+}
+
+impl Kind {
+    /// The kind of property `prop` of the vertex (`face` false) or face element.
+    fn of(prop: &Property, face: bool) -> Option<Kind> {
+        match (prop, face) {
+            (Property::Scalar { name, .. }, _) => match name.as_str() {
+                "nx" | "ny" | "nz" => Some(Kind::Normals),
+                "red" | "green" | "blue" | "alpha" | "diffuse_red" | "diffuse_green"
+                | "diffuse_blue" | "diffuse_alpha" => Some(Kind::Colours),
+                "u" | "v" | "s" | "t" | "texture_u" | "texture_v" | "texture_s" | "texture_t"
+                    if !face =>
+                {
+                    Some(Kind::TextureCoordinates)
+                }
+                _ => None,
+            },
+            (Property::List { name, .. }, true) if name == "texcoord" => {
+                Some(Kind::TextureCoordinates)
+            }
+            (Property::List { .. }, _) => None,
+        }
     }
+
+    /// The report entry of `count` values of this kind on the vertex or face element.
+    fn skipped(self, face: bool, count: u64) -> Skipped {
+        match (self, face) {
+            (Kind::Normals, false) => Skipped::items("vertex normals", "vertex normal", count),
+            (Kind::Normals, true) => Skipped::items("face normals", "face normal", count),
+            (Kind::Colours, false) => Skipped::items("vertex colours", "vertex colour", count),
+            (Kind::Colours, true) => Skipped::items("face colours", "face colour", count),
+            (Kind::TextureCoordinates, false) => {
+                Skipped::items("texture coordinates", "texture coordinate", count)
+            }
+            (Kind::TextureCoordinates, true) => Skipped::of(
+                "per-corner texture coordinates".to_owned(),
+                count,
+                "on ",
+                "face",
+                "faces",
+            ),
+        }
+    }
+}
+
+/// What the header declares besides the coordinates and the face indices (see the module
+/// documentation).
+fn report(header: &Header, plan: &Plan) -> ReadReport {
+    let mut r = ReadReport::default();
+    for (i, element) in header.elements.iter().enumerate() {
+        if element.count == 0 || element.props.is_empty() {
+            continue;
+        }
+        let face_list = plan.face.filter(|&(f, _)| f == i).map(|(_, list)| list);
+        if i != plan.vertex && face_list.is_none() {
+            r.push(Skipped::of(
+                format!("element `{}`", element.name),
+                element.count,
+                "",
+                "entry",
+                "entries",
+            ));
+            continue;
+        }
+        let face = i != plan.vertex;
+        let used = |k: usize| {
+            if face {
+                face_list == Some(k)
+            } else {
+                plan.xyz.contains(&k)
+            }
+        };
+        // The kinds already listed, indexed by `Kind as usize`.
+        let mut listed = [false; 3];
+        for (k, prop) in element.props.iter().enumerate() {
+            if used(k) {
+                continue;
+            }
+            match Kind::of(prop, face) {
+                Some(kind) => {
+                    if !listed[kind as usize] {
+                        listed[kind as usize] = true;
+                        r.push(kind.skipped(face, element.count));
+                    }
+                }
+                None => r.push(Skipped::of(
+                    format!("{} property `{}`", element.name, prop.name()),
+                    element.count,
+                    "",
+                    "value",
+                    "values",
+                )),
+            }
+        }
+    }
+    r
 }
 
 fn read_header<R: BufRead>(lines: &mut LineReader<R>) -> Result<Header, Error> {
@@ -913,6 +1028,10 @@ pub(crate) fn write<W: Write>(
 mod tests {
     use super::*;
 
+    fn read<R: BufRead>(reader: R) -> Result<Mesh, Error> {
+        super::read(reader).map(|(mesh, _)| mesh)
+    }
+
     fn tetra() -> Mesh {
         Mesh::new(
             vec![
@@ -962,6 +1081,102 @@ mod tests {
             assert_eq!(bits(&back), bits(&m));
             assert_eq!(back.triangles, m.triangles);
         }
+    }
+
+    #[test]
+    fn report_lists_normals_colours_properties_and_elements() {
+        let header = "comment normals, colours, a confidence, face colours and flags, edges\n\
+            element vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+            property float nx\nproperty float ny\nproperty float nz\n\
+            property uchar red\nproperty uchar green\nproperty uchar blue\nproperty uchar alpha\n\
+            property float confidence\n\
+            element face 2\nproperty list uchar int vertex_indices\n\
+            property uchar red\nproperty uchar green\nproperty uchar blue\nproperty int flags\n\
+            element edge 1\nproperty int vertex1\nproperty int vertex2\n\
+            element material 0\nproperty uchar ambient_red\nelement empty 5\n";
+        let ascii_file = format!(
+            "ply\nformat ascii 1.0\n{header}end_header\n\
+             0 0 0 0 0 1 255 0 0 255 0.5\n1 0 0 0 0 1 0 255 0 255 0.25\n\
+             0 1 0 0 0 1 0 0 255 255 1\n\
+             3 0 1 2 9 9 9 7\n3 0 2 1 8 8 8 6\n0 1\n"
+        );
+        let binary = binary_file(true, header, |out, big| {
+            for (x, y) in [(0.0f32, 0.0f32), (1.0, 0.0), (0.0, 1.0)] {
+                for c in [x, y, 0.0, 0.0, 0.0, 1.0] {
+                    put(out, c.to_le_bytes(), big);
+                }
+                out.extend_from_slice(&[1, 2, 3, 255]);
+                put(out, 0.5f32.to_le_bytes(), big);
+            }
+            for tri in [[0i32, 1, 2], [0, 2, 1]] {
+                out.push(3);
+                for i in tri {
+                    put(out, i.to_le_bytes(), big);
+                }
+                out.extend_from_slice(&[9, 9, 9]);
+                put(out, 7i32.to_le_bytes(), big);
+            }
+            put(out, 0i32.to_le_bytes(), big);
+            put(out, 1i32.to_le_bytes(), big);
+        });
+        for file in [ascii_file.into_bytes(), binary] {
+            let (mesh, report) = super::read(&file[..]).unwrap();
+            assert_eq!(mesh.triangles, vec![[0, 1, 2], [0, 2, 1]]);
+            assert_eq!(
+                report.pairs(),
+                vec![
+                    ("vertex normals", 3),
+                    ("vertex colours", 3),
+                    ("vertex property `confidence`", 3),
+                    ("face colours", 2),
+                    ("face property `flags`", 2),
+                    ("element `edge`", 1),
+                ]
+            );
+            assert_eq!(
+                report.to_string(),
+                "3 vertex normals, 3 vertex colours, vertex property `confidence` (3 values), \
+                 2 face colours, face property `flags` (2 values) and element `edge` (1 entry)"
+            );
+        }
+    }
+
+    #[test]
+    fn report_of_texture_coordinates_and_of_a_plain_file() {
+        let file = ascii(&[
+            "element vertex 3",
+            XYZ,
+            "property float s",
+            "property float t",
+            "element face 1",
+            "property list uchar int vertex_indices",
+            "property list uchar float texcoord",
+            "end_header",
+            "0 0 0 0 0\n1 0 0 1 0\n0 1 0 0 1",
+            "3 0 1 2 6 0 0 1 0 0 1",
+        ]);
+        let (_, report) = super::read(&file[..]).unwrap();
+        assert_eq!(
+            report.pairs(),
+            vec![
+                ("texture coordinates", 3),
+                ("per-corner texture coordinates", 1)
+            ]
+        );
+        assert_eq!(
+            report.to_string(),
+            "3 texture coordinates and per-corner texture coordinates (on 1 face)"
+        );
+        let mut out = Vec::new();
+        write(
+            &mut out,
+            &tetra(),
+            &[],
+            &[],
+            PlyEncoding::BinaryLittleEndian,
+        )
+        .unwrap();
+        assert!(super::read(&out[..]).unwrap().1.is_empty());
     }
 
     #[test]

@@ -17,6 +17,11 @@
 //! Does not read: colour or material conventions of the attribute bytes, ascii files without
 //! `endsolid`.
 //!
+//! The read report ([`crate::ReadReport`]) lists the binary attribute bytes only when some are
+//! not zero, as "STL attribute bytes" counting the facets whose two bytes are not both zero
+//! (almost every exporter writes zeros, and some readers take non-zero ones for a colour).
+//! Facet normals follow from the triangles and are not reported; nor is the 80-byte header.
+//!
 //! Writes ascii (coordinates in shortest round-trip form: exact for f64) or binary (f32:
 //! coordinates round to the nearest f32, so a round trip is exact only for f32-representable
 //! coordinates, and a coordinate beyond f32's range is refused). Facet normals are the unit
@@ -30,23 +35,27 @@ use whet_mesh::{DVec3, Mesh};
 
 use crate::binary::{array, ended, BinReader};
 use crate::text::{parse_f64, show, tokens, write_f64, LineReader};
-use crate::{capacity, Error, Fan, StlEncoding};
+use crate::{capacity, Error, Fan, ReadReport, Skipped, StlEncoding};
 
 /// Size of the binary header plus count.
 const HEAD: usize = 84;
 /// Size of one binary triangle record.
 const RECORD: u64 = 50;
 
-/// Reads an STL file; `size` is the total file size when known (it decides ascii vs binary
-/// for files that start with `solid`).
-pub(crate) fn read<R: BufRead>(mut reader: R, size: Option<u64>) -> Result<Mesh, Error> {
+/// Reads an STL file and reports what it skipped; `size` is the total file size when known
+/// (it decides ascii vs binary for files that start with `solid`).
+pub(crate) fn read<R: BufRead>(
+    mut reader: R,
+    size: Option<u64>,
+) -> Result<(Mesh, ReadReport), Error> {
     let mut head = [0u8; HEAD];
     let got = read_up_to(&mut reader, &mut head)?;
     let head = &head[..got];
     if is_binary(head, size) {
         read_binary(BinReader::with_prefix(reader, head))
     } else {
-        read_ascii(LineReader::new(head.chain(reader)))
+        let mesh = read_ascii(LineReader::new(head.chain(reader)))?;
+        Ok((mesh, ReadReport::default()))
     }
 }
 
@@ -137,7 +146,7 @@ fn key64(x: f64) -> u64 {
     }
 }
 
-fn read_binary<R: Read>(mut bin: BinReader<R>) -> Result<Mesh, Error> {
+fn read_binary<R: Read>(mut bin: BinReader<R>) -> Result<(Mesh, ReadReport), Error> {
     let head = bin.get(HEAD).map_err(|e| {
         if e.kind() == ErrorKind::UnexpectedEof {
             Error::truncated(
@@ -151,10 +160,13 @@ fn read_binary<R: Read>(mut bin: BinReader<R>) -> Result<Mesh, Error> {
     let n = u64::from(n);
     let mut weld = Welder::new(3 * n);
     let mut triangles = Vec::with_capacity(capacity(n));
+    // Facets whose attribute bytes are not zero.
+    let mut attributes: u64 = 0;
     for i in 0..n {
         let rec = bin
             .get(RECORD as usize)
             .map_err(|e| ended(e, n, "triangles", i))?;
+        attributes += u64::from(rec[48] | rec[49] != 0);
         let mut t = [0; 3];
         for (k, corner) in t.iter_mut().enumerate() {
             let o = 12 + 12 * k;
@@ -164,7 +176,15 @@ fn read_binary<R: Read>(mut bin: BinReader<R>) -> Result<Mesh, Error> {
         }
         triangles.push(t);
     }
-    Ok(Mesh::new(weld.positions, triangles))
+    let mut report = ReadReport::default();
+    report.push(Skipped::of(
+        "STL attribute bytes".to_owned(),
+        attributes,
+        "non-zero on ",
+        "facet",
+        "facets",
+    ));
+    Ok((Mesh::new(weld.positions, triangles), report))
 }
 
 fn read_ascii<R: BufRead>(mut lines: LineReader<R>) -> Result<Mesh, Error> {
@@ -341,6 +361,10 @@ fn write_binary<W: Write>(w: &mut W, mesh: &Mesh) -> Result<(), Error> {
 mod tests {
     use super::*;
 
+    fn read<R: BufRead>(reader: R, size: Option<u64>) -> Result<Mesh, Error> {
+        super::read(reader, size).map(|(mesh, _)| mesh)
+    }
+
     fn f32_mesh() -> Mesh {
         Mesh::new(
             vec![
@@ -364,6 +388,35 @@ mod tests {
             assert_eq!(read(&out[..], None).unwrap(), m, "{enc:?}");
             assert_eq!(read(&out[..], Some(size)).unwrap(), m, "{enc:?}");
         }
+    }
+
+    #[test]
+    fn report_counts_facets_with_non_zero_attribute_bytes() {
+        let m = f32_mesh();
+        let mut out = Vec::new();
+        write(&mut out, &m, StlEncoding::Binary).unwrap();
+        let size = Some(out.len() as u64);
+        // whet writes zeros: nothing to report.
+        let (back, report) = super::read(&out[..], size).unwrap();
+        assert_eq!(back, m);
+        assert!(report.is_empty(), "{report:?}");
+        // A colour in the attribute bytes of facets 1 and 3 (low byte, then high byte only).
+        let attr = |facet: usize| HEAD + RECORD as usize * facet + 48;
+        out[attr(1)] = 0x1f;
+        out[attr(3) + 1] = 0x80;
+        for size in [size, None] {
+            let (back, report) = super::read(&out[..], size).unwrap();
+            assert_eq!(back, m);
+            assert_eq!(report.pairs(), vec![("STL attribute bytes", 2)]);
+            assert_eq!(
+                report.to_string(),
+                "STL attribute bytes (non-zero on 2 facets)"
+            );
+        }
+        // Ascii STL has no attribute bytes, and its facet normals are not reported.
+        let mut text = Vec::new();
+        write(&mut text, &m, StlEncoding::Ascii).unwrap();
+        assert!(super::read(&text[..], None).unwrap().1.is_empty());
     }
 
     #[test]

@@ -2,7 +2,7 @@
 
 use std::fs;
 
-use whet_io::{read, read_path, Format};
+use whet_io::{read, read_path, read_path_with_report, read_with_report, Format};
 use whet_mesh::{DVec3, Mesh};
 
 use crate::common::temp_path;
@@ -196,4 +196,37 @@ fn stl_ascii_welds_corners() {
     let back = read_path(&path, None);
     fs::remove_file(&path).unwrap();
     assert_eq!(back.unwrap(), square());
+}
+
+#[test]
+fn reports_name_what_was_skipped_and_plain_reads_agree() {
+    let obj = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n\
+               vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\n\
+               f 1/1/1 2/2/1 3/3/1 4/4/1\n";
+    let path = temp_path("report.obj");
+    fs::write(&path, obj).unwrap();
+    let with_report = read_path_with_report(&path, None);
+    let plain = read_path(&path, None);
+    fs::remove_file(&path).unwrap();
+    let (mesh, report) = with_report.unwrap();
+    assert_eq!(mesh, square());
+    assert_eq!(plain.unwrap(), square());
+    let pairs: Vec<(&str, u64)> = report
+        .skipped
+        .iter()
+        .map(|s| (s.what.as_str(), s.count))
+        .collect();
+    assert_eq!(
+        pairs,
+        vec![("texture coordinates", 4), ("vertex normals", 1)]
+    );
+    assert_eq!(
+        report.to_string(),
+        "4 texture coordinates and 1 vertex normal"
+    );
+    let off = "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n";
+    let (mesh, report) = read_with_report(off.as_bytes(), Format::Off).unwrap();
+    assert_eq!(mesh, square());
+    assert!(report.is_empty());
+    assert_eq!(report.to_string(), "nothing");
 }
