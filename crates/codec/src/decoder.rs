@@ -160,7 +160,8 @@ pub fn decode_container(container: &Container, opts: &DecodeOptions) -> Result<M
     Ok(mesh)
 }
 
-/// A decoder over any reader: [`Decoder::read_header`] then [`Decoder::decode`].
+/// A decoder over any reader: [`Decoder::new`] then [`Decoder::decode`], which reads the
+/// whole stream (the header included) and decodes it.
 pub struct Decoder<R: Read> {
     reader: R,
     opts: DecodeOptions,

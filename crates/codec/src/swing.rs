@@ -40,7 +40,7 @@
 //!   through adaptive frequency tables instead of bit trees;
 //! * kinds 7 and 8, **what the encoder writes** (format 1.2): kinds 5 and 6 with the
 //!   connectivity coded inside the walk, label by label in creation order, in the context of
-//!   the geometry rebuilt around each gate ([`front`]); the connectivity section holds only
+//!   the geometry rebuilt around each gate (module `front`); the connectivity section holds only
 //!   the triangle count. The encoder falls back to kinds 5 and 6 if that walk does not
 //!   reproduce the retiled mesh;
 //! * kind 1, explicit: the exact mode's position coder on the kept retiled triangles,
@@ -934,13 +934,13 @@ pub struct SwingStreamInfo<'a> {
     /// optional header fields 17 and 19, written when not [`SurfaceFilter::NONE`]).
     pub sharpened_filter: SurfaceFilter,
     /// The sharpening the encoder measured best (optional header field 21, written when
-    /// `Some`; [`SharpenHint`]).
+    /// `Some`; [`crate::SharpenHint`]).
     pub sharpen_hint: Option<crate::SharpenHint>,
     /// Its smooth factor (optional header field 23, written when `Some` and the hint is;
-    /// [`SharpenHint::smooth_factor_code`]).
+    /// [`crate::SharpenHint::smooth_factor_code`]).
     pub sharpen_smooth_factor: Option<f64>,
     /// Its curved-wall factor (optional header field 27, written when `Some` and the hint
-    /// is; [`SharpenHint::curved_walls_code`]).
+    /// is; [`crate::SharpenHint::curved_walls_code`]).
     pub sharpen_curved_walls: Option<f64>,
     /// Its EdgeSharpener passes (optional header field 29, written when `Some` and the hint
     /// is).
