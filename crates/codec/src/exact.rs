@@ -817,6 +817,19 @@ fn encode_exact_with(
     let mut new_id = vec![u32::MAX; mesh.positions.len()];
     for (new, &old) in old_id.iter().enumerate() {
         if let Some(slot) = new_id.get_mut(old as usize) {
+            if *slot != u32::MAX {
+                // One input vertex became two traversal vertices: the only contact of two
+                // components, which the traversal ranks once per component (the deferred
+                // fan check cannot see it: the relabelled table has split it). Only one
+                // copy would get the position; the caller's full path cuts the vertex with
+                // `make_manifold` and reports it.
+                return Err(crate::Error::InvalidInput(
+                    whet_mesh::MeshError::NonManifoldVertex {
+                        vertex: old,
+                        fans: 2,
+                    },
+                ));
+            }
             *slot = new as u32;
         }
     }

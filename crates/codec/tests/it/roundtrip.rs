@@ -188,6 +188,66 @@ fn closed_surfaces_pinched_at_a_vertex_are_repaired_or_refused() {
     );
 }
 
+/// Two tetrahedra sharing one vertex, where the second component's first triangle holds it:
+/// the traversal starts that component there and ranks the vertex a second time. The fast
+/// path used to code only one copy's position (the other decoded at the grid's origin, a
+/// third of the diagonal away) and report no repair; the vertex is now cut and reported,
+/// and both copies decode where the input vertex is.
+#[test]
+fn a_vertex_shared_by_a_components_start_triangle_is_cut_and_reported() {
+    let p = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+    let m = Mesh::new(
+        vec![
+            p(0.0, 0.0, 0.0),
+            p(1.0, 0.0, 0.0),
+            p(0.0, 1.0, 0.0),
+            p(0.0, 0.0, 1.0),
+            p(-1.0, 0.0, 0.0),
+            p(0.0, -1.0, 0.0),
+            p(0.0, 0.0, -1.0),
+        ],
+        vec![
+            [0, 2, 1],
+            [0, 1, 3],
+            [0, 3, 2],
+            [1, 2, 3],
+            [0, 5, 4],
+            [0, 4, 6],
+            [0, 6, 5],
+            [4, 5, 6],
+        ],
+    );
+    let enc = encode(&m, &EncodeOptions::DEFAULT).unwrap();
+    assert_eq!(
+        enc.report.repair.added_vertices, 1,
+        "{:?}",
+        enc.report.repair
+    );
+    assert_eq!(enc.report.vertices, 8);
+    let order = &enc.report.vertex_order;
+    assert_eq!(order.iter().filter(|&&v| v == 0).count(), 2);
+    let dec = decode(&enc.bytes, &DecodeOptions::DEFAULT).unwrap();
+    // Every decoded vertex within half a step (14 bits over an extent of 2) of its source.
+    let half = 2.0 / ((1u64 << 14) - 1) as f64 * 0.5 * (1.0 + 1e-9);
+    for (i, &src) in order.iter().enumerate() {
+        let d = (dec.positions[i] - m.positions[src as usize])
+            .abs()
+            .max_element();
+        assert!(d <= half, "vertex {i} (input {src}) off by {d}");
+    }
+    let refuse = encode(&m, &EncodeOptions::DEFAULT.with_repair(false)).unwrap_err();
+    assert!(
+        matches!(
+            refuse,
+            whet_codec::Error::InvalidInput(whet_mesh::MeshError::NonManifoldVertex {
+                vertex: 0,
+                ..
+            })
+        ),
+        "{refuse}"
+    );
+}
+
 #[test]
 fn nan_input_is_refused() {
     let mut m = icosphere(0);
