@@ -431,37 +431,48 @@ impl CornerTable {
     /// end leaves corners unmet.
     fn fans_cover_all_corners(&self) -> bool {
         let nc = self.corner_vertex.len() as u64;
-        let opposite = self.opposite.as_slice();
         let mut met = 0u64;
         for &start in &self.vertex_corner {
             if start == NONE {
                 continue;
             }
-            met += 1;
-            // As in `check_fan`: the corner after c in its triangle, one modulo per step.
-            let mut after = {
-                let j = start % 3;
-                start - j + NEXT_IN_TRIANGLE[j as usize]
-            };
-            while let Some(&o) = opposite.get(after as usize) {
-                if o == NONE {
-                    break;
-                }
-                let jo = o % 3;
-                let base = o - jo;
-                let jn = NEXT_IN_TRIANGLE[jo as usize];
-                if base + jn == start || met > nc {
-                    break;
-                }
-                met += 1;
-                after = base + NEXT_IN_TRIANGLE[jn as usize];
-            }
+            met += self.fan_walk(start, nc - met);
             if met > nc {
                 // Only an inconsistent table walks past its corner count.
                 return false;
             }
         }
         met == nc
+    }
+
+    /// The corners met swinging from `start` (itself included) until the walk returns to
+    /// it or reaches a boundary, stopping once more than `cap` are met. Open fans start at
+    /// their clockwise end; a closed fan anywhere. Over the raw arrays with one 32-bit
+    /// modulo per step: the corner's own position in its triangle is known from the step
+    /// before (the walk runs once per vertex of every input, so its instructions count).
+    fn fan_walk(&self, start: u32, cap: u64) -> u64 {
+        let opposite = self.opposite.as_slice();
+        let mut seen = 1u64;
+        // The corner after c in its triangle.
+        let mut after = {
+            let j = start % 3;
+            start - j + NEXT_IN_TRIANGLE[j as usize]
+        };
+        while let Some(&o) = opposite.get(after as usize) {
+            if o == NONE {
+                break;
+            }
+            // The swung corner n = next(o), and the corner after it.
+            let jo = o % 3;
+            let base = o - jo;
+            let jn = NEXT_IN_TRIANGLE[jo as usize];
+            if base + jn == start || seen > cap {
+                break;
+            }
+            seen += 1;
+            after = base + NEXT_IN_TRIANGLE[jn as usize];
+        }
+        seen
     }
 
     fn fan_counts(&self) -> (Vec<u32>, Vec<u8>) {
@@ -491,34 +502,8 @@ impl CornerTable {
         if open_fans[v] > 1 {
             return Err(fail());
         }
-        // Open fans start at their clockwise end; a closed fan anywhere. Count the fan,
-        // swinging over the raw arrays with one 32-bit modulo per step: c's own position in
-        // its triangle is known from the step before (the walk runs once per vertex of
-        // every input, so its instructions count).
-        let opposite = self.opposite.as_slice();
-        let valence = valence[v];
-        let mut seen = 1u32;
-        // The corner after c in its triangle.
-        let mut after = {
-            let j = start % 3;
-            start - j + NEXT_IN_TRIANGLE[j as usize]
-        };
-        while let Some(&o) = opposite.get(after as usize) {
-            if o == NONE {
-                break;
-            }
-            // The swung corner n = next(o), and the corner after it.
-            let jo = o % 3;
-            let base = o - jo;
-            let jn = NEXT_IN_TRIANGLE[jo as usize];
-            let n = base + jn;
-            if n == start || seen > valence {
-                break;
-            }
-            seen += 1;
-            after = base + NEXT_IN_TRIANGLE[jn as usize];
-        }
-        if seen != valence {
+        let seen = self.fan_walk(start, valence[v] as u64);
+        if seen != valence[v] as u64 {
             return Err(fail());
         }
         Ok(())
