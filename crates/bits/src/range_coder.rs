@@ -280,6 +280,30 @@ impl<'a> RangeDecoder<'a> {
         symbol
     }
 
+    /// [`Self::decode_with`] without its second division: `find` gets `code` and `r =
+    /// range / total` and maps them to `(symbol, cum, freq)` of the first interval whose
+    /// scaled upper end `r (cum + freq)` lies above `code`, else of the last interval. That
+    /// is the interval holding `min(code / r, total - 1)` (`code / r < k` exactly when `code
+    /// < r k`), so the two decode the same symbols from any bytes, and the division leaves
+    /// the chain from symbol to symbol. `r (cum + freq)` never overflows: it is at most
+    /// `range`.
+    #[inline]
+    pub fn decode_scaled_with(
+        &mut self,
+        total: u32,
+        find: impl FnOnce(u32, u32) -> (usize, u32, u32),
+    ) -> usize {
+        let total = total.max(1);
+        // `range` is at least 2^24 after every step and a total at most 2^16 + 32, so `r` is
+        // at least 255; the `max` only keeps a broken invariant from zeroing the range.
+        let r = (self.range / total).max(1);
+        let (symbol, cum, freq) = find(self.code, r);
+        self.code = self.code.wrapping_sub(r * cum);
+        self.range = r * freq;
+        self.normalize();
+        symbol
+    }
+
     /// Decodes a value coded with [`RangeEncoder::encode_tree`].
     #[inline]
     pub fn decode_tree(&mut self, tree: &mut BitTree) -> u32 {
@@ -486,6 +510,33 @@ mod tests {
             let r = range / m.total();
             let target = (code / r).min(m.total() - 1);
             prop_assert_eq!(m.find_scaled(code, r), m.find(target));
+        }
+
+        /// `SymbolTables::decode` (scaled search) reads the symbols that dividing and
+        /// clamping read, from any bytes and any sequence of tables: the labels of swing
+        /// streams decode as they did before the division left the chain.
+        #[test]
+        fn scaled_tables_decode_as_the_divided_reference(
+            bytes in proptest::collection::vec(any::<u8>(), 5..300),
+            tables_seq in proptest::collection::vec(0usize..4, 1..2000),
+        ) {
+            use crate::SymbolTables;
+            let mut input = bytes.clone();
+            input[0] = 0;
+            let (Ok(mut d1), Ok(mut d2)) = (RangeDecoder::new(&input), RangeDecoder::new(&input))
+            else {
+                return Ok(());
+            };
+            let mut tables = SymbolTables::new(4, 5);
+            // The reference: one SymbolModel per table, decoded by division and clamp.
+            let mut models: Vec<SymbolModel> = (0..4).map(|_| SymbolModel::new(5)).collect();
+            for &t in &tables_seq {
+                let m = &mut models[t];
+                let reference = d1.decode_with(m.total(), |target| m.find(target));
+                m.update(reference);
+                prop_assert_eq!(tables.decode(&mut d2, t), reference);
+            }
+            prop_assert_eq!(d1.position(), d2.position());
         }
 
         #[test]
