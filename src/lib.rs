@@ -122,3 +122,25 @@ pub fn encode_subdiv(
         .map_err(whet_codec::Error::from)?;
     Ok((bytes, p.report))
 }
+
+#[cfg(test)]
+mod thread_safety {
+    /// Servers decode on worker threads and share options and meshes between them: the
+    /// facade's types must stay `Send + Sync` (a compile-time check: a type that stops being
+    /// thread-safe fails the build of the tests).
+    #[test]
+    fn the_facade_types_are_send_and_sync() {
+        fn both<T: Send + Sync>() {}
+        both::<crate::Mesh>();
+        both::<crate::CornerTable>();
+        both::<crate::Encoder>();
+        both::<crate::Decoder<std::fs::File>>();
+        both::<crate::StreamingDecoder>();
+        both::<crate::EncodeOptions>();
+        both::<crate::DecodeOptions>();
+        both::<crate::Error>();
+        both::<crate::io::Error>();
+        both::<crate::codec::Error>();
+        both::<crate::codec::EncodeReport>();
+    }
+}

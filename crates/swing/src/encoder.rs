@@ -337,6 +337,51 @@ pub fn valence6_fraction(mesh: &Mesh) -> f64 {
     deg.iter().filter(|&&d| d == 6).count() as f64 / deg.len() as f64
 }
 
+/// A retiler that got stuck on a surface that is not orientable (a Möbius strip, a Klein
+/// bottle, or a part whose triangles face both ways across an edge) says so: the repair
+/// oriented it by cutting it open, but the two sides of the cut still touch, and the retiler,
+/// which follows the surface by its geometry, walks across the cut onto the side facing the
+/// other way, where no swing closes. Other errors pass through unchanged.
+fn explain_stuck(e: Error, mesh: &Mesh) -> Error {
+    match e {
+        Error::Stuck(why) => match orientation_seams(mesh) {
+            0 => Error::Stuck(why),
+            n => Error::InvalidInput(format!(
+                "the surface is not orientable: orienting it cut {n} edge{} whose two sides \
+                 still touch and face opposite ways, and the retiler cannot grow across such a \
+                 seam ({why}); --mode exact codes it",
+                if n == 1 { "" } else { "s" }
+            )),
+        },
+        e => e,
+    }
+}
+
+/// Boundary edges of `mesh` (an oriented manifold) that run the same way as another boundary
+/// edge between the same two positions: the two sides of an edge that was cut to orient the
+/// surface. A hole's boundary, or two surfaces that merely touch with their orientations
+/// agreeing, run opposite ways and do not count.
+fn orientation_seams(mesh: &Mesh) -> usize {
+    use std::collections::{HashMap, HashSet};
+    let key = |p: whet_mesh::DVec3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+    let directed: HashSet<(u32, u32)> = mesh
+        .triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+        .collect();
+    let mut by_position: HashMap<([u64; 3], [u64; 3]), usize> = HashMap::new();
+    for &(u, v) in &directed {
+        if !directed.contains(&(v, u)) {
+            let ends = (
+                key(mesh.positions[u as usize]),
+                key(mesh.positions[v as usize]),
+            );
+            *by_position.entry(ends).or_default() += 1;
+        }
+    }
+    by_position.values().filter(|&&n| n >= 2).count()
+}
+
 /// Encodes meshes in the swing mode with fixed options.
 #[derive(Clone, Debug, Default)]
 pub struct SwingEncoder {
@@ -402,10 +447,11 @@ impl SwingEncoder {
             mesh: p.mesh,
         };
         let out = if o.auto_angle_bits {
-            self.encode_auto_angle_bits(&prep)?
+            self.encode_auto_angle_bits(&prep)
         } else {
-            self.encode_prepared(&prep)?
+            self.encode_prepared(&prep)
         };
+        let out = out.map_err(|e| explain_stuck(e, &prep.mesh))?;
         if o.error_of == ErrorOf::Sharpened {
             return self.choose_sharpening(&prep, out);
         }
@@ -1422,5 +1468,26 @@ mod stuck_search_tests {
         assert!(near(outside_stuck(0.1, &[0.1, 0.08], 0.001), 0.78 * 0.08));
         // Never under the floor.
         assert!(near(outside_stuck(0.1, &[0.1], 0.09), 0.09));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use whet_testkit::meshes::{grid, union};
+
+    #[test]
+    fn only_the_cut_of_an_orientation_counts_as_a_seam() {
+        // A border, and two grids touching along a border with agreeing orientations
+        // (their border edges there run opposite ways): no seam.
+        assert_eq!(orientation_seams(&grid(4, 3)), 0);
+        assert_eq!(orientation_seams(&union(grid(4, 3), &grid(4, 3), 4.0)), 0);
+        // The same two grids with the second one flipped: the shared border now runs the
+        // same way on both sides, as the cut of a twist does (the 3 edges along x = 4).
+        let mut flipped = grid(4, 3);
+        for t in &mut flipped.triangles {
+            t.swap(1, 2);
+        }
+        assert_eq!(orientation_seams(&union(grid(4, 3), &flipped, 4.0)), 3);
     }
 }
