@@ -4,7 +4,9 @@
 //! `-log2(p)` is tabulated at compile time by the classic squaring method: normalise `x` into
 //! `[1, 2)` and square it repeatedly; each squaring that overflows 2 yields one fraction bit.
 
-use crate::models::{BitModel, BitSink, BitTree, SymbolModel, PROB_BITS, PROB_ONE};
+use crate::models::{
+    BitModel, BitSink, BitTree, CountingBitModel, SymbolModel, PROB_BITS, PROB_ONE,
+};
 
 /// Fraction bits of a cost: costs are in units of `1 / COST_ONE` bit.
 pub const COST_FRAC_BITS: u32 = 8;
@@ -113,6 +115,11 @@ impl BitSink for CostCounter {
     #[inline]
     fn encode_interval(&mut self, _cum: u32, freq: u32, total: u32) {
         self.cost += ratio_cost(freq, total) as u64;
+    }
+    #[inline]
+    fn encode_counting_bit(&mut self, model: &mut CountingBitModel, bit: bool) {
+        self.cost += model.cost(bit) as u64;
+        model.update(bit);
     }
     #[inline]
     fn encode_tree(&mut self, tree: &mut BitTree, value: u32) {

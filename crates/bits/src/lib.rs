@@ -34,8 +34,8 @@ mod residual;
 
 pub use cost::{CostCounter, COST_FRAC_BITS, COST_ONE};
 pub use models::{
-    BitModel, BitSink, BitTree, SignedIntModel, SymbolModel, SymbolTables, UnsignedIntModel,
-    ADAPT_SHIFT, PROB_BITS, PROB_ONE,
+    BitModel, BitSink, BitTree, CountingBitModel, SignedIntModel, SymbolModel, SymbolTables,
+    UnsignedIntModel, ADAPT_SHIFT, COUNTING_PROB_BITS, PROB_BITS, PROB_ONE,
 };
 pub use range_coder::{RangeDecoder, RangeEncoder};
 pub use raw::{RawBitReader, RawBitWriter};

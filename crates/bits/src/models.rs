@@ -34,6 +34,8 @@ pub trait BitSink {
     /// Codes the interval `[cum, cum + freq)` of a frequency table summing to `total`
     /// (`0 < freq`, `cum + freq <= total <= 2^16`); the caller updates its table.
     fn encode_interval(&mut self, cum: u32, freq: u32, total: u32);
+    /// Codes one bit with a [`CountingBitModel`] (and updates it).
+    fn encode_counting_bit(&mut self, model: &mut CountingBitModel, bit: bool);
     /// Codes a value through a bit tree.
     fn encode_tree(&mut self, tree: &mut BitTree, value: u32) {
         let bits = tree.bits();
@@ -66,6 +68,10 @@ impl BitSink for RangeEncoder {
     #[inline]
     fn encode_tree(&mut self, tree: &mut BitTree, value: u32) {
         RangeEncoder::encode_tree(self, tree, value)
+    }
+    #[inline]
+    fn encode_counting_bit(&mut self, model: &mut CountingBitModel, bit: bool) {
+        RangeEncoder::encode_counting_bit(self, model, bit)
     }
 }
 
@@ -111,6 +117,99 @@ impl BitModel {
             self.0 as u32
         };
         crate::cost::price(p)
+    }
+}
+
+/// Probability precision of a [`CountingBitModel`].
+pub const COUNTING_PROB_BITS: u32 = 15;
+const COUNTING_ONE: u32 = 1 << COUNTING_PROB_BITS;
+/// Nearest a [`CountingBitModel`] gets to certainty, in `1 / 2^15`.
+const COUNTING_MARGIN: u32 = 32;
+
+/// An adaptive probability of a binary event that learns fast while it has seen little and
+/// then settles: after its `n`-th bit it moves `1 / 2^s` of the way to the bit seen, with
+/// `s` = 1 for `n` < 2, 2 below 5, 3 below 10, 4 below 22, 5 below 44 and 6 from then on
+/// (about `1 / (n + 1.5)`, the step of a count-based estimate, until the window reaches 64
+/// bits). A [`BitModel`]'s fixed `1 / 32` pays dearly for its first bits when a coder
+/// spreads its bits over hundreds of contexts; this one does not. P(bit = 0) is held in
+/// `1 / 2^15`, within `[32, 2^15 − 32]`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CountingBitModel {
+    p0: u16,
+    seen: u8,
+}
+
+impl Default for CountingBitModel {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl CountingBitModel {
+    /// Bits seen after which the rate stays at its slowest.
+    const SETTLED: u8 = 44;
+
+    /// Starts at probability one half, having seen nothing.
+    pub const fn new() -> Self {
+        CountingBitModel {
+            p0: (COUNTING_ONE / 2) as u16,
+            seen: 0,
+        }
+    }
+
+    /// P(bit = 0) in units of `1 / 2^15`.
+    #[inline]
+    pub fn p0(&self) -> u32 {
+        self.p0 as u32
+    }
+
+    /// The rate shift after `n` bits: round(log2(n + 1.5)) clamped to 1..=6
+    /// (docs/format.md), tabulated.
+    const SHIFTS: [u8; Self::SETTLED as usize + 1] = {
+        let mut t = [0u8; Self::SETTLED as usize + 1];
+        let mut n = 0;
+        while n < t.len() {
+            t[n] = 1
+                + (n >= 2) as u8
+                + (n >= 5) as u8
+                + (n >= 10) as u8
+                + (n >= 22) as u8
+                + (n >= Self::SETTLED as usize) as u8;
+            n += 1;
+        }
+        t
+    };
+
+    /// The rate shift for the next update.
+    #[inline]
+    fn shift(&self) -> u32 {
+        // `seen` never passes SETTLED: the index is in range.
+        Self::SHIFTS[(self.seen as usize).min(Self::SETTLED as usize)] as u32
+    }
+
+    /// Moves the probability towards the bit just seen.
+    #[inline]
+    pub fn update(&mut self, bit: bool) {
+        let s = self.shift();
+        let p = self.p0 as u32;
+        let p = if bit {
+            p - (p >> s)
+        } else {
+            p + ((COUNTING_ONE - p) >> s)
+        };
+        self.p0 = p.clamp(COUNTING_MARGIN, COUNTING_ONE - COUNTING_MARGIN) as u16;
+        self.seen = (self.seen + 1).min(Self::SETTLED);
+    }
+
+    /// Cost of coding `bit` now, in 1/[`crate::COST_ONE`] bits (without updating).
+    #[inline]
+    pub fn cost(&self, bit: bool) -> u32 {
+        let p = if bit {
+            COUNTING_ONE - self.p0 as u32
+        } else {
+            self.p0 as u32
+        };
+        crate::cost::ratio_cost(p, COUNTING_ONE)
     }
 }
 

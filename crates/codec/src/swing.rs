@@ -59,9 +59,13 @@ use whet_mesh::{Aabb, DVec3, ManifoldRepair, Mesh, VertexId};
 
 #[path = "swing_front.rs"]
 mod front;
+#[path = "swing_neighbours.rs"]
+mod neighbours;
 
 /// The format version of geometry kinds 5 and 6.
 const VERSION_1_2: Version = Version::new(1, 2);
+/// The format version of geometry kinds 9 and 10.
+const VERSION_1_3: Version = Version::new(1, 3);
 
 /// Fewest angle bits a stream may use.
 pub const MIN_ANGLE_BITS: u32 = 3;
@@ -84,6 +88,30 @@ const KIND_SWING_SCALED_CUT: u8 = 6;
 /// writes (format 1.2).
 const KIND_SWING_FORWARD: u8 = 7;
 const KIND_SWING_FORWARD_CUT: u8 = 8;
+/// Kinds 7 and 8 with the neighbourhood prediction and bitwise residuals ([`neighbours`]);
+/// what the encoder writes unless kind 7 or 8 is smaller (format 1.3).
+const KIND_SWING_NEIGHBOURS: u8 = 9;
+const KIND_SWING_NEIGHBOURS_CUT: u8 = 10;
+
+/// How a forward walk (kinds 7 to 10) codes its swing indices.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum ForwardCoding {
+    /// Kinds 7 and 8: the kind 5 prediction and frequency tables.
+    Scaled,
+    /// Kinds 9 and 10: the neighbourhood prediction and bitwise residuals.
+    Neighbours,
+}
+
+impl ForwardCoding {
+    fn kind(self, cutting: bool) -> u8 {
+        match (self, cutting) {
+            (ForwardCoding::Scaled, false) => KIND_SWING_FORWARD,
+            (ForwardCoding::Scaled, true) => KIND_SWING_FORWARD_CUT,
+            (ForwardCoding::Neighbours, false) => KIND_SWING_NEIGHBOURS,
+            (ForwardCoding::Neighbours, true) => KIND_SWING_NEIGHBOURS_CUT,
+        }
+    }
+}
 
 /// How a stream codes its swing indices (by geometry kind).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -693,6 +721,17 @@ trait SwingIo {
         bits: u32,
         q: &mut i32,
     ) -> Result<(), Error>;
+    /// The swing index of the tip `v` in kinds 9 and 10: predicted as `pred`, its residual
+    /// coded through `models` in context `ctx`.
+    fn neighbour_index(
+        &mut self,
+        v: VertexId,
+        models: &mut neighbours::ResidualModels,
+        ctx: &neighbours::ResidualContext,
+        pred: i32,
+        bits: u32,
+        q: &mut i32,
+    ) -> Result<(), Error>;
 }
 
 struct SwingWriter<'a> {
@@ -727,12 +766,35 @@ impl SwingIo for SwingWriter<'_> {
                 model.encode(self.sink, zigzag(wrap_index(i - pred, bits)) & mask);
                 Ok(())
             }
-            _ => Err(Error::Corrupt(format!(
-                "retiled vertex {} is created by a C triangle but has no swing index",
-                v.0
-            ))),
+            _ => Err(no_swing_index(v)),
         }
     }
+    fn neighbour_index(
+        &mut self,
+        v: VertexId,
+        models: &mut neighbours::ResidualModels,
+        ctx: &neighbours::ResidualContext,
+        pred: i32,
+        bits: u32,
+        q: &mut i32,
+    ) -> Result<(), Error> {
+        match self.sources.get(v.index()) {
+            Some(&VertexSource::Swing(i)) => {
+                *q = i;
+                models.encode(self.sink, ctx, wrap_index(i - pred, bits), bits);
+                Ok(())
+            }
+            _ => Err(no_swing_index(v)),
+        }
+    }
+}
+
+#[cold]
+fn no_swing_index(v: VertexId) -> Error {
+    Error::Corrupt(format!(
+        "retiled vertex {} is created by a C triangle but has no swing index",
+        v.0
+    ))
 }
 
 struct SwingReader<'a, 'b> {
@@ -756,6 +818,19 @@ impl SwingIo for SwingReader<'_, '_> {
         q: &mut i32,
     ) -> Result<(), Error> {
         *q = wrap_index(pred + unzigzag(model.decode(self.dec)), bits);
+        Ok(())
+    }
+    #[inline]
+    fn neighbour_index(
+        &mut self,
+        _v: VertexId,
+        models: &mut neighbours::ResidualModels,
+        ctx: &neighbours::ResidualContext,
+        pred: i32,
+        bits: u32,
+        q: &mut i32,
+    ) -> Result<(), Error> {
+        *q = wrap_index(pred + models.decode(self.dec, ctx, bits), bits);
         Ok(())
     }
 }
@@ -958,10 +1033,31 @@ pub fn encode_retiled(
     params: &SwingParams,
     info: &SwingStreamInfo<'_>,
 ) -> Result<SwingEncoded, Error> {
-    if let Some(enc) = encode_forward(retiled, params, info)? {
-        return Ok(enc);
+    // Kinds 9 and 10 code smaller on every fixture measured (docs/results.md); kinds 7 and
+    // 8 are kept when they are not larger, so no stream grows.
+    let scaled = encode_forward(retiled, params, info, ForwardCoding::Scaled)?;
+    let neighbours = encode_forward(retiled, params, info, ForwardCoding::Neighbours)?;
+    match (scaled, neighbours) {
+        (Some(s), Some(n)) => Ok(if n.bytes.len() < s.bytes.len() { n } else { s }),
+        (Some(e), None) | (None, Some(e)) => Ok(e),
+        (None, None) => encode_retiled_as(retiled, params, info, IndexCoding::Scaled),
     }
-    encode_retiled_as(retiled, params, info, IndexCoding::Scaled)
+}
+
+/// [`encode_retiled`] with the forward walk's indices coded by `coding` only (`None` when the
+/// forward walk does not reproduce the retiling); for tests and measurements.
+pub fn encode_retiled_forward(
+    retiled: &RetiledMesh,
+    params: &SwingParams,
+    info: &SwingStreamInfo<'_>,
+    neighbourhood_prediction: bool,
+) -> Result<Option<SwingEncoded>, Error> {
+    let coding = if neighbourhood_prediction {
+        ForwardCoding::Neighbours
+    } else {
+        ForwardCoding::Scaled
+    };
+    encode_forward(retiled, params, info, coding)
 }
 
 /// A seed and index coder `inner` with what a forward walk needs besides (kinds 7 and 8):
@@ -985,6 +1081,18 @@ impl<W: SwingIo, S> SwingIo for Forward<W, S> {
         q: &mut i32,
     ) -> Result<(), Error> {
         self.inner.index(v, model, pred, bits, q)
+    }
+    #[inline]
+    fn neighbour_index(
+        &mut self,
+        v: VertexId,
+        models: &mut neighbours::ResidualModels,
+        ctx: &neighbours::ResidualContext,
+        pred: i32,
+        bits: u32,
+        q: &mut i32,
+    ) -> Result<(), Error> {
+        self.inner.neighbour_index(v, models, ctx, pred, bits, q)
     }
 }
 
@@ -1136,6 +1244,7 @@ fn encode_forward(
     retiled: &RetiledMesh,
     params: &SwingParams,
     info: &SwingStreamInfo<'_>,
+    coding: ForwardCoding,
 ) -> Result<Option<SwingEncoded>, Error> {
     let n = retiled.triangles.len();
     let cutting = retiled.deleted.iter().any(|&d| d);
@@ -1162,7 +1271,7 @@ fn encode_forward(
             connectivity_cost: 0,
         },
     };
-    let Ok(walked) = front::front_walk(&mut io, params, retiled.components, n, n) else {
+    let Ok(walked) = front::front_walk(&mut io, params, coding, retiled.components, n, n) else {
         return Ok(None);
     };
     let same_positions = walked.positions.len() == retiled.positions.len()
@@ -1187,11 +1296,7 @@ fn encode_forward(
     } else {
         info.filter.apply_closed(&mut mesh, walked.fan);
     }
-    let mut geometry = vec![if cutting {
-        KIND_SWING_FORWARD_CUT
-    } else {
-        KIND_SWING_FORWARD
-    }];
+    let mut geometry = vec![coding.kind(cutting)];
     geometry.extend_from_slice(&range.finish());
     let mut connectivity = Vec::new();
     whet_format::write_varint(&mut connectivity, n as u64);
@@ -1370,6 +1475,14 @@ fn write_stream(
         // Geometry kinds 5 and 6 are format 1.2 (docs/format.md section 6): older readers
         // refuse them by kind.
         header = header.with_version(VERSION_1_2);
+    }
+    if geometry
+        .first()
+        .is_some_and(|&k| k >= KIND_SWING_NEIGHBOURS)
+        && header.version < VERSION_1_3
+    {
+        // Kinds 9 and 10 are format 1.3; older readers refuse them by kind too.
+        header = header.with_version(VERSION_1_3);
     }
     if !info.filter.is_none() {
         // The filter fields are format 1.1 (docs/format.md section 6): a 1.0 reader refuses
@@ -1573,11 +1686,11 @@ pub(crate) fn decode_swing(
     let geom = container
         .section(SectionKind::GEOMETRY)
         .ok_or(Error::MissingSection("geometry"))?;
-    if let Some(&kind @ (KIND_SWING_FORWARD | KIND_SWING_FORWARD_CUT)) = geom.first() {
+    if let Some(&kind @ KIND_SWING_FORWARD..=KIND_SWING_NEIGHBOURS_CUT) = geom.first() {
         return decode_forward(
             conn_bytes,
             &geom[1..],
-            kind == KIND_SWING_FORWARD_CUT,
+            kind,
             &params,
             components,
             filter,
@@ -1681,23 +1794,29 @@ pub(crate) fn decode_swing(
             Ok(mesh)
         }
         (other, None) => Err(Error::Corrupt(format!(
-            "unknown swing geometry kind {other} (this whet reads kinds 0 to {KIND_SWING_FORWARD_CUT}; \
+            "unknown swing geometry kind {other} (this whet reads kinds 0 to {KIND_SWING_NEIGHBOURS_CUT}; \
              a newer whet may have written it)"
         ))),
     }
 }
 
-/// Decodes geometry kinds 7 (`cutting` false) and 8: the triangle count from the
-/// connectivity section, then the forward walk over the geometry payload.
+/// Decodes geometry kinds 7 to 10 (`kind`; the even ones carry deletion flags): the triangle
+/// count from the connectivity section, then the forward walk over the geometry payload.
 fn decode_forward(
     conn_bytes: &[u8],
     payload: &[u8],
-    cutting: bool,
+    kind: u8,
     params: &SwingParams,
     components: u64,
     filter: SurfaceFilter,
     opts: &crate::DecodeOptions,
 ) -> Result<Mesh, Error> {
+    let coding = if kind >= KIND_SWING_NEIGHBOURS {
+        ForwardCoding::Neighbours
+    } else {
+        ForwardCoding::Scaled
+    };
+    let cutting = kind == KIND_SWING_FORWARD_CUT || kind == KIND_SWING_NEIGHBOURS_CUT;
     let mut pos = 0;
     let n = whet_format::read_varint(conn_bytes, &mut pos)?;
     if pos != conn_bytes.len() {
@@ -1750,7 +1869,14 @@ fn decode_forward(
     };
     // A retiled triangle costs about a bit and a half; 64 per byte is far beyond any stream.
     let capacity = payload.len().saturating_mul(64).saturating_add(1024);
-    let walked = front::front_walk(&mut io, params, components as usize, n as usize, capacity)?;
+    let walked = front::front_walk(
+        &mut io,
+        params,
+        coding,
+        components as usize,
+        n as usize,
+        capacity,
+    )?;
     let flags = if cutting {
         decode_cut_flags(&mut dec, walked.triangles.len())
     } else {
@@ -2031,28 +2157,35 @@ mod tests {
                             assert_eq!(raw.positions, retiled.positions);
                         }
                     }
-                    // What the encoder writes: kind 7, or 8 with deletions.
+                    // The forward kinds: 7 and 9, or 8 and 10 with deletions; the encoder
+                    // writes the smaller of the two.
                     let info = SwingStreamInfo { filter, ..info() };
-                    let enc = encode_retiled(&retiled, &params, &info).unwrap();
-                    let expected = if cutting {
-                        KIND_SWING_FORWARD_CUT
-                    } else {
-                        KIND_SWING_FORWARD
-                    };
-                    assert_eq!(kind_of(&enc.bytes), expected, "bits {bits} q {q}");
-                    let back = crate::decode(&enc.bytes, &crate::DecodeOptions::DEFAULT).unwrap();
-                    assert_eq!(back, enc.decoded, "bits {bits} q {q} forward");
                     let mut unfiltered =
                         Mesh::new(retiled.positions.clone(), retiled.triangles.clone());
                     if cutting {
                         unfiltered = cut(unfiltered, &retiled.deleted);
                     }
-                    let raw = crate::decode(
-                        &enc.bytes,
-                        &crate::DecodeOptions::DEFAULT.with_surface_filter(false),
-                    )
-                    .unwrap();
-                    assert_eq!(raw, unfiltered);
+                    let mut sizes = Vec::new();
+                    for coding in [ForwardCoding::Scaled, ForwardCoding::Neighbours] {
+                        let enc = encode_forward(&retiled, &params, &info, coding)
+                            .unwrap()
+                            .unwrap();
+                        assert_eq!(kind_of(&enc.bytes), coding.kind(cutting));
+                        let back =
+                            crate::decode(&enc.bytes, &crate::DecodeOptions::DEFAULT).unwrap();
+                        assert_eq!(back, enc.decoded, "bits {bits} q {q} {coding:?}");
+                        let raw = crate::decode(
+                            &enc.bytes,
+                            &crate::DecodeOptions::DEFAULT.with_surface_filter(false),
+                        )
+                        .unwrap();
+                        assert_eq!(raw, unfiltered);
+                        sizes.push(enc.bytes.len());
+                    }
+                    let enc = encode_retiled(&retiled, &params, &info).unwrap();
+                    assert!((KIND_SWING_FORWARD..=KIND_SWING_NEIGHBOURS_CUT)
+                        .contains(&kind_of(&enc.bytes)));
+                    assert_eq!(enc.bytes.len(), sizes[0].min(sizes[1]), "bits {bits} q {q}");
                 }
             }
         }

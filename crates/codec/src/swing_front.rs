@@ -239,6 +239,9 @@ struct Rebuilt {
     /// Per vertex, its triangles (at most the triangle count, which the caller bounds far
     /// below `u32::MAX`).
     built: Vec<u32>,
+    /// Per vertex, the residual of its swing index in kinds 9 and 10 (0 for seeds and in
+    /// kinds 7 and 8).
+    residual: Vec<i32>,
 }
 
 impl Rebuilt {
@@ -250,6 +253,7 @@ impl Rebuilt {
             triangles: Vec::with_capacity(triangles),
             fan: Vec::with_capacity(vertices),
             built: Vec::with_capacity(vertices),
+            residual: Vec::with_capacity(vertices),
         }
     }
 
@@ -258,6 +262,7 @@ impl Rebuilt {
         self.positions.push(p);
         self.fan.push(DVec3::ZERO);
         self.built.push(0);
+        self.residual.push(0);
     }
 
     /// Adds triangle `t` of existing vertices; a triangle repeating a vertex (only a corrupt
@@ -301,6 +306,7 @@ pub(super) struct FrontWalk {
 pub(super) fn front_walk<I: FrontIo>(
     io: &mut I,
     params: &SwingParams,
+    coding: ForwardCoding,
     components: usize,
     triangles: usize,
     capacity: usize,
@@ -311,6 +317,8 @@ pub(super) fn front_walk<I: FrontIo>(
     let l = params.edge_length;
     let inv_l2 = 1.0 / (l * l);
     let mut models = SwingModels::new(angle_bits, IndexCoding::Scaled);
+    let mut residual_models = neighbours::ResidualModels::new();
+    let predictor = neighbours::Predictor::new(&params.angles);
     let mut labels = SymbolTables::new(LABEL_CONTEXTS, 5);
     let mut split = SplitModels {
         rank: UnsignedIntModel::below_2_31(),
@@ -380,15 +388,35 @@ pub(super) fn front_walk<I: FrontIo>(
                     else {
                         return Err(corrupt("a C on a gate without a swing (2L or flat)"));
                     };
-                    let pred = predict_swing_scaled(
-                        &frame,
-                        add(out.fan[a as usize], out.fan[b as usize]),
-                        &params.angles,
-                    );
+                    let normal = add(out.fan[a as usize], out.fan[b as usize]);
                     let v = out.positions.len() as u32;
                     let mut q = 0i32;
-                    io.index(VertexId(v), models.model(pred), pred, angle_bits, &mut q)?;
+                    let residual = match coding {
+                        ForwardCoding::Scaled => {
+                            let pred = predict_swing_scaled(&frame, normal, &params.angles);
+                            io.index(VertexId(v), models.model(pred), pred, angle_bits, &mut q)?;
+                            0
+                        }
+                        ForwardCoding::Neighbours => {
+                            let near = neighbours::Neighbourhood {
+                                a: out.residual[a as usize],
+                                b: out.residual[b as usize],
+                                parent: out.residual[node_a.opp as usize],
+                            };
+                            let (pred, ctx) = predictor.predict(&frame, normal, px, near);
+                            io.neighbour_index(
+                                VertexId(v),
+                                &mut residual_models,
+                                &ctx,
+                                pred,
+                                angle_bits,
+                                &mut q,
+                            )?;
+                            wrap_index(q - pred, angle_bits)
+                        }
+                    };
                     out.add_vertex(frame.tip(&params.angles, q));
+                    out.residual[v as usize] = residual;
                     front.add_vertex();
                     out.add_triangle([v, a, b])?;
                     // Loop a -> v -> b: edge a -> v faces b, edge v -> b faces a.

@@ -12,11 +12,9 @@ use crate::support::{check, error};
 /// Metro face samples per direction (the figures use 1M; bounds below leave room).
 const SAMPLES: Option<usize> = Some(200_000);
 
-fn swing_decoded(name: &str, bpv: f64) -> (Mesh, Mesh) {
+fn swing_decoded(name: &str, rate: Rate) -> (Mesh, Mesh) {
     let original = whet_io::read_path(&whet_testkit::shared_fixture(name), None).unwrap();
-    let opts = SwingOptions::DEFAULT
-        .with_rate(Rate::BitsPerVertex(bpv))
-        .with_angle_bits(6);
+    let opts = SwingOptions::DEFAULT.with_rate(rate).with_angle_bits(6);
     let out = whet_swing::encode(&original, &opts).unwrap();
     let decoded = whet_codec::decode(
         &out.bytes,
@@ -34,11 +32,15 @@ fn swing_decoded_fandisk_is_sharpened_and_rocker_arm_not_made_worse() {
     // RMS 0.0376 % -> 0.0374 %, max unchanged. Before the surface-sampling rules rocker_arm
     // went to 0.0409 % and 0.47 %. Since the stream carries the surface filter's two fields
     // the rate search lands on another L for fandisk: 0.067 % -> 0.027 % (2.5x), max 0.73 % ->
-    // 0.50 % (1.45x; the max gain moves with L, hence the bound of 1.25x here).
-    for (name, min_rms_gain, min_max_gain) in
-        [("fandisk.off", 2.0, 1.25), ("rocker_arm.off", 0.99, 0.999)]
-    {
-        let (original, decoded) = swing_decoded(name, 4.0);
+    // 0.50 % (1.45x; the max gain moves with L, hence the bound of 1.25x here). The
+    // edge lengths are pinned to where `--bpv 4` landed then (fandisk 0.987 %, rocker_arm
+    // 0.802 % of the diagonal): geometry kind 9 codes the same retilings 6 % smaller, so the
+    // search now lands on finer ones (fandisk 0.966 %, where the max moves by 1.12x only).
+    for (name, edge_length, min_rms_gain, min_max_gain) in [
+        ("fandisk.off", 0.00987, 2.0, 1.25),
+        ("rocker_arm.off", 0.00802, 0.99, 0.999),
+    ] {
+        let (original, decoded) = swing_decoded(name, Rate::EdgeLength(edge_length));
         let before = error(&original, &decoded, SAMPLES);
         for method in crate::EDGE_SHARPENER {
             let out = sharpen(&decoded, &SharpenOptions::DEFAULT.with_method(method)).unwrap();
