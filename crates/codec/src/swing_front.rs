@@ -1,6 +1,7 @@
-//! The forward swing walk of geometry kinds 7 and 8: the connectivity of the retiled mesh is
-//! coded inside the geometry walk, label by label in creation order, so that every label is
-//! coded in the context of the geometry already rebuilt around its gate.
+//! The forward swing walk of geometry kinds 7 to 10 (9 and 10 code the swing indices through
+//! `swing_neighbours.rs`): the connectivity of the retiled mesh is coded inside the geometry
+//! walk, label by label in creation order, so that every label is coded in the context of
+//! the geometry already rebuilt around its gate.
 //!
 //! Both sides run [`front_walk`]: it keeps the retiler's own state (whet-swing `retiler.rs`:
 //! the loops bounding the built region as linked lists of nodes, the current gate, a stack of
