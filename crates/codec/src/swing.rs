@@ -1522,7 +1522,17 @@ fn write_stream(
             header = header.with(tag::SHARPEN_PASSES, u64::from(p));
         }
     }
-    header.set_bbox(min, max);
+    // With kinds 9 and 10 (format 1.3 already) a box of binary32 coordinates, what the
+    // swing encoder makes, takes 24 bytes (docs/format.md, tag 32); streams of the older
+    // kinds keep the 48-byte box, and with it the version they need.
+    if geometry
+        .first()
+        .is_some_and(|&k| k >= KIND_SWING_NEIGHBOURS)
+    {
+        header.set_bbox_compact(min, max);
+    } else {
+        header.set_bbox(min, max);
+    }
     let container = Container::new(header)
         .with_section(SectionKind::CONNECTIVITY, connectivity)
         .with_section(SectionKind::GEOMETRY, geometry);
@@ -2038,8 +2048,17 @@ mod tests {
         )
         .unwrap();
         assert_eq!(raw.positions, retiled.positions);
+        // Format 1.2 for kind 7, 1.3 for kind 9 (whose header states the tetrahedron's box,
+        // binary32 coordinates, in 24 bytes: tag 32).
         let header = crate::peek_header(&enc.bytes).unwrap();
-        assert_eq!(header.version, VERSION_1_2);
+        let c = whet_format::parse(&enc.bytes, &crate::Limits::DEFAULT).unwrap();
+        if kind_of(&enc.bytes) >= KIND_SWING_NEIGHBOURS {
+            assert_eq!(header.version, VERSION_1_3);
+            assert!(c.header.get(tag::BBOX_F32).is_some() && c.header.get(tag::BBOX).is_none());
+        } else {
+            assert_eq!(header.version, VERSION_1_2);
+            assert!(c.header.get(tag::BBOX).is_some());
+        }
         // The filter for after sharpening: optional fields, read back as written, absent
         // (no filter) unless given.
         let parsed = |bytes: &[u8]| {

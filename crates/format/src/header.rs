@@ -178,9 +178,14 @@ pub mod tag {
     /// sharpening and the planar-region projection, its move limit in hundredths of the
     /// angle step (swing; absent, or outside 1..=1000: none).
     pub const QUADRIC_PROJECTION: u64 = 31;
+    /// bytes, exactly 24 (format 1.3): the quantization box as f32 min x, y, z then max x,
+    /// y, z, for a box whose coordinates are binary32 values (swing streams round their box
+    /// outward to them); a header holds this field or [`BBOX`], not both. See
+    /// [`Header::bbox`](crate::Header::bbox).
+    pub const BBOX_F32: u64 = 32;
 
     /// Every tag this crate knows, with its name and value type.
-    pub const KNOWN: [(u64, &str, ValueType); 17] = [
+    pub const KNOWN: [(u64, &str, ValueType); 18] = [
         (ENCODER, "encoder", ValueType::Bytes),
         (COMPONENT_COUNT, "component_count", ValueType::U64),
         (QUANT_BITS, "quant_bits", ValueType::U64),
@@ -210,6 +215,7 @@ pub mod tag {
         (SHARPEN_CURVED_WALLS, "sharpen_curved_walls", ValueType::U64),
         (SHARPEN_PASSES, "sharpen_passes", ValueType::U64),
         (QUADRIC_PROJECTION, "quadric_projection", ValueType::U64),
+        (BBOX_F32, "bbox_f32", ValueType::Bytes),
     ];
 
     /// Name and type of a known tag.
@@ -228,6 +234,8 @@ pub mod tag {
 
 /// Byte length of the [`tag::BBOX`] value.
 pub const BBOX_LEN: usize = 48;
+/// Byte length of the [`tag::BBOX_F32`] value.
+pub const BBOX_F32_LEN: usize = 24;
 
 /// Wire type of a header field value, the low two bits of its key.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -455,24 +463,69 @@ impl Header {
         }
     }
 
-    /// The [`tag::BBOX`] field as `(min, max)`, if present and 48 bytes long.
+    /// The quantization box as `(min, max)`: the [`tag::BBOX`] field (48 bytes) or the
+    /// [`tag::BBOX_F32`] field (24 bytes, widened exactly to f64); `None` when neither is
+    /// present and well formed, or when both are.
     pub fn bbox(&self) -> Option<([f64; 3], [f64; 3])> {
-        let b = self.get_bytes(tag::BBOX)?;
-        if b.len() != BBOX_LEN {
-            return None;
-        }
-        let mut v = [0.0; 6];
-        LittleEndian::read_f64_into(b, &mut v);
+        let v: [f64; 6] = match (self.get_bytes(tag::BBOX), self.get_bytes(tag::BBOX_F32)) {
+            (Some(b), None) if b.len() == BBOX_LEN => {
+                let mut v = [0.0; 6];
+                LittleEndian::read_f64_into(b, &mut v);
+                v
+            }
+            (None, Some(b)) if b.len() == BBOX_F32_LEN => {
+                let mut v = [0.0f32; 6];
+                LittleEndian::read_f32_into(b, &mut v);
+                v.map(f64::from)
+            }
+            _ => return None,
+        };
         Some(([v[0], v[1], v[2]], [v[3], v[4], v[5]]))
     }
 
-    /// Sets the [`tag::BBOX`] field.
+    /// Sets the [`tag::BBOX`] field (and removes a [`tag::BBOX_F32`] one).
     pub fn set_bbox(&mut self, min: [f64; 3], max: [f64; 3]) {
         let mut b = vec![0; BBOX_LEN];
         let v = [min[0], min[1], min[2], max[0], max[1], max[2]];
         LittleEndian::write_f64_into(&v, &mut b);
+        self.remove(tag::BBOX_F32);
         self.set(tag::BBOX, b);
     }
+
+    /// Sets the box as the 24-byte [`tag::BBOX_F32`] field when every coordinate is a
+    /// binary32 value (exactly), else as [`tag::BBOX`]; returns true for the short form. The
+    /// short form is format 1.3: the caller raises the version.
+    pub fn set_bbox_compact(&mut self, min: [f64; 3], max: [f64; 3]) -> bool {
+        let v = [min[0], min[1], min[2], max[0], max[1], max[2]];
+        if !v.iter().all(|&x| f64::from(x as f32) == x) {
+            self.set_bbox(min, max);
+            return false;
+        }
+        let mut b = vec![0; BBOX_F32_LEN];
+        LittleEndian::write_f32_into(&v.map(|x| x as f32), &mut b);
+        self.remove(tag::BBOX);
+        self.set(tag::BBOX_F32, b);
+        true
+    }
+}
+
+/// The smallest box of binary32 coordinates holding `(min, max)`: each coordinate rounded
+/// outward to the nearest f32 (`None` when one is not finite or beyond the f32 range).
+pub fn box_f32_outward(min: [f64; 3], max: [f64; 3]) -> Option<([f64; 3], [f64; 3])> {
+    let down = |x: f64| {
+        let f = x as f32;
+        let f = if f64::from(f) > x { f.next_down() } else { f };
+        (f.is_finite() && x.is_finite()).then_some(f64::from(f))
+    };
+    let up = |x: f64| {
+        let f = x as f32;
+        let f = if f64::from(f) < x { f.next_up() } else { f };
+        (f.is_finite() && x.is_finite()).then_some(f64::from(f))
+    };
+    Some((
+        [down(min[0])?, down(min[1])?, down(min[2])?],
+        [up(max[0])?, up(max[1])?, up(max[2])?],
+    ))
 }
 
 /// Checks a field against the known-tag table (docs/format.md §3). Unknown odd tags pass.
@@ -497,6 +550,12 @@ pub(crate) fn check_field(tag: u64, value: &HeaderValue) -> Result<(), FormatErr
             return Err(FormatError::FieldValue {
                 tag,
                 reason: "bbox must be 48 bytes (6 f64)",
+            });
+        }
+        if tag == tag::BBOX_F32 && b.len() != BBOX_F32_LEN {
+            return Err(FormatError::FieldValue {
+                tag,
+                reason: "bbox_f32 must be 24 bytes (6 f32)",
             });
         }
     }
@@ -637,6 +696,13 @@ pub(crate) fn decode_body(
         previous = Some(tag);
         let value = decode_value(body, &mut pos, ValueType::from_bits(key))?;
         check_field(tag, &value)?;
+        if tag == tag::BBOX_F32 && header.get(tag::BBOX).is_some() {
+            return Err(FormatError::FieldValue {
+                tag,
+                reason: "the box is given twice (bbox and bbox_f32)",
+            }
+            .into());
+        }
         if tag::known(tag).is_some() {
             // Fields arrive in increasing tag order, so pushing keeps `fields` sorted.
             header.fields.push(HeaderField { tag, value });
@@ -755,6 +821,40 @@ mod tests {
         assert_eq!(h.get_f64(tag::ANGLE_BITS), None, "wrong type");
         assert_eq!(h.remove(tag::ANGLE_BITS), Some(HeaderValue::U64(9)));
         assert_eq!(h.get(tag::ANGLE_BITS), None);
+    }
+
+    #[test]
+    fn the_compact_box_round_trips_and_is_refused_twice() {
+        let mut h = Header::new(Mode::Swing, 1, 1);
+        // Not binary32 values: the long form.
+        assert!(!h.set_bbox_compact([0.1, 0.0, 0.0], [1.0, 1.0, 1.0]));
+        assert_eq!(h.get_bytes(tag::BBOX).map(<[u8]>::len), Some(48));
+        // Rounded outward, they are: the short form, read back exactly.
+        let (min, max) = box_f32_outward([0.1, -1e-9, 3.0], [1.0, 2.5e-7, 1e30]).unwrap();
+        assert!(min[0] <= 0.1 && min[1] <= -1e-9 && max[1] >= 2.5e-7 && max[2] >= 1e30);
+        assert!(min[0] > 0.1 - 1e-8 && max[2] < 1e30 * (1.0 + 1e-7));
+        assert!(h.set_bbox_compact(min, max));
+        assert_eq!(h.get(tag::BBOX), None);
+        assert_eq!(h.get_bytes(tag::BBOX_F32).map(<[u8]>::len), Some(24));
+        assert_eq!(h.bbox(), Some((min, max)));
+        // Beyond the f32 range, or not finite: no short form.
+        assert_eq!(box_f32_outward([0.0; 3], [1e39, 1.0, 1.0]), None);
+        assert_eq!(box_f32_outward([f64::NAN, 0.0, 0.0], [1.0; 3]), None);
+        // A header with both forms is refused when read, naming the problem.
+        let mut both = Header::new(Mode::Swing, 1, 1);
+        both.set_bbox([0.0; 3], [1.0; 3]);
+        both.set(tag::BBOX_F32, vec![0u8; 24]);
+        let bytes = crate::Container::new(both).to_bytes().unwrap();
+        let err = crate::parse(&bytes, &crate::Limits::DEFAULT).unwrap_err();
+        assert!(err.to_string().contains("twice"), "{err}");
+        assert_eq!(
+            check_field(tag::BBOX_F32, &vec![0u8; 23].into()).map_err(|e| e.to_string()),
+            Err(FormatError::FieldValue {
+                tag: tag::BBOX_F32,
+                reason: "bbox_f32 must be 24 bytes (6 f32)"
+            }
+            .to_string())
+        );
     }
 
     #[test]

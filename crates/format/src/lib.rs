@@ -43,8 +43,8 @@ pub use decoder::{parse, read_from, Progress, StreamingDecoder};
 pub use error::{Error, FormatError};
 pub use fuzz::fuzz_parse;
 pub use header::{
-    peek_header, tag, Header, HeaderField, HeaderInfo, HeaderValue, Mode, ValueType, Version,
-    BBOX_LEN, MAGIC, MAX_HEADER_LEN,
+    box_f32_outward, peek_header, tag, Header, HeaderField, HeaderInfo, HeaderValue, Mode,
+    ValueType, Version, BBOX_F32_LEN, BBOX_LEN, MAGIC, MAX_HEADER_LEN,
 };
 pub use limits::{Limits, ALLOCATION_LIMIT};
 pub use varint::{

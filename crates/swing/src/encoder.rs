@@ -337,6 +337,21 @@ pub fn valence6_fraction(mesh: &Mesh) -> f64 {
     deg.iter().filter(|&&d| d == 6).count() as f64 / deg.len() as f64
 }
 
+/// The box of the seeds' quantization grid: the mesh's bounding box rounded outward to
+/// binary32 coordinates, which the stream states in 24 bytes instead of 48 (docs/format.md,
+/// tag 32); the mesh's own box when it is beyond the f32 range. The grid moves by about
+/// 1e-7 of the box, far below its step.
+fn seed_box(mesh: &Mesh) -> whet_mesh::Aabb {
+    let b = mesh.bounding_box();
+    match whet_format::box_f32_outward(b.min.to_array(), b.max.to_array()) {
+        Some((min, max)) => whet_mesh::Aabb {
+            min: whet_mesh::DVec3::from_array(min),
+            max: whet_mesh::DVec3::from_array(max),
+        },
+        None => b,
+    }
+}
+
 /// A retiler that got stuck on a surface that is not orientable (a Möbius strip, a Klein
 /// bottle, or a part whose triangles face both ways across an edge) says so: the repair
 /// oriented it by cutting it open, but the two sides of the cut still touch, and the retiler,
@@ -822,7 +837,7 @@ impl SwingEncoder {
     ) -> Result<Vec<SwingOutput>, Error> {
         let o = &self.opts;
         let l = fraction * prep.diagonal;
-        let params = SwingParams::new(l, o.angle_bits, &prep.mesh.bounding_box(), o.quant_bits)?;
+        let params = SwingParams::new(l, o.angle_bits, &seed_box(&prep.mesh), o.quant_bits)?;
         let sharpen: Vec<_> = candidates.iter().map(Candidate::sharpen_options).collect();
         let retiled = retile_fitted(&prep.mesh, &params, &o.tuning, o.surface_filter, &sharpen)?;
         let mut outs = Vec::with_capacity(candidates.len());
