@@ -512,14 +512,33 @@ impl Header {
 /// The smallest box of binary32 coordinates holding `(min, max)`: each coordinate rounded
 /// outward to the nearest f32 (`None` when one is not finite or beyond the f32 range).
 pub fn box_f32_outward(min: [f64; 3], max: [f64; 3]) -> Option<([f64; 3], [f64; 3])> {
+    // The neighbouring binary32 value towards `towards` (`f32::next_up`/`next_down`, spelled
+    // out for the workspace's minimum Rust version); `f` finite.
+    let step = |f: f32, towards: f32| -> f32 {
+        if f == 0.0 {
+            f32::from_bits(1).copysign(towards)
+        } else if (f < towards) == (f > 0.0) {
+            f32::from_bits(f.to_bits() + 1)
+        } else {
+            f32::from_bits(f.to_bits() - 1)
+        }
+    };
     let down = |x: f64| {
         let f = x as f32;
-        let f = if f64::from(f) > x { f.next_down() } else { f };
+        let f = if f.is_finite() && f64::from(f) > x {
+            step(f, f32::NEG_INFINITY)
+        } else {
+            f
+        };
         (f.is_finite() && x.is_finite()).then_some(f64::from(f))
     };
     let up = |x: f64| {
         let f = x as f32;
-        let f = if f64::from(f) < x { f.next_up() } else { f };
+        let f = if f.is_finite() && f64::from(f) < x {
+            step(f, f32::INFINITY)
+        } else {
+            f
+        };
         (f.is_finite() && x.is_finite()).then_some(f64::from(f))
     };
     Some((
@@ -837,6 +856,14 @@ mod tests {
         assert_eq!(h.get(tag::BBOX), None);
         assert_eq!(h.get_bytes(tag::BBOX_F32).map(<[u8]>::len), Some(24));
         assert_eq!(h.bbox(), Some((min, max)));
+        // Around zero and on negative values the rounding goes outward too.
+        for x in [0.0, -0.0, 1e-50, -1e-50, -0.1, -3.0e38, 0.3] {
+            let (lo, hi) = box_f32_outward([x; 3], [x; 3]).unwrap();
+            assert!(lo[0] <= x && x <= hi[0], "{x}: {lo:?} {hi:?}");
+            assert_eq!(f64::from(lo[0] as f32), lo[0]);
+            assert_eq!(f64::from(hi[0] as f32), hi[0]);
+            assert!(hi[0] - lo[0] <= x.abs() * 2.4e-7 + 3e-45, "{x}");
+        }
         // Beyond the f32 range, or not finite: no short form.
         assert_eq!(box_f32_outward([0.0; 3], [1e39, 1.0, 1.0]), None);
         assert_eq!(box_f32_outward([f64::NAN, 0.0, 0.0], [1.0; 3]), None);
