@@ -967,6 +967,10 @@ impl SwingEncoder {
         start: Option<f64>,
     ) -> Result<SwingOutput, Error> {
         let tol = self.opts.tolerance;
+        let late = match self.opts.error_of {
+            ErrorOf::Sharpened => LATE_FIELD_BYTES,
+            ErrorOf::Decoded => 0,
+        };
         let goal = (target as f64).ln();
         let mut search = Vec::new();
         let mut best: Option<SwingOutput> = None;
@@ -1015,7 +1019,11 @@ impl SwingEncoder {
             if better {
                 best = Some(out);
             }
-            if err <= tol {
+            // Within the tolerance with room for the header fields the sharpening choice
+            // adds after the search, so that the final stream is within it too.
+            let low = (1.0 - tol) * target as f64;
+            let high = (1.0 + tol) * target as f64;
+            if size as f64 >= low && (size + late) as f64 <= high {
                 break;
             }
             // Slope of ln(bytes) against ln(L): -2 in theory; measured once two points exist.
@@ -1419,9 +1427,14 @@ impl Candidate {
     }
 }
 
+/// Most bytes the sharpening choice (`--optimize-for sharpened`) adds to the size search's
+/// stream: header fields 21 (method, 2 bytes), 23, 25, 27 and 31 (3 each), 29 (2), and up to
+/// 2 more for the filter after sharpening refitted for the chosen sharpening.
+const LATE_FIELD_BYTES: usize = 20;
+
 /// `out` with header field 25 stating the planar-region projection at `factor` angle steps
 /// (rounded to the field's hundredths, which is what a decoder reads). The field's three
-/// bytes come after the size search, within its tolerance.
+/// bytes come after the size search, in the room it leaves ([`LATE_FIELD_BYTES`]).
 fn restate_planar(mut out: SwingOutput, factor: f64) -> Result<SwingOutput, Error> {
     let code = SharpenHint::smooth_factor_code(factor)
         .ok_or_else(|| Error::Internal(format!("planar factor {factor} out of range")))?;
