@@ -1,13 +1,16 @@
 //! `whet info`: counts, topology and problems of a mesh.
 
-use super::{print_json, read_mesh, CliResult};
+use super::{print_json, read_mesh, CliResult, Failure};
+use anyhow::anyhow;
 use clap::Args;
 use serde_json::json;
-use std::path::PathBuf;
+use std::io::Read;
+use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
 pub struct InfoArgs {
-    /// Mesh file (.off, .obj, .ply, .stl).
+    /// Mesh file (.off, .obj, .ply, .stl), or a `.whet` stream (its header and sections,
+    /// checked but not decoded).
     mesh: PathBuf,
     /// Input format, overriding the extension.
     #[arg(long)]
@@ -18,6 +21,9 @@ pub struct InfoArgs {
 }
 
 pub fn run(args: &InfoArgs) -> CliResult {
+    if args.format.is_none() && is_stream(&args.mesh) {
+        return stream_info(args);
+    }
     let mesh = read_mesh(&args.mesh, args.format)?;
     let r = mesh.topology_report();
     let diagonal = mesh.diagonal();
@@ -100,4 +106,109 @@ fn finite_or_null(x: f64) -> serde_json::Value {
     } else {
         serde_json::Value::Null
     }
+}
+
+/// A `.whet` file: by its extension, or by its magic when the extension names no mesh format.
+fn is_stream(path: &Path) -> bool {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("whet") => true,
+        Some("off" | "obj" | "ply" | "stl") => false,
+        _ => {
+            let mut magic = [0u8; 4];
+            std::fs::File::open(path)
+                .and_then(|mut f| f.read_exact(&mut magic))
+                .is_ok_and(|()| magic == whet_format::MAGIC)
+        }
+    }
+}
+
+/// `whet info` of a `.whet` stream: the container is parsed and every checksum checked
+/// (whet-format, the default limits), nothing is decoded.
+fn stream_info(args: &InfoArgs) -> CliResult {
+    let path = &args.mesh;
+    let bytes = std::fs::read(path)
+        .map_err(|e| Failure::input(anyhow!("cannot read {}: {e}", path.display())))?;
+    let c = whet_format::parse(&bytes, &whet_format::Limits::DEFAULT)
+        .map_err(|e| Failure::input(anyhow!("{}: {e}", path.display())))?;
+    let h = &c.header;
+    let fields: Vec<(String, serde_json::Value)> = h
+        .fields()
+        .iter()
+        .map(|f| {
+            let name = whet_format::tag::known(f.tag)
+                .map_or_else(|| format!("tag_{}", f.tag), |(n, _)| n.to_string());
+            let value = match (&f.value, f.tag) {
+                (_, whet_format::tag::BBOX | whet_format::tag::BBOX_F32) => h.bbox().map_or(
+                    serde_json::Value::Null,
+                    |(min, max)| json!({ "min": min, "max": max }),
+                ),
+                (whet_format::HeaderValue::U64(v), _) => json!(v),
+                (whet_format::HeaderValue::I64(v), _) => json!(v),
+                (whet_format::HeaderValue::F64(v), _) => finite_or_null(*v),
+                (whet_format::HeaderValue::Bytes(b), whet_format::tag::ENCODER) => {
+                    json!(String::from_utf8_lossy(b))
+                }
+                (whet_format::HeaderValue::Bytes(b), _) => json!({ "bytes": b.len() }),
+            };
+            (name, value)
+        })
+        .collect();
+    let sections: Vec<serde_json::Value> = c
+        .sections
+        .iter()
+        .map(|s| {
+            json!({
+                "tag": s.kind.tag(),
+                "name": s.kind.name().unwrap_or("unknown"),
+                "bytes": s.payload.len(),
+            })
+        })
+        .collect();
+    // A swing stream's geometry section starts with its kind (docs/format.md).
+    let geometry_kind = (h.mode == whet_format::Mode::Swing)
+        .then(|| c.section(whet_format::SectionKind::GEOMETRY))
+        .flatten()
+        .and_then(|g| g.first().copied());
+    if args.json {
+        print_json(&json!({
+            "stream": true,
+            "bytes": bytes.len(),
+            "version": h.version.to_string(),
+            "mode": h.mode.name(),
+            "vertices": h.vertex_count,
+            "triangles": h.triangle_count,
+            "fields": serde_json::Map::from_iter(fields),
+            "sections": sections,
+            "geometry_kind": geometry_kind,
+        }));
+    } else {
+        outln!("{}", path.display());
+        outln!(
+            "  stream          {} bytes, format {}",
+            bytes.len(),
+            h.version
+        );
+        outln!("  mode            {}", h.mode.name());
+        outln!("  vertices        {}", h.vertex_count);
+        outln!("  triangles       {}", h.triangle_count);
+        for (name, value) in &fields {
+            outln!("  {name:<15} {value}");
+        }
+        for s in &sections {
+            outln!(
+                "  section         {} ({} bytes)",
+                s["name"].as_str().unwrap_or("?"),
+                s["bytes"]
+            );
+        }
+        if let Some(k) = geometry_kind {
+            outln!("  geometry kind   {k}");
+        }
+        outln!("  checksums       ok");
+    }
+    Ok(())
 }

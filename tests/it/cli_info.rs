@@ -142,3 +142,55 @@ fn non_manifold_mesh_is_reported_not_refused() {
         "{text}"
     );
 }
+
+/// `whet info` of a `.whet` stream: its header and sections, checksums checked, nothing
+/// decoded; a damaged stream is an input error (exit 2) naming the problem.
+#[test]
+fn a_stream_reports_its_header_and_sections() {
+    let dir = scratch_dir("cli-info-stream");
+    let stream = dir.join("f.whet");
+    let enc = whet_json(&[
+        "encode",
+        s(&shared_fixture("fandisk.off")),
+        "-o",
+        s(&stream),
+        "--edge-length",
+        "0.02",
+        "--json",
+    ]);
+    let j = whet_json(&["info", s(&stream), "--json"]);
+    assert_eq!(j["stream"], true);
+    assert_eq!(j["mode"], "swing");
+    assert_eq!(j["bytes"], enc["bytes"]);
+    assert_eq!(j["vertices"], enc["vertices"]);
+    assert_eq!(j["triangles"], enc["triangles"]);
+    assert_eq!(j["version"], "1.3");
+    assert_eq!(j["geometry_kind"], 9);
+    assert_eq!(j["fields"]["angle_bits"], 6);
+    // The box is the fixture's, rounded outward to binary32 (24 bytes, tag 32).
+    let min = j["fields"]["bbox_f32"]["min"].as_array().unwrap();
+    assert!(min.iter().all(|x| x.as_f64().unwrap().is_finite()));
+    let names: Vec<&str> = j["sections"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["connectivity", "geometry"]);
+    // Text form, and a stream found by its magic without the extension.
+    let plain = dir.join("f.bin");
+    std::fs::copy(&stream, &plain).unwrap();
+    let o = whet(&["info", s(&plain)]);
+    assert!(o.status.success());
+    assert!(String::from_utf8_lossy(&o.stdout).contains("geometry kind   9"));
+    // One flipped payload bit: the checksum names the section.
+    let mut bytes = std::fs::read(&stream).unwrap();
+    let n = bytes.len();
+    bytes[n - 10] ^= 0x10;
+    let bad = dir.join("bad.whet");
+    std::fs::write(&bad, &bytes).unwrap();
+    let o = whet(&["info", s(&bad)]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("checksum mismatch in geometry"), "{err}");
+}
