@@ -59,11 +59,7 @@ pub struct DecodeArgs {
 }
 
 pub fn run(args: &DecodeArgs) -> CliResult {
-    let bytes = std::fs::read(&args.input).map_err(|e| {
-        Failure::input(
-            anyhow::Error::new(e).context(format!("cannot read {}", args.input.display())),
-        )
-    })?;
+    let bytes = super::read_stream_file(&args.input, args.max_memory)?;
     let limits = whet_format::Limits::DEFAULT.with_max_alloc_bytes(args.max_memory);
     if args.sharpen {
         // An exact or swing stream states its triangle count: refuse sharpening it before

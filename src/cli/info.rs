@@ -18,6 +18,9 @@ pub struct InfoArgs {
     /// Print one JSON object instead of text.
     #[arg(long)]
     json: bool,
+    /// A `.whet` stream: refuse, before reading it, a file larger than this many bytes.
+    #[arg(long, value_name = "BYTES", default_value_t = super::DEFAULT_MAX_MEMORY)]
+    max_memory: u64,
 }
 
 pub fn run(args: &InfoArgs) -> CliResult {
@@ -130,8 +133,7 @@ fn is_stream(path: &Path) -> bool {
 /// (whet-format, the default limits), nothing is decoded.
 fn stream_info(args: &InfoArgs) -> CliResult {
     let path = &args.mesh;
-    let bytes = std::fs::read(path)
-        .map_err(|e| Failure::input(anyhow!("cannot read {}: {e}", path.display())))?;
+    let bytes = super::read_stream_file(path, args.max_memory)?;
     let c = whet_format::parse(&bytes, &whet_format::Limits::DEFAULT)
         .map_err(|e| Failure::input(anyhow!("{}: {e}", path.display())))?;
     let h = &c.header;

@@ -135,6 +135,23 @@ pub fn run(cli: Cli) -> CliResult {
 /// (`whet_format::Limits::DEFAULT`, 4 GiB).
 pub const DEFAULT_MAX_MEMORY: u64 = whet_format::Limits::DEFAULT.max_alloc_bytes;
 
+/// The bytes of the stream file `path`, refused before reading when the file is larger than
+/// `max_bytes` (a decoder holds the whole stream: a huge file must not fill the memory before
+/// any limit is checked).
+pub fn read_stream_file(path: &Path, max_bytes: u64) -> CliResult<Vec<u8>> {
+    let cannot = |e: std::io::Error| {
+        Failure::input(anyhow::Error::new(e).context(format!("cannot read {}", path.display())))
+    };
+    let len = std::fs::metadata(path).map_err(cannot)?.len();
+    if len > max_bytes {
+        return Err(Failure::input(anyhow::anyhow!(
+            "{} is {len} bytes, more than the memory budget of {max_bytes} bytes (--max-memory)",
+            path.display()
+        )));
+    }
+    std::fs::read(path).map_err(cannot)
+}
+
 /// Refuses (exit code 2) an operation whose output of `triangles` triangles would take more
 /// than `max_memory` bytes at `bytes_per_triangle` (the operation's measured peak): a few
 /// levels of subdivision turn a small mesh into one no machine holds, and the allocator would

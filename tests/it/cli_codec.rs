@@ -372,3 +372,28 @@ fn an_empty_mesh_is_refused_naming_the_path_once() {
         "{err}"
     );
 }
+
+/// A stream file larger than the memory budget is refused before it is read (a decoder holds
+/// the whole stream), by `whet decode` and `whet info` alike.
+#[test]
+fn a_stream_file_over_the_budget_is_refused_before_reading() {
+    let dir = scratch_dir("cli-decode-huge");
+    let big = dir.join("big.whet");
+    // 64 MB of zeros (sparse where the file system allows).
+    std::fs::File::create(&big)
+        .unwrap()
+        .set_len(64 << 20)
+        .unwrap();
+    for args in [
+        vec!["decode", s(&big), "-o", "x.off", "--max-memory", "1000000"],
+        vec!["info", s(&big), "--max-memory", "1000000"],
+    ] {
+        let o = whet(&args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            err.contains("67108864 bytes, more than the memory budget of 1000000"),
+            "{err}"
+        );
+    }
+}
