@@ -38,11 +38,13 @@
 //! * kinds 5 and 6 (format 1.2): kinds 3 and 4 with the predicted
 //!   angle scaled by [`PREDICTION_SCALE`] ([`predict_swing_scaled`]) and the residuals coded
 //!   through adaptive frequency tables instead of bit trees;
-//! * kinds 7 and 8, **what the encoder writes** (format 1.2): kinds 5 and 6 with the
-//!   connectivity coded inside the walk, label by label in creation order, in the context of
-//!   the geometry rebuilt around each gate (module `front`); the connectivity section holds only
-//!   the triangle count. The encoder falls back to kinds 5 and 6 if that walk does not
-//!   reproduce the retiled mesh;
+//! * kinds 7 and 8 (format 1.2): kinds 5 and 6 with the connectivity coded inside the walk,
+//!   label by label in creation order, in the context of the geometry rebuilt around each
+//!   gate (module `front`); the connectivity section holds only the triangle count;
+//! * kinds 9 and 10, **what the encoder writes** unless kind 7 or 8 is smaller (format 1.3):
+//!   kinds 7 and 8 with each index predicted from its neighbourhood and its residual coded
+//!   bit by bit (module `neighbours`). The encoder falls back to kinds 5 and 6 if the forward
+//!   walk does not reproduce the retiled mesh;
 //! * kind 1, explicit: the exact mode's position coder on the kept retiled triangles,
 //!   positions quantized to `quant_bits` — only the safety net for a failed encoder
 //!   self-check (a retiler bug), never written otherwise.
@@ -81,11 +83,12 @@ const KIND_SWING_CUT: u8 = 2;
 const KIND_SWING_PRED: u8 = 3;
 const KIND_SWING_PRED_CUT: u8 = 4;
 /// Kinds 3 and 4 with the prediction scaled ([`predict_swing_scaled`]) and the residuals
-/// coded through adaptive frequency tables; what the encoder writes (format 1.2).
+/// coded through adaptive frequency tables (format 1.2); the encoder's fallback when the
+/// forward walk does not reproduce the retiling.
 const KIND_SWING_SCALED: u8 = 5;
 const KIND_SWING_SCALED_CUT: u8 = 6;
-/// Kinds 5 and 6 with the connectivity coded in the walk ([`front`]); what the encoder
-/// writes (format 1.2).
+/// Kinds 5 and 6 with the connectivity coded in the walk ([`front`]); format 1.2, what the
+/// encoder writes when it is smaller than kind 9 or 10.
 const KIND_SWING_FORWARD: u8 = 7;
 const KIND_SWING_FORWARD_CUT: u8 = 8;
 /// Kinds 7 and 8 with the neighbourhood prediction and bitwise residuals ([`neighbours`]);
