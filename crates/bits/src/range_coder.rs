@@ -92,29 +92,28 @@ impl RangeEncoder {
     /// Codes one bit with an adaptive probability, updating the model.
     #[inline]
     pub fn encode_bit(&mut self, model: &mut BitModel, bit: bool) {
-        let bound = (self.range >> PROB_BITS) * model.p0() as u32;
+        self.encode_split((self.range >> PROB_BITS) * model.p0() as u32, bit);
+        model.update(bit);
+    }
+
+    /// Codes `bit` against the split of the range at `bound` (0 below it, 1 above), then
+    /// normalizes: the step every binary model shares.
+    #[inline(always)]
+    fn encode_split(&mut self, bound: u32, bit: bool) {
         if bit {
             self.low += bound as u64;
             self.range -= bound;
         } else {
             self.range = bound;
         }
-        model.update(bit);
         self.normalize();
     }
 
     /// Codes one bit with a [`CountingBitModel`], updating it.
     #[inline]
     pub fn encode_counting_bit(&mut self, model: &mut CountingBitModel, bit: bool) {
-        let bound = (self.range >> COUNTING_PROB_BITS) * model.p0();
-        if bit {
-            self.low += bound as u64;
-            self.range -= bound;
-        } else {
-            self.range = bound;
-        }
+        self.encode_split((self.range >> COUNTING_PROB_BITS) * model.p0(), bit);
         model.update(bit);
-        self.normalize();
     }
 
     /// Codes the low `bits` bits of `value` (most significant first) with probability 1/2
@@ -232,13 +231,19 @@ impl<'a> RangeDecoder<'a> {
     /// Decodes one bit coded with `model`, updating it the same way the encoder did.
     #[inline]
     pub fn decode_bit(&mut self, model: &mut BitModel) -> bool {
-        let bound = (self.range >> PROB_BITS) * model.p0() as u32;
+        let bit = self.decode_split((self.range >> PROB_BITS) * model.p0() as u32);
+        model.update(bit);
+        bit
+    }
+
+    /// Decodes the bit coded against the split of the range at `bound`, then normalizes.
+    #[inline(always)]
+    fn decode_split(&mut self, bound: u32) -> bool {
         // Without a branch on the bit (see BitModel::update): the masked interval.
         let bit = self.code >= bound;
         let one = 0u32.wrapping_sub(bit as u32);
         self.code = self.code.wrapping_sub(bound & one);
         self.range = (bound & !one) | (self.range.wrapping_sub(bound) & one);
-        model.update(bit);
         self.normalize();
         bit
     }
@@ -246,13 +251,8 @@ impl<'a> RangeDecoder<'a> {
     /// Decodes one bit coded with a [`CountingBitModel`], updating it as the encoder did.
     #[inline]
     pub fn decode_counting_bit(&mut self, model: &mut CountingBitModel) -> bool {
-        let bound = (self.range >> COUNTING_PROB_BITS) * model.p0();
-        let bit = self.code >= bound;
-        let one = 0u32.wrapping_sub(bit as u32);
-        self.code = self.code.wrapping_sub(bound & one);
-        self.range = (bound & !one) | (self.range.wrapping_sub(bound) & one);
+        let bit = self.decode_split((self.range >> COUNTING_PROB_BITS) * model.p0());
         model.update(bit);
-        self.normalize();
         bit
     }
 

@@ -1047,22 +1047,6 @@ pub fn encode_retiled(
     }
 }
 
-/// [`encode_retiled`] with the forward walk's indices coded by `coding` only (`None` when the
-/// forward walk does not reproduce the retiling); for tests and measurements.
-pub fn encode_retiled_forward(
-    retiled: &RetiledMesh,
-    params: &SwingParams,
-    info: &SwingStreamInfo<'_>,
-    neighbourhood_prediction: bool,
-) -> Result<Option<SwingEncoded>, Error> {
-    let coding = if neighbourhood_prediction {
-        ForwardCoding::Neighbours
-    } else {
-        ForwardCoding::Scaled
-    };
-    encode_forward(retiled, params, info, coding)
-}
-
 /// A seed and index coder `inner` with what a forward walk needs besides (kinds 7 and 8):
 /// `state` for the labels and S tips.
 struct Forward<W, S> {
