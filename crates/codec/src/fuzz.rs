@@ -29,6 +29,11 @@ pub fn fuzz_decode(data: &[u8]) {
     }
     let limits = whet_edgebreaker::ConnectivityLimits::DEFAULT.with_max_triangles(1 << 20);
     let _ = whet_edgebreaker::decode_connectivity(data, &limits);
+    // Header field 33 (snap vetoes) behind the container's checks, and on the raw bytes.
+    if let Ok(c) = whet_format::parse(data, &opts.limits) {
+        let _ = crate::SnapVetoes::of(&c.header);
+    }
+    let _ = crate::SnapVetoes::from_field(data, 1 << 16);
 }
 
 /// The exact mode's payload decoders behind the container's CRCs: byte 0 picks the

@@ -33,6 +33,7 @@ mod fuzz;
 mod parallelogram;
 mod quantize;
 mod sharpen_hint;
+mod snap_vetoes;
 pub mod surface_filter;
 pub mod swing;
 
@@ -49,6 +50,7 @@ pub use fuzz::{fuzz_decode, fuzz_exact_payloads, fuzz_swing_payloads, swing_payl
 pub use parallelogram::{average, candidates, gate_fallback, MAX_CANDIDATES};
 pub use quantize::Quantizer;
 pub use sharpen_hint::SharpenHint;
+pub use snap_vetoes::{SnapVetoes, MAX_VETO_PASSES};
 pub use surface_filter::{untouched_by_sharpening, FilterFields, SurfaceFilter};
 pub use swing::{
     encode_retiled, AngleTable, RetiledMesh, SwingEncoded, SwingFrame, SwingGeometry, SwingParams,

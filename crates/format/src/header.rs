@@ -183,9 +183,13 @@ pub mod tag {
     /// outward to them); a header holds this field or [`BBOX`], not both. See
     /// [`Header::bbox`](crate::Header::bbox).
     pub const BBOX_F32: u64 = 32;
+    /// bytes (format 1.3, optional): the snaps of `whet decode --sharpen` that the encoder
+    /// measured farther from the original than their rest positions, and vetoed, for the
+    /// sharpening the stream states (swing; absent: none). Layout in docs/format.md section 3.
+    pub const SNAP_VETOES: u64 = 33;
 
     /// Every tag this crate knows, with its name and value type.
-    pub const KNOWN: [(u64, &str, ValueType); 18] = [
+    pub const KNOWN: [(u64, &str, ValueType); 19] = [
         (ENCODER, "encoder", ValueType::Bytes),
         (COMPONENT_COUNT, "component_count", ValueType::U64),
         (QUANT_BITS, "quant_bits", ValueType::U64),
@@ -216,6 +220,7 @@ pub mod tag {
         (SHARPEN_PASSES, "sharpen_passes", ValueType::U64),
         (QUADRIC_PROJECTION, "quadric_projection", ValueType::U64),
         (BBOX_F32, "bbox_f32", ValueType::Bytes),
+        (SNAP_VETOES, "snap_vetoes", ValueType::Bytes),
     ];
 
     /// Name and type of a known tag.
