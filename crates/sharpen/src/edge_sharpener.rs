@@ -219,6 +219,23 @@ impl EdgeSharpener {
 
     /// Sharpens `mesh`; see [`crate::sharpen`].
     pub fn sharpen(&mut self, mesh: &Mesh) -> Result<Sharpened, Error> {
+        self.sharpen_with(mesh, None)
+    }
+
+    /// Sharpens `mesh` with every pass's snaps put to `judge`; see [`crate::sharpen_judged`].
+    pub fn sharpen_judged(
+        &mut self,
+        mesh: &Mesh,
+        judge: &mut dyn crate::SnapJudge,
+    ) -> Result<Sharpened, Error> {
+        self.sharpen_with(mesh, Some(judge))
+    }
+
+    fn sharpen_with(
+        &mut self,
+        mesh: &Mesh,
+        mut judge: Option<&mut (dyn crate::SnapJudge + '_)>,
+    ) -> Result<Sharpened, Error> {
         if self.options.method == Method::NormalFilter {
             // One pass, whatever `passes` says (the option is EdgeSharpener's).
             let mut out = crate::normal_filter::run(mesh, &self.options, None)?;
@@ -227,7 +244,7 @@ impl EdgeSharpener {
         }
         let start = Instant::now();
         self.options.validate()?;
-        let mut out = self.sharpen_once(mesh)?;
+        let mut out = self.sharpen_once(mesh, judge.as_deref_mut())?;
         out.report.passes = 1;
         // A pass that gives its input back would do so again.
         let mut unchanged = out.mesh == *mesh;
@@ -244,7 +261,7 @@ impl EdgeSharpener {
             {
                 break;
             }
-            let Ok(next) = self.sharpen_once(&out.mesh) else {
+            let Ok(next) = self.sharpen_once(&out.mesh, judge.as_deref_mut()) else {
                 break;
             };
             unchanged = next.mesh == out.mesh;
@@ -257,7 +274,11 @@ impl EdgeSharpener {
     }
 
     /// One pass of [`Self::sharpen`] (options validated).
-    fn sharpen_once(&mut self, mesh: &Mesh) -> Result<Sharpened, Error> {
+    fn sharpen_once(
+        &mut self,
+        mesh: &Mesh,
+        mut judge: Option<&mut (dyn crate::SnapJudge + '_)>,
+    ) -> Result<Sharpened, Error> {
         let start = Instant::now();
         if let Some(v) = mesh.positions.iter().position(|p| !p.is_finite()) {
             return Err(Error::InvalidInput(MeshError::NonFiniteCoordinate {
@@ -315,7 +336,7 @@ impl EdgeSharpener {
                 input_table: &table,
                 welded: w,
             });
-            let (mut out, mut parents, mut tags) = run.run();
+            let (mut out, mut parents, mut tags) = run.run(judge.as_deref_mut());
             for p in &mut parents {
                 *p = FaceId(w.input_triangle[p.index()]);
             }
@@ -356,7 +377,7 @@ impl EdgeSharpener {
             }
         }
         let mut run = Run::new(mesh, &table, &self.options, &mut self.scratch, report);
-        let (out, parents, tags) = run.run();
+        let (out, parents, tags) = run.run(judge);
         let mut report = run.report;
         report.time = start.elapsed();
         Ok(Sharpened {
@@ -512,10 +533,16 @@ impl<'a> Run<'a> {
         }
     }
 
-    fn run(&mut self) -> (Mesh, Vec<FaceId>, SharpTags) {
+    fn run(
+        &mut self,
+        judge: Option<&mut (dyn crate::SnapJudge + '_)>,
+    ) -> (Mesh, Vec<FaceId>, SharpTags) {
         self.detect();
         self.insert_vertices();
         self.reset_reference_normals();
+        if let Some(judge) = judge {
+            self.judge_snaps(judge);
+        }
         self.settle_positions();
         let mut out = crate::slivers::Output::assemble(self);
         out.remove_slivers(self);
@@ -1600,6 +1627,48 @@ impl<'a> Run<'a> {
             self.mesh.positions[v as usize]
         } else {
             self.s.new_vertices[v as usize - nv].rest
+        }
+    }
+
+    /// Puts the snaps to `judge` (moved input vertices by index, then snapped new vertices by
+    /// index) and unsnaps those it vetoes, before [`Run::settle_positions`] checks what is
+    /// left.
+    fn judge_snaps(&mut self, judge: &mut dyn crate::SnapJudge) {
+        let nv = self.mesh.positions.len();
+        let mut vertices: Vec<u32> = (0..nv as u32)
+            .filter(|&v| self.s.vflags[v as usize] & V_MOVED != 0)
+            .collect();
+        vertices.extend(
+            self.s
+                .new_vertices
+                .iter()
+                .enumerate()
+                .filter(|(_, n)| n.status == SNAPPED)
+                .map(|(k, _)| (nv + k) as u32),
+        );
+        if vertices.is_empty() {
+            return;
+        }
+        let snaps: Vec<crate::Snap> = vertices
+            .iter()
+            .map(|&v| crate::Snap {
+                rest: self.rest_of(v),
+                snapped: self.positions[v as usize],
+                origins: if (v as usize) < nv {
+                    Vec::new()
+                } else {
+                    self.origin_vertices(v)
+                        .into_iter()
+                        .map(|o| self.positions[o as usize])
+                        .collect()
+                },
+            })
+            .collect();
+        let vetoes = judge.vetoes(&snaps);
+        for (&v, &veto) in vertices.iter().zip(&vetoes) {
+            if veto {
+                self.unsnap(v, UnmovedReason::Vetoed);
+            }
         }
     }
 

@@ -33,6 +33,7 @@
 mod edge_sharpener;
 mod extended;
 mod fuzz;
+mod judge;
 mod normal_filter;
 mod options;
 mod planar;
@@ -53,6 +54,7 @@ pub use edge_sharpener::EdgeSharpener;
 pub const PEAK_BYTES_PER_TRIANGLE: u64 = 200;
 
 pub use fuzz::{fuzz_input, fuzz_seed, fuzz_sharpen};
+pub use judge::{Snap, SnapJudge, VetoReplay};
 pub use normal_filter::VertexSelection;
 pub use options::{Method, SharpenOptions, DEFAULT_CURVED_WALL_FACTOR, MAX_PASSES};
 pub use planar::{flatten_planar_regions, PlanarOptions, PlanarReport};
@@ -135,6 +137,16 @@ impl Error {
 /// and with [`Error::Parameter`] for options out of range. Never panics.
 pub fn sharpen(mesh: &Mesh, options: &SharpenOptions) -> Result<Sharpened, Error> {
     EdgeSharpener::new(*options).sharpen(mesh)
+}
+
+/// [`sharpen`] with every pass's snaps put to `judge` before the mesh is settled (see
+/// [`SnapJudge`]; the normal-filter method snaps nothing and never asks).
+pub fn sharpen_judged(
+    mesh: &Mesh,
+    options: &SharpenOptions,
+    judge: &mut dyn SnapJudge,
+) -> Result<Sharpened, Error> {
+    EdgeSharpener::new(*options).sharpen_judged(mesh, judge)
 }
 
 /// The normal filter ([`Method::NormalFilter`], whatever `options.method` says) limited to

@@ -26,11 +26,14 @@ pub enum UnmovedReason {
     /// Extended method: the planes of the neighbouring vertices of the same surfaces disagree
     /// with the snapped point (the surface is curved at the scale of the sampling).
     Curved,
+    /// A [`crate::SnapJudge`] vetoed the snap: a swing stream's encoder measured it farther
+    /// from the original than the rest position (docs/sharpen.md, "Snap vetoes").
+    Vetoed,
 }
 
 impl UnmovedReason {
     /// Every reason, in declaration order.
-    pub const ALL: [UnmovedReason; 7] = [
+    pub const ALL: [UnmovedReason; 8] = [
         UnmovedReason::Parallel,
         UnmovedReason::Dependent,
         UnmovedReason::MixedConvexity,
@@ -38,6 +41,7 @@ impl UnmovedReason {
         UnmovedReason::Flipped,
         UnmovedReason::Sliver,
         UnmovedReason::Curved,
+        UnmovedReason::Vetoed,
     ];
 
     /// The snake_case name used in JSON.
@@ -50,6 +54,7 @@ impl UnmovedReason {
             UnmovedReason::Flipped => "flipped",
             UnmovedReason::Sliver => "sliver",
             UnmovedReason::Curved => "curved",
+            UnmovedReason::Vetoed => "vetoed",
         }
     }
 
@@ -101,7 +106,7 @@ pub struct SharpenReport {
     pub snapped_vertices: usize,
     /// New vertices of the output left at their midpoint or centroid, by reason (indexed like
     /// [`UnmovedReason::ALL`]; see [`SharpenReport::unmoved`]).
-    pub unmoved_by_reason: [usize; 7],
+    pub unmoved_by_reason: [usize; 8],
     /// Input vertices moved (extended mode only; always chamfer vertices).
     pub moved_input_vertices: usize,
     /// Triangles removed by the sliver pass's edge collapses.

@@ -913,7 +913,7 @@ impl Output {
         let mut positions = std::mem::take(&mut run.positions);
         let mut next = nv as u32;
         let mut snapped = 0;
-        let mut unmoved = [0usize; 7];
+        let mut unmoved = [0usize; UnmovedReason::ALL.len()];
         for k in 0..remap.len() {
             if remap[k] == NONE {
                 continue;

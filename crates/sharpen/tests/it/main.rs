@@ -8,6 +8,7 @@
 //!   selection, random damage);
 //! - `robustness`: random noise, holes and options never break the output's guarantees.
 //! - `swing`: swing-decoded fixtures (whet-swing, whet-codec as dev-dependencies).
+//! - `judge`: snap vetoes (`SnapJudge`, `VetoReplay`).
 #![allow(clippy::unwrap_used)] // a panic is a test failure
 
 #[path = "../../examples/support/mod.rs"]
@@ -19,6 +20,7 @@ pub const EDGE_SHARPENER: [whet_sharpen::Method; 2] =
 
 mod inputs;
 mod issue6;
+mod judge;
 mod normal_filter;
 mod outputs;
 mod ridge;
