@@ -150,7 +150,17 @@ pub fn run(args: &DecodeArgs) -> CliResult {
             opts = opts.with_curved_wall_factor(w);
         }
         opts.validate().map_err(super::Failure::input)?;
-        let mut s = super::sharpen::run_sharpen(&mesh, &opts)?;
+        // The stream's snap vetoes (field 33) were judged for the sharpening it states: they
+        // are replayed only when no option changes that sharpening.
+        let own_sharpening = args.method.is_none()
+            && args.smooth_factor.is_none()
+            && args.curved_walls.is_none()
+            && args.passes.is_none();
+        let mut replay = match (&header, own_sharpening) {
+            (Some(h), true) => super::sharpen::stated_vetoes(h)?,
+            _ => None,
+        };
+        let mut s = super::sharpen::run_sharpen_replayed(&mesh, &opts, replay.as_mut())?;
         if !args.no_surface_filter {
             // A swing stream's filter for after sharpening: the smooth parts the sharpener
             // left alone get the surface filter fitted for them (docs/swing.md section 2).

@@ -357,7 +357,7 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh, skipped: &whet::io::ReadRepor
     }
     let h = r.clers_histogram;
     if args.json {
-        print_json(&json!({
+        let mut j = json!({
             "mode": "swing",
             "bytes": r.bytes,
             "triangles": r.triangles,
@@ -420,7 +420,14 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh, skipped: &whet::io::ReadRepor
             "repair": repair_json(r),
             "dropped_unused_vertices": r.dropped_unused_vertices,
             "skipped_attributes": skipped_json(skipped),
-        }));
+        });
+        // Field 33 (docs/sharpen.md, "Snap vetoes"); out of the literal above, which is at
+        // serde_json's macro recursion limit.
+        // `snap_vetoes` counts the snaps vetoed (in field 33, or through the hint "none"
+        // where they were the majority); `snaps_judged` those judged (0: no judgement).
+        j["snap_vetoes"] = json!(out.snap_vetoes.as_ref().map_or(0, |v| v.vetoed()));
+        j["snaps_judged"] = json!(out.snap_vetoes.as_ref().map_or(0, |v| v.judged()));
+        print_json(&j);
     } else {
         outln!(
             "{} -> {}: {} bytes, {} retiled vertices, {} retiled triangles (L = {:.4} of the diagonal), {:.3} bits per original vertex, {:.3} bits/retiled triangle (connectivity {} bits, geometry {} bits)",

@@ -154,6 +154,19 @@ fn stream_info(args: &InfoArgs) -> CliResult {
                 (whet_format::HeaderValue::Bytes(b), whet_format::tag::ENCODER) => {
                     json!(String::from_utf8_lossy(b))
                 }
+                (whet_format::HeaderValue::Bytes(b), whet_format::tag::SNAP_VETOES) => {
+                    // Counts when the field reads (a malformed one: its size and the error).
+                    match whet_codec::SnapVetoes::of(h) {
+                        Some(Ok(v)) => json!({
+                            "bytes": b.len(),
+                            "judgements": v.passes().len(),
+                            "snaps": v.judged(),
+                            "vetoed": v.vetoed(),
+                        }),
+                        Some(Err(e)) => json!({ "bytes": b.len(), "error": e.to_string() }),
+                        None => json!({ "bytes": b.len() }),
+                    }
+                }
                 (whet_format::HeaderValue::Bytes(b), _) => json!({ "bytes": b.len() }),
             };
             (name, value)

@@ -235,6 +235,7 @@ fn sharpened(
     smooth_factor: f64,
     curved_walls: Option<f64>,
     passes: u32,
+    mut replay: Option<&mut whet_sharpen::VetoReplay>,
 ) -> Result<whet_sharpen::Sharpened, String> {
     let mut opts = whet_sharpen::SharpenOptions::DEFAULT
         .with_method(method)
@@ -243,7 +244,11 @@ fn sharpened(
     if let Some(w) = curved_walls {
         opts = opts.with_curved_wall_factor(w);
     }
-    let run = |m: &Mesh| whet_sharpen::sharpen(m, &opts);
+    // With the stream's snap vetoes (field 33) when it states any, as `whet decode --sharpen`.
+    let mut run = |m: &Mesh| match replay.as_deref_mut() {
+        Some(r) => whet_sharpen::sharpen_judged(m, &opts, r),
+        None => whet_sharpen::sharpen(m, &opts),
+    };
     match run(mesh) {
         Ok(s) => Ok(s),
         Err(whet_sharpen::Error::InvalidInput(_)) => {
@@ -284,7 +289,23 @@ fn sharpened_from_stream(mesh: &Mesh, bytes: &[u8]) -> Result<(Mesh, Vec<[u32; 2
         .as_ref()
         .and_then(whet_codec::SharpenHint::passes_of)
         .unwrap_or(1);
-    let mut s = sharpened(mesh, method, smooth_factor, curved_walls, passes)?;
+    let mut replay = match &header {
+        Some(h) => match whet_codec::SnapVetoes::of(h) {
+            Some(v) => Some(whet_sharpen::VetoReplay::new(
+                v.map_err(|e| e.to_string())?.passes().to_vec(),
+            )),
+            None => None,
+        },
+        None => None,
+    };
+    let mut s = sharpened(
+        mesh,
+        method,
+        smooth_factor,
+        curved_walls,
+        passes,
+        replay.as_mut(),
+    )?;
     if let Some(h) = &header {
         whet_codec::SurfaceFilter::after_sharpening_of(h).apply_after_sharpening(mesh, &mut s.mesh);
         super::sharpen::project_as_stated(h, &mut s.mesh);

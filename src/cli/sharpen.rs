@@ -75,15 +75,49 @@ pub fn sharpen_options(method: &str, smooth_factor: f64) -> Result<SharpenOption
 
 /// Sharpens, cutting non-manifold input first (and saying so).
 pub fn run_sharpen(mesh: &Mesh, opts: &SharpenOptions) -> CliResult<Sharpened> {
-    match sharpen(mesh, opts) {
+    run_sharpen_replayed(mesh, opts, None)
+}
+
+/// [`run_sharpen`] replaying a stream's snap vetoes (field 33) when `replay` is given; a
+/// warning says so when they did not fit the run (they are then not applied).
+pub fn run_sharpen_replayed(
+    mesh: &Mesh,
+    opts: &SharpenOptions,
+    mut replay: Option<&mut whet_sharpen::VetoReplay>,
+) -> CliResult<Sharpened> {
+    let mut run = |m: &Mesh| match replay.as_deref_mut() {
+        Some(r) => whet_sharpen::sharpen_judged(m, opts, r),
+        None => sharpen(m, opts),
+    };
+    let out = match run(mesh) {
         Ok(s) => Ok(s),
         Err(whet_sharpen::Error::InvalidInput(e)) if e.is_structural() => {
             let mut m = mesh.clone();
             let rep = m.make_manifold();
             eprintln!("whet: the mesh is not an oriented manifold ({e}); make_manifold {rep}");
-            sharpen(&m, opts).map_err(Failure::input)
+            run(&m).map_err(Failure::input)
         }
         Err(e) => Err(Failure::input(e)),
+    }?;
+    if let Some(r) = replay {
+        if r.mismatched_passes() > 0 {
+            eprintln!(
+                "whet: the stream's snap vetoes do not fit this sharpening run ({} of its \
+                 passes differ); they were not applied there",
+                r.mismatched_passes()
+            );
+        }
+    }
+    Ok(out)
+}
+
+/// The snap vetoes a swing stream's header states (field 33) for the sharpening it states,
+/// ready to replay; `None` without the field. A malformed field is bad input.
+pub fn stated_vetoes(header: &whet_format::Header) -> CliResult<Option<whet_sharpen::VetoReplay>> {
+    match whet_codec::SnapVetoes::of(header) {
+        None => Ok(None),
+        Some(Ok(v)) => Ok(Some(whet_sharpen::VetoReplay::new(v.passes().to_vec()))),
+        Some(Err(e)) => Err(Failure::input(e)),
     }
 }
 

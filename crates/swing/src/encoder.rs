@@ -6,8 +6,8 @@
 use crate::retiler::{retile_fitted, RetileStats, RetileTuning};
 use crate::Error;
 use whet_codec::{
-    encode_retiled, prepare_mesh, EncodeReport, SharpenHint, SurfaceFilter, SwingEncoded,
-    SwingGeometry, SwingParams, SwingStreamInfo, Version,
+    encode_retiled, prepare_mesh, EncodeReport, SharpenHint, SnapVetoes, SurfaceFilter,
+    SwingEncoded, SwingGeometry, SwingParams, SwingStreamInfo, Version,
 };
 use whet_mesh::Mesh;
 use whet_metro::{metro, MetroOptions};
@@ -298,6 +298,13 @@ pub struct SwingOutput {
     /// decoded mesh without its surface filter): no sharpening whose max is over it is
     /// chosen. `None` when no choice was made.
     pub sharpen_input_max_pct: Option<f64>,
+    /// The snaps of the stated sharpening (EdgeSharpener's default when the stream states
+    /// none) that the encoder judged against the original, and which it vetoed: what header
+    /// field 33 states when one or more was vetoed and the field was written (see
+    /// `SwingEncoder::encode`; a size-searched stream leaves it out rather than miss its
+    /// target, and a part where most snaps were vetoed states no sharpening instead).
+    /// `None` when no judgement was made.
+    pub snap_vetoes: Option<SnapVetoes>,
     /// How far the original's surface strays from the retiling, in units of `L`: the
     /// largest distance of a sample of the original's vertices, outside the components
     /// coded as pillows, to the retiled mesh (see `MAX_COVERAGE_GAP`); infinite when a
@@ -405,6 +412,8 @@ pub struct SwingEncoder {
 
 struct Prepared {
     mesh: Mesh,
+    /// The original's BVH for judging snaps (`crate::snap_judge`), built on first use.
+    bvh: std::sync::OnceLock<whet_metro::Bvh>,
     repair: whet_mesh::ManifoldRepair,
     dropped: usize,
     diagonal: f64,
@@ -455,6 +464,7 @@ impl SwingEncoder {
             )));
         }
         let prep = Prepared {
+            bvh: std::sync::OnceLock::new(),
             area: p.mesh.area(),
             diagonal,
             repair: p.repair,
@@ -470,7 +480,54 @@ impl SwingEncoder {
         if o.error_of == ErrorOf::Sharpened {
             return self.choose_sharpening(&prep, out);
         }
-        Ok(out)
+        self.veto_default_sharpening(&prep, out)
+    }
+
+    /// A stream encoded for the decoded output states no sharpening, so `whet decode
+    /// --sharpen` runs EdgeSharpener's default on it: the snaps of that run that the
+    /// original says are worse than no snap (a fillet about an edge wide sharpened into a
+    /// corner) are vetoed in field 33 (docs/sharpen.md, "Snap vetoes"). The field is left
+    /// out when nothing is vetoed, and when its bytes would take a size-searched stream past
+    /// the search's tolerance.
+    fn veto_default_sharpening(
+        &self,
+        prep: &Prepared,
+        out: SwingOutput,
+    ) -> Result<SwingOutput, Error> {
+        let input = unfiltered(&out)?;
+        let (_, v) = crate::snap_judge::sharpen_judged(
+            &prep.mesh,
+            &prep.bvh,
+            &input,
+            &whet_sharpen::SharpenOptions::DEFAULT,
+        );
+        drop(input);
+        let mut out = out;
+        out.snap_vetoes = Some(v.clone());
+        if v.vetoed() == 0 {
+            return Ok(out);
+        }
+        let target = match self.opts.rate {
+            Rate::BitsPerVertex(r) => Some(r * prep.mesh.positions.len() as f64 / 8.0),
+            Rate::TargetBytes(n) => Some(n as f64),
+            Rate::EdgeLength(_) | Rate::MaxError(_) => None,
+        };
+        // Where most snaps are worse than none, the part has no crease the sharpener finds
+        // right (fertility's rounded base at L = 0.96 %: 123 of 155 vetoed): the stream
+        // states no sharpening (two bytes), as a stream encoded for the sharpened output
+        // would after measuring; the plain decoded mesh keeps its surface filter.
+        let vetoed = if 2 * v.vetoed() > v.judged() {
+            restate_hint(out.clone(), SharpenHint::Unsharpened)?
+        } else {
+            restate_vetoes(out.clone(), &v)?
+        };
+        match target {
+            Some(t) if vetoed.bytes.len() as f64 > t * (1.0 + self.opts.tolerance) => {
+                out.snap_vetoes = None;
+                Ok(out)
+            }
+            _ => Ok(vetoed),
+        }
     }
 
     /// Which sharpening `whet decode --sharpen` should run on `out`'s stream, measured
@@ -537,7 +594,7 @@ impl SwingEncoder {
         }
         .into_iter();
         let mut trials = Vec::new();
-        let mut best: Option<(SharpenTrial, Option<SwingOutput>)> = None;
+        let mut best: Option<(SharpenTrial, Option<SwingOutput>, SnapVetoes)> = None;
         // Sharpening must not make a case worse (the "no case gets worse", RMS or
         // max): the score (RMS weighted by the max, `MAX_ERROR_WEIGHT`) decides among the
         // candidates whose max stays within that of the mesh they sharpen and whose RMS stays
@@ -566,7 +623,7 @@ impl SwingEncoder {
         for (i, c) in candidates.iter().enumerate() {
             let (hint, smooth_factor) = (c.hint.unwrap_or(SharpenHint::Extended), c.smooth_factor);
             let opts = c.sharpen_options();
-            let ((rms, max), stream) = if i == 0 {
+            let (((rms, max), vetoes), stream) = if i == 0 {
                 // `out` was encoded for this one.
                 let f = self.measure_sharpened(prep, &out, &input, &opts, &mut measured)?;
                 (f, None)
@@ -592,15 +649,15 @@ impl SwingEncoder {
                 && rms <= none.rms_pct
                 && best
                     .as_ref()
-                    .is_none_or(|(b, _)| trial.score() < MARGIN * b.score())
+                    .is_none_or(|(b, _, _)| trial.score() < MARGIN * b.score())
             {
-                best = Some((trial, stream));
+                best = Some((trial, stream, vetoes));
             }
         }
         trials.push(none);
-        let (chosen_trial, stream) = match best {
-            Some((b, s)) if none.score() >= MARGIN * b.score() => (b, s),
-            _ => (none, None),
+        let (chosen_trial, stream, vetoes) = match best {
+            Some((b, s, v)) if none.score() >= MARGIN * b.score() => (b, s, v),
+            _ => (none, None, SnapVetoes::default()),
         };
         let mut chosen = match stream {
             Some(mut p) => {
@@ -615,6 +672,11 @@ impl SwingEncoder {
             None => out,
         };
         chosen.rms_pct = Some(chosen_trial.rms_pct);
+        if vetoes.vetoed() > 0 {
+            // Measured with its vetoes: the stream must carry them, whatever they cost.
+            chosen = restate_vetoes(chosen, &vetoes)?;
+        }
+        chosen.snap_vetoes = Some(vetoes);
         if chosen_trial.hint != SharpenHint::Unsharpened {
             let opts = Candidate {
                 hint: Some(chosen_trial.hint),
@@ -635,7 +697,7 @@ impl SwingEncoder {
             ];
             for (k, restate) in restated.iter().enumerate() {
                 let projected = restate(chosen.clone())?;
-                let (rms, max) =
+                let ((rms, max), _) =
                     self.measure_sharpened(prep, &projected, &input, &opts, &mut Vec::new())?;
                 let trial = SharpenTrial {
                     rms_pct: rms,
@@ -895,6 +957,7 @@ impl SwingEncoder {
                 quadric_factor: None,
                 sharpen_trials: Vec::new(),
                 sharpen_input_max_pct: None,
+                snap_vetoes: None,
             });
         }
         Ok(outs)
@@ -1098,9 +1161,9 @@ impl SwingEncoder {
     ) -> Result<(f64, f64), Error> {
         match error_of {
             ErrorOf::Decoded => self.measure_mesh(prep, &out.retiled, measured),
-            ErrorOf::Sharpened => {
-                self.measure_sharpened(prep, out, &*unfiltered(out)?, sharpen, measured)
-            }
+            ErrorOf::Sharpened => Ok(self
+                .measure_sharpened(prep, out, &*unfiltered(out)?, sharpen, measured)?
+                .0),
         }
     }
 
@@ -1114,9 +1177,13 @@ impl SwingEncoder {
         input: &Mesh,
         sharpen: &whet_sharpen::SharpenOptions,
         measured: &mut Vec<(u64, (f64, f64))>,
-    ) -> Result<(f64, f64), Error> {
-        let sharpened = match whet_sharpen::sharpen(input, sharpen) {
-            Ok(s) => {
+    ) -> Result<((f64, f64), SnapVetoes), Error> {
+        // Judged against the original: the snaps that make it worse are vetoed, and the
+        // stream that carries this sharpening carries the vetoes (field 33).
+        let (sharpened, vetoes) =
+            crate::snap_judge::sharpen_judged(&prep.mesh, &prep.bvh, input, sharpen);
+        let sharpened = match sharpened {
+            Some(s) => {
                 let mut m = s.mesh;
                 out.sharpened_filter.apply_after_sharpening(input, &mut m);
                 if let Some(f) = out.planar_factor {
@@ -1135,9 +1202,10 @@ impl SwingEncoder {
             // A retiled mesh is a valid manifold; should the sharpener refuse one anyway,
             // `whet decode --sharpen` would fail the same way, and the decoded mesh is what
             // the user keeps.
-            Err(_) => None,
+            None => None,
         };
-        self.measure_mesh(prep, sharpened.as_ref().unwrap_or(input), measured)
+        let figures = self.measure_mesh(prep, sharpened.as_ref().unwrap_or(input), measured)?;
+        Ok((figures, vetoes))
     }
 
     /// The symmetric `(rms, max)` errors of `mesh` against the original, % of the diagonal;
@@ -1439,6 +1507,7 @@ fn restate_planar(mut out: SwingOutput, factor: f64) -> Result<SwingOutput, Erro
     let code = SharpenHint::smooth_factor_code(factor)
         .ok_or_else(|| Error::Internal(format!("planar factor {factor} out of range")))?;
     out.bytes = with_header_field(&out.bytes, whet_format::tag::PLANAR_TOLERANCE, code)?;
+    out.report.bytes = out.bytes.len();
     out.planar_factor = Some(code as f64 / 100.0);
     Ok(out)
 }
@@ -1450,7 +1519,16 @@ fn restate_quadric(mut out: SwingOutput, factor: f64) -> Result<SwingOutput, Err
     let code = SharpenHint::smooth_factor_code(factor)
         .ok_or_else(|| Error::Internal(format!("quadric factor {factor} out of range")))?;
     out.bytes = with_header_field(&out.bytes, whet_format::tag::QUADRIC_PROJECTION, code)?;
+    out.report.bytes = out.bytes.len();
     out.quadric_factor = Some(code as f64 / 100.0);
+    Ok(out)
+}
+
+/// `out` with header field 33 stating `vetoes` for the sharpening its stream states.
+fn restate_vetoes(mut out: SwingOutput, vetoes: &SnapVetoes) -> Result<SwingOutput, Error> {
+    out.bytes = with_header_field(&out.bytes, whet_format::tag::SNAP_VETOES, vetoes.to_field())?;
+    out.report.bytes = out.bytes.len();
+    out.snap_vetoes = Some(vetoes.clone());
     Ok(out)
 }
 
@@ -1458,13 +1536,18 @@ fn restate_quadric(mut out: SwingOutput, factor: f64) -> Result<SwingOutput, Err
 /// whatever the hint, so the size does not change).
 fn restate_hint(mut out: SwingOutput, hint: SharpenHint) -> Result<SwingOutput, Error> {
     out.bytes = with_header_field(&out.bytes, whet_format::tag::SHARPEN_METHOD, hint.code())?;
+    out.report.bytes = out.bytes.len();
     out.sharpen_hint = Some(hint);
     Ok(out)
 }
 
 /// The encoder's own stream `bytes` with header field `tag` set to `value` (the payload is
 /// copied unchanged; the container's checksums are recomputed).
-fn with_header_field(bytes: &[u8], tag: u64, value: u64) -> Result<Vec<u8>, Error> {
+fn with_header_field(
+    bytes: &[u8],
+    tag: u64,
+    value: impl Into<whet_format::HeaderValue>,
+) -> Result<Vec<u8>, Error> {
     let mut container = whet_format::parse(bytes, &whet_codec::Limits::UNLIMITED)
         .map_err(whet_codec::Error::from)?;
     container.header = container.header.clone().with(tag, value);

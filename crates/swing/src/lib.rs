@@ -24,6 +24,7 @@ mod fuzz;
 mod grid;
 mod holes;
 mod retiler;
+pub mod snap_judge;
 mod surface;
 
 pub use encoder::{

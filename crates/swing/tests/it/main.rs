@@ -1,5 +1,5 @@
 //! Integration tests of whet-swing: bit-exact round trips on built and public meshes, rate
-//! control, open and degenerate originals, corrupted streams, property tests.
+//! control, open and degenerate originals, corrupted streams, property tests, snap vetoes.
 #![allow(clippy::unwrap_used)] // a panic is a test failure
 
 mod corruption;
@@ -8,6 +8,7 @@ mod open;
 mod props;
 mod rate;
 mod round_trip;
+mod vetoes;
 
 use whet_codec::{decode, DecodeOptions, SwingGeometry};
 use whet_mesh::Mesh;

@@ -288,10 +288,16 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
         let opts = SwingOptions::DEFAULT
             .with_rate(Rate::BitsPerVertex(bpv))
             .with_metro_samples(100_000);
+        // A stream for the decoded output measures no sharpening; it states none, or "no
+        // sharpening" where most snaps of the default one were vetoed (docs/sharpen.md, "Snap
+        // vetoes": rocker_arm's blends).
         let plain = encode(&mesh, &opts).unwrap();
-        assert_eq!(plain.sharpen_hint, None);
+        assert!(matches!(
+            plain.sharpen_hint,
+            None | Some(SharpenHint::Unsharpened)
+        ));
         assert!(plain.sharpen_trials.is_empty());
-        assert_eq!(SharpenHint::of(&header(&plain.bytes)), None);
+        assert_eq!(SharpenHint::of(&header(&plain.bytes)), plain.sharpen_hint);
 
         let out = encode(&mesh, &opts.with_error_of(ErrorOf::Sharpened)).unwrap();
         let hint = out.sharpen_hint.unwrap();
