@@ -73,7 +73,9 @@ pub fn fuzz_input(data: &[u8]) -> Option<(Mesh, SharpenOptions, PlanarOptions, Q
 }
 
 /// Sharpens the mesh `data` describes ([`fuzz_input`]) as `whet sharpen` does (cut to a
-/// manifold first when it is not one), then runs the two projections after sharpening.
+/// manifold first when it is not one), then runs the two projections after sharpening; the
+/// EdgeSharpener methods run once more with a pseudo-random half of their snaps vetoed, as
+/// a stream's field 33 may ask.
 /// Panics only on a bug: a panic inside, an internal error, or an output that breaks the
 /// guarantees (indices in range, finite positions, an oriented manifold with the input's
 /// boundary, one parent per triangle, the input's vertices first). Returns the projected
@@ -96,6 +98,22 @@ pub fn fuzz_sharpen(data: &[u8]) -> Option<(Mesh, Vec<[u32; 2]>)> {
         }
         Err(e) => panic!("{:?} refused a make_manifold output: {e}", opts.method),
     };
+    if opts.method != Method::NormalFilter {
+        // A stream's snap vetoes (header field 33) may veto any subset of the snaps: a
+        // hostile one chooses. Vetoing a pseudo-random half (seeded by the input) must keep
+        // every guarantee.
+        let mut judge = ArbitraryVetoes(
+            data.iter()
+                .fold(data.len() as u64, |h, &b| h.rotate_left(5) ^ u64::from(b)),
+        );
+        match crate::sharpen_judged(&mesh, &opts, &mut judge) {
+            Ok(judged) => {
+                check_output(&mesh, &judged.mesh, true);
+                assert_eq!(judged.parents.len(), judged.mesh.triangles.len());
+            }
+            Err(e) => panic!("{:?} with vetoes refused what it took: {e}", opts.method),
+        }
+    }
     let mut sharp = out.mesh;
     check_output(&mesh, &sharp, opts.method != Method::NormalFilter);
     assert_eq!(
@@ -129,6 +147,24 @@ pub fn fuzz_sharpen(data: &[u8]) -> Option<(Mesh, Vec<[u32; 2]>)> {
     check_moves(&before, &sharp, quadric.max_move, "quadric projection");
     let edges = out.tags.edges.iter().map(|e| [e[0].0, e[1].0]).collect();
     Some((sharp, edges))
+}
+
+/// Vetoes each snap by one bit of a SplitMix64 sequence seeded by the input.
+struct ArbitraryVetoes(u64);
+
+impl crate::SnapJudge for ArbitraryVetoes {
+    fn vetoes(&mut self, snaps: &[crate::Snap]) -> Vec<bool> {
+        snaps
+            .iter()
+            .map(|_| {
+                self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+                let mut z = self.0;
+                z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+                z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+                (z ^ (z >> 31)) & 1 == 1
+            })
+            .collect()
+    }
 }
 
 /// The [`fuzz_sharpen`] input describing `mesh` (scaled into the byte grid) with option
