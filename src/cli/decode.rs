@@ -16,7 +16,9 @@ pub struct DecodeArgs {
     #[arg(long)]
     output_format: Option<whet::io::Format>,
     /// Run EdgeSharpener on the decoded mesh (restores the sharp edges and corners a uniform
-    /// retiling chamfered).
+    /// retiling chamfered). A swing stream's snap vetoes (the snaps its encoder measured
+    /// worse against the original) are replayed unless --method, --smooth-factor,
+    /// --curved-walls or --passes changes the sharpening they were judged for.
     #[arg(long)]
     sharpen: bool,
     /// Then refine with Bender this many levels (needs --sharpen for its tags).
@@ -29,7 +31,8 @@ pub struct DecodeArgs {
     /// EdgeSharpener's method: extended, papers, or none (decode as without --sharpen, then
     /// --bend with filter 3bis's tags). Without it, a swing stream encoded with
     /// `--optimize-for sharpened` names the method (and smooth factor) its encoder measured
-    /// best against the original, or none for a part sharpening makes worse; otherwise
+    /// best against the original, or none for a part sharpening makes worse (as any swing
+    /// stream does where most of the default sharpening's snaps were worse); otherwise
     /// extended.
     #[arg(long)]
     method: Option<String>,
