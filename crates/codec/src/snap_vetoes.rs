@@ -112,19 +112,26 @@ impl SnapVetoes {
         Ok(SnapVetoes { passes })
     }
 
+    /// The most snaps a stream of `vertices` and `triangles` may state vetoes for, over all
+    /// its judgements: four times one snap per vertex, per edge and per triangle (a first
+    /// pass snaps at most one of each; later passes and repeated judgements snap few). The
+    /// encoder leaves the field out beyond it, so a reader can hold a hostile field to it
+    /// (14 bytes of flags per triangle at most, against the sharpener's 200).
+    pub fn max_snaps(vertices: u64, triangles: u64) -> u64 {
+        vertices
+            .saturating_add(triangles.saturating_mul(3))
+            .saturating_mul(4)
+            .saturating_add(64)
+    }
+
     /// The vetoes a swing stream's header states: `None` without field 33 or for other
-    /// modes. Bounded by the header's counts: a judgement holds at most one snap per edge
-    /// and per triangle of its pass's input, plus its input's vertices; each pass's input is
-    /// at most four times the previous one's, and a pass asks at most twice.
+    /// modes; at most [`Self::max_snaps`] of the header's counts.
     pub fn of(header: &whet_format::Header) -> Option<Result<SnapVetoes, Error>> {
         if header.mode != whet_format::Mode::Swing {
             return None;
         }
         let bytes = header.get_bytes(whet_format::tag::SNAP_VETOES)?;
-        let per_pass = header
-            .vertex_count
-            .saturating_add(header.triangle_count.saturating_mul(3));
-        let max = per_pass.saturating_mul(2 * (1 + 4 + 16 + 64));
+        let max = Self::max_snaps(header.vertex_count, header.triangle_count);
         Some(SnapVetoes::from_field(bytes, max))
     }
 }
@@ -170,11 +177,13 @@ mod tests {
         let field = SnapVetoes::new(vec![vec![true; 50]]).to_field();
         let swing = whet_format::Header::new(whet_format::Mode::Swing, 3, 1)
             .with(whet_format::tag::SNAP_VETOES, field.clone());
-        // 3 vertices and 1 triangle: at most 6 snaps a pass, 1020 over four passes.
+        // 3 vertices and 1 triangle: at most 4 · 6 + 64 = 88 snaps.
+        assert_eq!(SnapVetoes::max_snaps(3, 1), 88);
         assert!(SnapVetoes::of(&swing).unwrap().is_ok());
-        let small = whet_format::Header::new(whet_format::Mode::Swing, 0, 0)
-            .with(whet_format::tag::SNAP_VETOES, field.clone());
-        assert!(SnapVetoes::of(&small).unwrap().is_err());
+        let big = SnapVetoes::new(vec![vec![true; 89]]).to_field();
+        let over = whet_format::Header::new(whet_format::Mode::Swing, 3, 1)
+            .with(whet_format::tag::SNAP_VETOES, big);
+        assert!(SnapVetoes::of(&over).unwrap().is_err());
         let exact = whet_format::Header::new(whet_format::Mode::Exact, 3, 1)
             .with(whet_format::tag::SNAP_VETOES, field);
         assert!(SnapVetoes::of(&exact).is_none());

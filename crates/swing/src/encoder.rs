@@ -508,6 +508,11 @@ impl SwingEncoder {
         if v.vetoed() == 0 {
             return Ok(out);
         }
+        if !vetoes_fit(&out, &v) {
+            // More snaps than a reader accepts (not seen on any mesh): no field.
+            out.snap_vetoes = None;
+            return Ok(out);
+        }
         let target = match self.opts.rate {
             Rate::BitsPerVertex(r) => Some(r * prep.mesh.positions.len() as f64 / 8.0),
             Rate::TargetBytes(n) => Some(n as f64),
@@ -691,7 +696,7 @@ impl SwingEncoder {
         if chosen_trial.hint != SharpenHint::Unsharpened {
             let ((rms, max), v) =
                 self.measure_sharpened(prep, &chosen, &input, &chosen_opts, &mut Vec::new(), true)?;
-            if v.vetoed() > 0 {
+            if v.vetoed() > 0 && vetoes_fit(&chosen, &v) {
                 let with = restate_vetoes(chosen.clone(), &v)?;
                 let judged_trial = SharpenTrial {
                     rms_pct: rms,
@@ -1571,6 +1576,12 @@ fn restate_quadric(mut out: SwingOutput, factor: f64) -> Result<SwingOutput, Err
     out.report.bytes = out.bytes.len();
     out.quadric_factor = Some(code as f64 / 100.0);
     Ok(out)
+}
+
+/// Whether `out`'s stream can state `vetoes` ([`SnapVetoes::max_snaps`] of its counts).
+fn vetoes_fit(out: &SwingOutput, vetoes: &SnapVetoes) -> bool {
+    vetoes.judged() as u64
+        <= SnapVetoes::max_snaps(out.report.vertices as u64, out.report.triangles as u64)
 }
 
 /// `out` with header field 33 stating `vetoes` for the sharpening its stream states.
