@@ -290,12 +290,7 @@ fn sharpened_from_stream(mesh: &Mesh, bytes: &[u8]) -> Result<(Mesh, Vec<[u32; 2
         .and_then(whet_codec::SharpenHint::passes_of)
         .unwrap_or(1);
     let mut replay = match &header {
-        Some(h) => match whet_codec::SnapVetoes::of(h) {
-            Some(v) => Some(whet_sharpen::VetoReplay::new(
-                v.map_err(|e| e.to_string())?.passes().to_vec(),
-            )),
-            None => None,
-        },
+        Some(h) => super::sharpen::stated_vetoes(h).map_err(|f| format!("{:#}", f.error))?,
         None => None,
     };
     let mut s = sharpened(

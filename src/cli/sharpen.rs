@@ -116,7 +116,7 @@ pub fn run_sharpen_replayed(
 pub fn stated_vetoes(header: &whet_format::Header) -> CliResult<Option<whet_sharpen::VetoReplay>> {
     match whet_codec::SnapVetoes::of(header) {
         None => Ok(None),
-        Some(Ok(v)) => Ok(Some(whet_sharpen::VetoReplay::new(v.passes().to_vec()))),
+        Some(Ok(v)) => Ok(Some(whet_sharpen::VetoReplay::new(v.into_passes()))),
         Some(Err(e)) => Err(Failure::input(e)),
     }
 }

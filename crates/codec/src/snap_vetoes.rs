@@ -36,6 +36,11 @@ impl SnapVetoes {
         &self.passes
     }
 
+    /// The flags, pass by pass, taken out (for `whet_sharpen::VetoReplay::new`).
+    pub fn into_passes(self) -> Vec<Vec<bool>> {
+        self.passes
+    }
+
     /// How many snaps were judged.
     pub fn judged(&self) -> usize {
         self.passes.iter().map(Vec::len).sum()

@@ -180,13 +180,11 @@ impl NearSnaps {
     fn new(original: &Mesh, longest_edge: f64, snaps: &[Snap]) -> Option<NearSnaps> {
         let trust = snaps
             .iter()
-            .flat_map(|s| std::iter::once(s.snapped).chain(s.origins.iter().copied()))
-            .zip(
-                snaps
-                    .iter()
-                    .flat_map(|s| std::iter::repeat_n(s.rest, 1 + s.origins.len())),
-            )
-            .map(|(p, r)| p.distance(r))
+            .flat_map(|s| {
+                std::iter::once(s.snapped)
+                    .chain(s.origins.iter().copied())
+                    .map(|p| p.distance(s.rest))
+            })
             .fold(0.0, f64::max);
         // Every query point is within `trust` of its snap's rest position (on a segment
         // from an origin to the snapped or the rest position): a triangle within `trust` of
