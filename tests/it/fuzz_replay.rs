@@ -44,11 +44,16 @@ fn exact_payload_regressions_and_seeds() {
 }
 
 /// Swing streams of built meshes (closed, filtered; open, with deletion flags; unfiltered)
-/// as `swing_payloads` inputs: the seeds of that target's corpus.
+/// as `swing_payloads` inputs: the seeds of that target's corpus (with the two-field
+/// surface filter, the one that target's input holds).
 fn swing_seed_streams() -> Vec<(String, Vec<u8>)> {
     use whet_swing::{encode, Rate, SwingOptions};
     use whet_testkit::meshes::{icosphere, punch, torus};
-    let at = |f: f64| SwingOptions::DEFAULT.with_rate(Rate::EdgeLength(f));
+    let at = |f: f64| {
+        SwingOptions::DEFAULT
+            .with_rate(Rate::EdgeLength(f))
+            .with_extended_filter(false)
+    };
     let cases = [
         ("icosphere_filtered", icosphere(3), at(0.08)),
         (

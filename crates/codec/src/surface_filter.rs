@@ -27,13 +27,21 @@ pub const SCALE: f64 = 1024.0;
 /// Largest coded factor magnitude (`±4.0`), checked by the decoder.
 pub const MAX_CODED: i64 = 4 * 1024;
 
-/// The two coded factors of the filter, in units of `1 / SCALE`; both zero: no filter.
+/// The coded factors of the filter, in units of `1 / SCALE`; all zero: no filter. The last
+/// three make the extended filter (format 1.4, header fields 34, 36 and 38); with them zero
+/// the filter is the two-field one of format 1.1, computed exactly as before.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SurfaceFilter {
     /// Factor of the vertex's own normal Laplacian `d(v)`.
     pub normal: i64,
     /// Factor of the one-ring mean `s(v)` of the normal Laplacian.
     pub smoothed: i64,
+    /// Factor of `s2(v)`, the one-ring mean of `s` (extended filter).
+    pub smoothed2: i64,
+    /// Factor of `q(v) = d(v) |d(v)| / L` (extended filter).
+    pub quadratic: i64,
+    /// Factor of the umbrella Laplacian `u(v)`, a vector (extended filter).
+    pub umbrella: i64,
 }
 
 impl SurfaceFilter {
@@ -41,27 +49,61 @@ impl SurfaceFilter {
     pub const NONE: SurfaceFilter = SurfaceFilter {
         normal: 0,
         smoothed: 0,
+        smoothed2: 0,
+        quadratic: 0,
+        umbrella: 0,
     };
 
     /// The coded form of real factors: rounded, and clamped to the range the decoder
     /// accepts (non-finite factors give no filter).
     pub fn from_factors(normal: f64, smoothed: f64) -> SurfaceFilter {
-        let code = |x: f64| {
-            if x.is_finite() {
-                ((x * SCALE).round() as i64).clamp(-MAX_CODED, MAX_CODED)
-            } else {
-                0
-            }
-        };
+        SurfaceFilter::from_extended_factors([normal, smoothed, 0.0, 0.0, 0.0])
+    }
+
+    /// The coded form of the five real factors of the extended filter, in the order of
+    /// [`Self::extended_factors`].
+    pub fn from_extended_factors(f: [f64; 5]) -> SurfaceFilter {
+        let [normal, smoothed, smoothed2, quadratic, umbrella] = f.map(code_factor);
         SurfaceFilter {
-            normal: code(normal),
-            smoothed: code(smoothed),
+            normal,
+            smoothed,
+            smoothed2,
+            quadratic,
+            umbrella,
         }
     }
 
     /// True when the filter moves nothing.
     pub fn is_none(&self) -> bool {
-        self.normal == 0 && self.smoothed == 0
+        self.normal == 0 && !self.is_extended() && self.smoothed == 0
+    }
+
+    /// True when a factor of the extended filter (format 1.4) is not zero.
+    pub fn is_extended(&self) -> bool {
+        self.smoothed2 != 0 || self.quadratic != 0 || self.umbrella != 0
+    }
+
+    /// Every coded factor lies within `±MAX_CODED` (what a decoder accepts).
+    pub fn in_range(&self) -> bool {
+        self.coded()
+            .iter()
+            .all(|c| (-MAX_CODED..=MAX_CODED).contains(c))
+    }
+
+    /// The five coded factors: `d`, `s`, `s2`, `q`, `u`.
+    pub fn coded(&self) -> [i64; 5] {
+        [
+            self.normal,
+            self.smoothed,
+            self.smoothed2,
+            self.quadratic,
+            self.umbrella,
+        ]
+    }
+
+    /// The five factors as reals, in the order `d`, `s`, `s2`, `q`, `u`.
+    pub fn extended_factors(&self) -> [f64; 5] {
+        self.coded().map(|c| c as f64 / SCALE)
     }
 
     /// The factors as reals.
@@ -69,13 +111,14 @@ impl SurfaceFilter {
         (self.normal as f64 / SCALE, self.smoothed as f64 / SCALE)
     }
 
-    /// Moves the vertices of `mesh` by the filter (nothing when it is [`Self::NONE`]).
-    pub fn apply(&self, mesh: &mut Mesh) {
+    /// Moves the vertices of `mesh`, a swing stream's decoded mesh at edge length
+    /// `edge_length`, by the filter (nothing when it is [`Self::NONE`]).
+    pub fn apply(&self, mesh: &mut Mesh, edge_length: f64) {
         if self.is_none() {
             return;
         }
         let normals = unit_normals(&mesh.positions, &mesh.triangles);
-        self.apply_with_normals(mesh, normals);
+        self.apply_with_normals(mesh, normals, edge_length);
     }
 
     /// [`Self::apply`] on a closed mesh (every fan closed) whose per-vertex sums of the
@@ -84,7 +127,7 @@ impl SurfaceFilter {
     /// walk sums the same products in the same triangle order, but its arithmetic is its own
     /// code: encoder and decoder pick the same entry point by rule (docs/swing.md section
     /// 2), so the two never need to agree to the bit.
-    pub(crate) fn apply_closed(&self, mesh: &mut Mesh, mut fan_sums: Vec<DVec3>) {
+    pub(crate) fn apply_closed(&self, mesh: &mut Mesh, mut fan_sums: Vec<DVec3>, edge_length: f64) {
         if self.is_none() {
             return;
         }
@@ -97,20 +140,51 @@ impl SurfaceFilter {
                 DVec3::ZERO
             };
         }
-        self.apply_with_normals(mesh, fan_sums);
+        self.apply_with_normals(mesh, fan_sums, edge_length);
     }
 
-    fn apply_with_normals(&self, mesh: &mut Mesh, normals: Vec<DVec3>) {
-        let (a, b) = self.factors();
-        let (d, s) = normal_fields(&mesh.positions, &mesh.triangles, &normals);
-        for (((p, n), d), s) in mesh.positions.iter_mut().zip(&normals).zip(&d).zip(&s) {
-            // Finite in, finite out: sums of huge coordinates may overflow, and such a
-            // vertex then stays where it is (on both sides alike).
-            let moved = *p + (a * d + b * s) * *n;
+    fn apply_with_normals(&self, mesh: &mut Mesh, normals: Vec<DVec3>, edge_length: f64) {
+        if !self.is_extended() {
+            // The two-field filter of format 1.1, to the bit as it always was.
+            let (a, b) = self.factors();
+            let (d, s) = normal_fields(&mesh.positions, &mesh.triangles, &normals);
+            for (((p, n), d), s) in mesh.positions.iter_mut().zip(&normals).zip(&d).zip(&s) {
+                // Finite in, finite out: sums of huge coordinates may overflow, and such a
+                // vertex then stays where it is (on both sides alike).
+                let moved = *p + (a * d + b * s) * *n;
+                if moved.is_finite() {
+                    *p = moved;
+                }
+            }
+            return;
+        }
+        let [a, b, c, e, f] = self.extended_factors();
+        let x = fields(&mesh.positions, &mesh.triangles, &normals, true);
+        let s2 = one_ring_mean(&mesh.triangles, &x.s, &x.k);
+        for (v, p) in mesh.positions.iter_mut().enumerate().take(s2.len()) {
+            let n = normals[v];
+            if n == DVec3::ZERO {
+                // Boundary vertices and vanishing normals stay put, as in the two-field
+                // filter.
+                continue;
+            }
+            let along =
+                a * x.d[v] + b * x.s[v] + c * s2[v] + e * quadratic_field(x.d[v], edge_length);
+            let moved = *p + along * n + f * umbrella_field(x.next_sum[v], x.k[v], *p, n);
             if moved.is_finite() {
                 *p = moved;
             }
         }
+    }
+}
+
+/// A real factor in units of `1 / SCALE`, rounded and clamped to what a decoder accepts
+/// (0 when not finite).
+fn code_factor(x: f64) -> i64 {
+    if x.is_finite() {
+        ((x * SCALE).round() as i64).clamp(-MAX_CODED, MAX_CODED)
+    } else {
+        0
     }
 }
 
@@ -175,6 +249,7 @@ impl SurfaceFilter {
         let f = SurfaceFilter {
             normal: get(whet_format::tag::SHARPENED_FILTER_NORMAL),
             smoothed: get(whet_format::tag::SHARPENED_FILTER_SMOOTHED),
+            ..SurfaceFilter::NONE
         };
         let coded = -MAX_CODED..=MAX_CODED;
         if header.mode != whet_format::Mode::Swing
@@ -227,6 +302,31 @@ impl FilterFields {
             normal: keep(&self.normal),
             smoothed: keep(&self.smoothed),
         }
+    }
+
+    /// The fields of `mesh` (as [`Self::new`] computes them) and the extended filter's
+    /// three, for a swing stream at edge length `edge_length`: `s2 n`, `q n` and `u` per
+    /// vertex; the encoder fits the five factors on them.
+    pub fn extended(mesh: &Mesh, edge_length: f64) -> (FilterFields, [Vec<DVec3>; 3]) {
+        let normals = unit_normals(&mesh.positions, &mesh.triangles);
+        let x = fields(&mesh.positions, &mesh.triangles, &normals, true);
+        let s2 = one_ring_mean(&mesh.triangles, &x.s, &x.k);
+        let along =
+            |f: &[f64]| -> Vec<DVec3> { normals.iter().zip(f).map(|(n, x)| *x * *n).collect() };
+        let q: Vec<f64> =
+            x.d.iter()
+                .map(|&d| quadratic_field(d, edge_length))
+                .collect();
+        let u: Vec<DVec3> = (0..s2.len())
+            .map(|v| umbrella_field(x.next_sum[v], x.k[v], mesh.positions[v], normals[v]))
+            .collect();
+        (
+            FilterFields {
+                normal: along(&x.d),
+                smoothed: along(&x.s),
+            },
+            [along(&s2), along(&q), u],
+        )
     }
 
     /// `(d n, s n)` per vertex.
@@ -282,9 +382,32 @@ fn unit_normals(pos: &[DVec3], triangles: &[[u32; 3]]) -> Vec<DVec3> {
 /// meets each neighbour twice. `s(v)` is the mean of `d` over `v` and its neighbours (each
 /// once, as the next corner of a triangle).
 fn normal_fields(pos: &[DVec3], triangles: &[[u32; 3]], normals: &[DVec3]) -> (Vec<f64>, Vec<f64>) {
+    let f = fields(pos, triangles, normals, false);
+    (f.d, f.s)
+}
+
+/// The per-vertex sums the filters read.
+struct Fields {
+    d: Vec<f64>,
+    s: Vec<f64>,
+    /// Triangles at each vertex.
+    k: Vec<u32>,
+    /// Per vertex, the sum of the next corners of its triangles (the extended filter's
+    /// umbrella Laplacian; empty unless asked for).
+    next_sum: Vec<DVec3>,
+}
+
+/// `d`, `s` and the triangle counts (see [`normal_fields`]), and with `umbrella` the sums of
+/// next corners too, summed in the same pass (which leaves `d` and `s` as they are without).
+fn fields(pos: &[DVec3], triangles: &[[u32; 3]], normals: &[DVec3], umbrella: bool) -> Fields {
     let n = pos.len().min(normals.len());
     let mut d = vec![0.0f64; n];
     let mut k = vec![0u32; n];
+    let mut next_sum = if umbrella {
+        vec![DVec3::ZERO; n]
+    } else {
+        Vec::new()
+    };
     for t in triangles {
         let Some([i, j, l]) = corners(t, n) else {
             continue;
@@ -293,6 +416,11 @@ fn normal_fields(pos: &[DVec3], triangles: &[[u32; 3]], normals: &[DVec3]) -> (V
         for v in [i, j, l] {
             d[v] += normals[v].dot(sum);
             k[v] += 1;
+        }
+        if umbrella {
+            next_sum[i] += pos[j];
+            next_sum[j] += pos[l];
+            next_sum[l] += pos[i];
         }
     }
     for v in 0..n {
@@ -304,22 +432,53 @@ fn normal_fields(pos: &[DVec3], triangles: &[[u32; 3]], normals: &[DVec3]) -> (V
             0.0
         };
     }
-    let mut s = d.clone();
+    let s = one_ring_mean(triangles, &d, &k);
+    Fields { d, s, k, next_sum }
+}
+
+/// `(f(v) + Σ f(next corner)) / (1 + k)` per vertex, 0 where not finite: `s` of `d`, and
+/// `s2` of `s`.
+fn one_ring_mean(triangles: &[[u32; 3]], f: &[f64], k: &[u32]) -> Vec<f64> {
+    let n = f.len().min(k.len());
+    let mut s = f[..n].to_vec();
     for t in triangles {
         let Some([i, j, l]) = corners(t, n) else {
             continue;
         };
-        s[i] += d[j];
-        s[j] += d[l];
-        s[l] += d[i];
+        s[i] += f[j];
+        s[j] += f[l];
+        s[l] += f[i];
     }
-    for (s, k) in s.iter_mut().zip(&k) {
+    for (s, k) in s.iter_mut().zip(k) {
         *s /= (1 + k) as f64;
         if !s.is_finite() {
             *s = 0.0;
         }
     }
-    (d, s)
+    s
+}
+
+/// `q(v) = d |d| / L`, 0 where not finite.
+#[inline]
+fn quadratic_field(d: f64, edge_length: f64) -> f64 {
+    let q = d * d.abs() / edge_length;
+    if q.is_finite() {
+        q
+    } else {
+        0.0
+    }
+}
+
+/// `u(v)`: the mean of the next corners minus `v`; zero where the normal is zero, without
+/// triangles, or not finite.
+#[inline]
+fn umbrella_field(next_sum: DVec3, k: u32, p: DVec3, normal: DVec3) -> DVec3 {
+    let u = next_sum / k as f64 - p;
+    if k > 0 && normal != DVec3::ZERO && u.is_finite() {
+        u
+    } else {
+        DVec3::ZERO
+    }
 }
 
 #[cfg(test)]
@@ -335,7 +494,7 @@ mod tests {
     fn convex_vertices_move_outwards() {
         let mut m = octahedron();
         let before = m.positions.clone();
-        SurfaceFilter::from_factors(0.25, 0.0).apply(&mut m);
+        SurfaceFilter::from_factors(0.25, 0.0).apply(&mut m, 1.0);
         for (p, q) in m.positions.iter().zip(&before) {
             // d = 1 at every vertex (the neighbours' mean is the origin): moved out by 1/4.
             assert!((p.length() - 1.25).abs() < 1e-12, "{p:?}");
@@ -370,7 +529,7 @@ mod tests {
         let mut out = sharp.clone();
         filter.apply_after_sharpening(&raw, &mut out);
         let mut expected = raw.clone();
-        filter.apply(&mut expected);
+        filter.apply(&mut expected, 1.0);
         for v in 0..out.positions.len() {
             if free[v] {
                 // The fields are the unfiltered mesh's: exactly what the filter does there.
@@ -394,8 +553,8 @@ mod tests {
         assert_eq!(
             SurfaceFilter::after_sharpening_of(&header),
             SurfaceFilter {
-                normal: 0,
-                smoothed: -7
+                smoothed: -7,
+                ..SurfaceFilter::NONE
             }
         );
     }
@@ -414,9 +573,9 @@ mod tests {
         let mut m = octahedron();
         m.triangles.pop();
         let before = m.positions.clone();
-        SurfaceFilter::NONE.apply(&mut m);
+        SurfaceFilter::NONE.apply(&mut m, 1.0);
         assert_eq!(m.positions, before);
-        SurfaceFilter::from_factors(0.3, 0.2).apply(&mut m);
+        SurfaceFilter::from_factors(0.3, 0.2).apply(&mut m, 1.0);
         for v in [0usize, 3, 5] {
             assert_eq!(m.positions[v], before[v], "boundary vertex {v} moved");
         }
@@ -429,7 +588,7 @@ mod tests {
         for p in &mut m.positions {
             *p *= 1e307;
         }
-        SurfaceFilter::from_factors(4.0, 4.0).apply(&mut m);
+        SurfaceFilter::from_factors(4.0, 4.0).apply(&mut m, 1.0);
         assert!(m.positions.iter().all(|p| p.is_finite()));
     }
 
@@ -442,5 +601,73 @@ mod tests {
             SurfaceFilter::from_factors(f64::NAN, 0.0),
             SurfaceFilter::NONE
         );
+    }
+
+    #[test]
+    fn an_extended_filter_with_its_three_factors_zero_is_the_two_field_filter() {
+        let mut two = octahedron();
+        let mut five = two.clone();
+        let f = SurfaceFilter::from_factors(0.3, -0.2);
+        f.apply(&mut two, 1.0);
+        // The extended path with zero extended factors is never taken (is_extended is
+        // false); its arithmetic must still agree with the two-field one to rounding.
+        let zero = SurfaceFilter::from_extended_factors([0.3, -0.2, 0.0, 0.0, 0.0]);
+        assert_eq!(zero, f);
+        assert!(!zero.is_extended());
+        zero.apply(&mut five, 1.0);
+        assert_eq!(two.positions, five.positions);
+    }
+
+    #[test]
+    fn the_extended_fields_move_as_defined() {
+        // The octahedron: every vertex has 4 triangles, d = 1 (the neighbours' mean is the
+        // origin), s = s2 = 1, q = d |d| / L = 1 / L, and the umbrella Laplacian is −v.
+        let m = octahedron();
+        for (field, factor, along) in [
+            (2usize, 0.25, 0.25),
+            (3, 0.25, 0.25 / 2.0),
+            (4, 0.25, -0.25),
+        ] {
+            let mut f = [0.0; 5];
+            f[field] = factor;
+            let filter = SurfaceFilter::from_extended_factors(f);
+            assert!(filter.is_extended());
+            let mut moved = m.clone();
+            filter.apply(&mut moved, 2.0);
+            for (p, q) in moved.positions.iter().zip(&m.positions) {
+                assert!(
+                    (*p - (*q + along * *q)).length() < 1e-12,
+                    "field {field}: {q:?} went to {p:?}"
+                );
+            }
+        }
+        // The encoder's fields are the ones applied.
+        let (two, [s2, q, u]) = FilterFields::extended(&m, 2.0);
+        let plain = FilterFields::new(&m);
+        assert_eq!(two.normal, plain.normal);
+        assert_eq!(two.smoothed, plain.smoothed);
+        for (v, p) in m.positions.iter().enumerate() {
+            assert!((s2[v] - *p).length() < 1e-12);
+            assert!((q[v] - 0.5 * *p).length() < 1e-12);
+            assert!((u[v] + *p).length() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn the_extended_filter_leaves_boundary_vertices_and_stays_finite() {
+        let mut m = octahedron();
+        m.triangles.pop();
+        let before = m.positions.clone();
+        SurfaceFilter::from_extended_factors([0.3, 0.2, -0.4, 0.5, 0.25]).apply(&mut m, 0.5);
+        for v in [0usize, 3, 5] {
+            assert_eq!(m.positions[v], before[v], "boundary vertex {v} moved");
+        }
+        assert_ne!(m.positions[4], before[4]);
+        let mut huge = octahedron();
+        for p in &mut huge.positions {
+            *p *= 1e307;
+        }
+        SurfaceFilter::from_extended_factors([4.0; 5]).apply(&mut huge, 1e-300);
+        assert!(huge.positions.iter().all(|p| p.is_finite()));
     }
 }

@@ -68,6 +68,8 @@ mod neighbours;
 const VERSION_1_2: Version = Version::new(1, 2);
 /// The format version of geometry kinds 9 and 10.
 const VERSION_1_3: Version = Version::new(1, 3);
+/// The format version of the extended surface filter (header fields 34, 36 and 38).
+const VERSION_1_4: Version = Version::new(1, 4);
 
 /// Fewest angle bits a stream may use.
 pub const MIN_ANGLE_BITS: u32 = 3;
@@ -1279,9 +1281,10 @@ fn encode_forward(
     if cutting {
         code_cut_flags(&mut range, &retiled.deleted);
         mesh = cut(mesh, &retiled.deleted);
-        info.filter.apply(&mut mesh);
+        info.filter.apply(&mut mesh, params.edge_length);
     } else {
-        info.filter.apply_closed(&mut mesh, walked.fan);
+        info.filter
+            .apply_closed(&mut mesh, walked.fan, params.edge_length);
     }
     let mut geometry = vec![coding.kind(cutting)];
     geometry.extend_from_slice(&range.finish());
@@ -1375,11 +1378,11 @@ fn encode_retiled_as(
                 // The walk met the triangles in creation order (the labels matched).
                 code_cut_flags(&mut range, &retiled.deleted);
                 mesh = cut(mesh, &retiled.deleted);
-                info.filter.apply(&mut mesh);
+                info.filter.apply(&mut mesh, params.edge_length);
             } else if let (Ok(fan), true) = (walked, coding != IndexCoding::Order0) {
-                info.filter.apply_closed(&mut mesh, fan);
+                info.filter.apply_closed(&mut mesh, fan, params.edge_length);
             } else {
-                info.filter.apply(&mut mesh);
+                info.filter.apply(&mut mesh, params.edge_length);
             }
             geometry.push(coding.kind(cutting));
             geometry.extend_from_slice(&range.finish());
@@ -1407,7 +1410,7 @@ fn encode_retiled_as(
         geometry.extend_from_slice(&bytes);
         let tris = traversal_triangles(&enc.connectivity)?;
         let mut mesh = output_mesh(&enc.connectivity, &positions, &tris);
-        info.filter.apply(&mut mesh);
+        info.filter.apply(&mut mesh, params.edge_length);
         decoded = Some(mesh);
     }
     let decoded = decoded.unwrap_or_default();
@@ -1480,6 +1483,17 @@ fn write_stream(
         header = header
             .with(tag::FILTER_NORMAL, info.filter.normal)
             .with(tag::FILTER_SMOOTHED, info.filter.smoothed);
+        if info.filter.is_extended() {
+            // The extended filter's fields are format 1.4, and required (even): a stream
+            // with them decodes to another mesh, so an older reader must refuse it.
+            if header.version < VERSION_1_4 {
+                header = header.with_version(VERSION_1_4);
+            }
+            header = header
+                .with(tag::FILTER_SMOOTHED2, info.filter.smoothed2)
+                .with(tag::FILTER_QUADRATIC, info.filter.quadratic)
+                .with(tag::FILTER_UMBRELLA, info.filter.umbrella);
+        }
     }
     if !info.sharpened_filter.is_none() {
         // Optional (odd) tags: a reader that does not know them skips them.
@@ -1666,13 +1680,14 @@ pub(crate) fn decode_swing(
     let filter = SurfaceFilter {
         normal: h.get_i64(tag::FILTER_NORMAL).unwrap_or(0),
         smoothed: h.get_i64(tag::FILTER_SMOOTHED).unwrap_or(0),
+        smoothed2: h.get_i64(tag::FILTER_SMOOTHED2).unwrap_or(0),
+        quadratic: h.get_i64(tag::FILTER_QUADRATIC).unwrap_or(0),
+        umbrella: h.get_i64(tag::FILTER_UMBRELLA).unwrap_or(0),
     };
-    let coded = -surface_filter::MAX_CODED..=surface_filter::MAX_CODED;
-    if !coded.contains(&filter.normal) || !coded.contains(&filter.smoothed) {
+    if !filter.in_range() {
         return Err(Error::Corrupt(format!(
-            "surface filter factors {} and {} out of range (at most {} in magnitude)",
-            filter.normal,
-            filter.smoothed,
+            "surface filter factors {:?} out of range (at most {} in magnitude)",
+            filter.coded(),
             surface_filter::MAX_CODED
         )));
     }
@@ -1753,9 +1768,9 @@ pub(crate) fn decode_swing(
                 // As the encoder does: the walk's fan sums on a closed (uncut) predicted
                 // mesh, else the filter's own normals.
                 if !cutting && coding != IndexCoding::Order0 {
-                    filter.apply_closed(&mut mesh, fan);
+                    filter.apply_closed(&mut mesh, fan, params.edge_length);
                 } else {
-                    filter.apply(&mut mesh);
+                    filter.apply(&mut mesh, params.edge_length);
                 }
             }
             Ok(mesh)
@@ -1786,7 +1801,7 @@ pub(crate) fn decode_swing(
             let tris = traversal_triangles(&conn)?;
             let mut mesh = output_mesh(&conn, &positions, &tris);
             if opts.surface_filter {
-                filter.apply(&mut mesh);
+                filter.apply(&mut mesh, params.edge_length);
             }
             Ok(mesh)
         }
@@ -1888,9 +1903,9 @@ fn decode_forward(
     let mut mesh = cut(Mesh::new(walked.positions, walked.triangles), &flags);
     if opts.surface_filter {
         if cutting {
-            filter.apply(&mut mesh);
+            filter.apply(&mut mesh, params.edge_length);
         } else {
-            filter.apply_closed(&mut mesh, walked.fan);
+            filter.apply_closed(&mut mesh, walked.fan, params.edge_length);
         }
     }
     Ok(mesh)
@@ -2017,7 +2032,7 @@ mod tests {
             assert_ne!(p, r);
         }
         let mut expected = Mesh::new(retiled.positions.clone(), retiled.triangles.clone());
-        filter.apply(&mut expected);
+        filter.apply(&mut expected, params.edge_length);
         assert_eq!(enc.decoded, expected);
         let back = crate::decode(&enc.bytes, &crate::DecodeOptions::DEFAULT).unwrap();
         let bits = |m: &Mesh| -> Vec<[u64; 3]> {
@@ -2086,6 +2101,64 @@ mod tests {
             .header
             .clone()
             .with(tag::FILTER_NORMAL, surface_filter::MAX_CODED + 1);
+        let bad = container.to_bytes().unwrap();
+        let err = crate::decode(&bad, &crate::DecodeOptions::DEFAULT).unwrap_err();
+        assert!(err.to_string().contains("surface filter"), "{err}");
+    }
+
+    #[test]
+    fn the_extended_surface_filter_is_format_1_4_required_and_checked() {
+        let (retiled, params) = tetrahedron(-20);
+        let filter = SurfaceFilter::from_extended_factors([0.25, -0.125, 0.5, -0.75, 0.125]);
+        let with_filter = SwingStreamInfo { filter, ..info() };
+        let enc = encode_retiled(&retiled, &params, &with_filter).unwrap();
+        let mut expected = Mesh::new(retiled.positions.clone(), retiled.triangles.clone());
+        filter.apply(&mut expected, params.edge_length);
+        assert_eq!(enc.decoded, expected);
+        let back = crate::decode(&enc.bytes, &crate::DecodeOptions::DEFAULT).unwrap();
+        let bits = |m: &Mesh| -> Vec<[u64; 3]> {
+            m.positions
+                .iter()
+                .map(|p| p.to_array().map(f64::to_bits))
+                .collect()
+        };
+        assert_eq!(bits(&back), bits(&enc.decoded));
+        // Unlike the two-field filter's result.
+        let two = encode_retiled(
+            &retiled,
+            &params,
+            &SwingStreamInfo {
+                filter: SurfaceFilter::from_factors(0.25, -0.125),
+                ..info()
+            },
+        )
+        .unwrap();
+        assert_ne!(bits(&two.decoded), bits(&enc.decoded));
+        // Version 1.4, the three fields even (required: a reader before 1.4 refuses the
+        // stream rather than decode another mesh), read back as written.
+        let c = whet_format::parse(&enc.bytes, &crate::Limits::DEFAULT).unwrap();
+        assert_eq!(c.header.version, VERSION_1_4);
+        for (t, v) in [
+            (tag::FILTER_SMOOTHED2, filter.smoothed2),
+            (tag::FILTER_QUADRATIC, filter.quadratic),
+            (tag::FILTER_UMBRELLA, filter.umbrella),
+        ] {
+            assert_eq!(t % 2, 0);
+            assert_eq!(c.header.get_i64(t), Some(v));
+        }
+        assert_eq!(
+            whet_format::parse(&two.bytes, &crate::Limits::DEFAULT)
+                .unwrap()
+                .header
+                .get_i64(tag::FILTER_UMBRELLA),
+            None
+        );
+        // A factor beyond the range is refused by name.
+        let mut container = c;
+        container.header = container
+            .header
+            .clone()
+            .with(tag::FILTER_UMBRELLA, -surface_filter::MAX_CODED - 1);
         let bad = container.to_bytes().unwrap();
         let err = crate::decode(&bad, &crate::DecodeOptions::DEFAULT).unwrap_err();
         assert!(err.to_string().contains("surface filter"), "{err}");

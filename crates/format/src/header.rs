@@ -187,9 +187,20 @@ pub mod tag {
     /// measured farther from the original than their rest positions, and vetoed, for the
     /// sharpening the stream states (swing; absent: none). Layout in docs/format.md section 3.
     pub const SNAP_VETOES: u64 = 33;
+    /// i64 (format 1.4): factor of `s2`, the one-ring mean of the filter's smoothed field,
+    /// in the swing decoder's extended surface filter, in units of 1/1024 (swing; absent:
+    /// 0). Required: a stream with it decodes to another mesh.
+    pub const FILTER_SMOOTHED2: u64 = 34;
+    /// i64 (format 1.4): factor of `q = d |d| / L` in the extended surface filter, in units
+    /// of 1/1024 (swing; absent: 0).
+    pub const FILTER_QUADRATIC: u64 = 36;
+    /// i64 (format 1.4): factor of the umbrella Laplacian (a vector: it also moves vertices
+    /// along the surface) in the extended surface filter, in units of 1/1024 (swing;
+    /// absent: 0).
+    pub const FILTER_UMBRELLA: u64 = 38;
 
     /// Every tag this crate knows, with its name and value type.
-    pub const KNOWN: [(u64, &str, ValueType); 19] = [
+    pub const KNOWN: [(u64, &str, ValueType); 22] = [
         (ENCODER, "encoder", ValueType::Bytes),
         (COMPONENT_COUNT, "component_count", ValueType::U64),
         (QUANT_BITS, "quant_bits", ValueType::U64),
@@ -221,6 +232,9 @@ pub mod tag {
         (QUADRIC_PROJECTION, "quadric_projection", ValueType::U64),
         (BBOX_F32, "bbox_f32", ValueType::Bytes),
         (SNAP_VETOES, "snap_vetoes", ValueType::Bytes),
+        (FILTER_SMOOTHED2, "filter_smoothed2", ValueType::I64),
+        (FILTER_QUADRATIC, "filter_quadratic", ValueType::I64),
+        (FILTER_UMBRELLA, "filter_umbrella", ValueType::I64),
     ];
 
     /// Name and type of a known tag.

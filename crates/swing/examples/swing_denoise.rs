@@ -140,7 +140,7 @@ fn main() {
                 bvh.closest_point_within(p, 2.0 * l).map(|c| c.point)
             });
             let raw = metro(&mesh, &m, &mo).unwrap().symmetric.rms_pct;
-            filter.apply(&mut m);
+            filter.apply(&mut m, l);
             let filtered = metro(&mesh, &m, &mo).unwrap().symmetric.rms_pct;
             println!(
                 "{name} L={f} B={bits}: gamma {gamma} passes {passes} clamp {clamp}: denoised {raw:.4} %, filtered {filtered:.4} % (factors {:?})",

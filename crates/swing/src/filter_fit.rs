@@ -49,12 +49,196 @@ pub fn fit_displacements(
     mesh: &Mesh,
     first: &[DVec3],
     second: &[DVec3],
-    mut closest: impl FnMut(DVec3) -> Option<DVec3>,
+    closest: impl FnMut(DVec3) -> Option<DVec3>,
 ) -> SurfaceFilter {
-    let decoded = mesh;
+    let mut normal = TwoFieldEquations::default();
+    sample_fields(mesh, [first, second], closest, |area, r, [x0, x1]| {
+        normal.add(area, r, x0, x1);
+    });
+    normal.solve()
+}
+
+/// What [`fit_filters`] found on one set of samples.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FilterFit {
+    /// The two-field filter, exactly as [`fit_displacements`] fits it.
+    pub basic: SurfaceFilter,
+    /// The extended filter (five fields, format 1.4) and the ratio of its fitted RMS to the
+    /// basic filter's, both with their coded factors (under 1 when it fits better); `None`
+    /// when its equations are degenerate.
+    pub extended: Option<(SurfaceFilter, f64)>,
+}
+
+/// Fits the two-field filter and the extended one (docs/swing.md section 2, "Extended
+/// surface filter") to the original on one set of samples: `fields` are the filter's fields
+/// of `decoded` and `extra` the extended filter's three ([`FilterFields::extended`]).
+pub fn fit_filters(
+    decoded: &Mesh,
+    fields: &FilterFields,
+    extra: &[Vec<DVec3>; 3],
+    closest: impl FnMut(DVec3) -> Option<DVec3>,
+) -> FilterFit {
+    let mut basic = TwoFieldEquations::default();
+    let mut m = [[0.0f64; 5]; 5];
+    let mut v = [0.0f64; 5];
+    let mut rr = 0.0f64;
+    let all: [&[DVec3]; 5] = [
+        &fields.normal,
+        &fields.smoothed,
+        &extra[0],
+        &extra[1],
+        &extra[2],
+    ];
+    sample_fields(decoded, all, closest, |area, r, x| {
+        // The two-field sums exactly as fit_displacements makes them (same samples, same
+        // order), so the basic filter does not change with the extended fit beside it.
+        basic.add(area, r, x[0], x[1]);
+        if !(r.is_finite() && x.iter().all(|x| x.is_finite())) {
+            return;
+        }
+        rr += area * r * r;
+        for a in 0..5 {
+            v[a] += area * r * x[a];
+            for b in 0..5 {
+                m[a][b] += area * x[a] * x[b];
+            }
+        }
+    });
+    let basic = basic.solve();
+    let extended = solve_spd(m, v).and_then(|c| {
+        let filter = SurfaceFilter::from_extended_factors(c);
+        if !filter.is_extended() {
+            return None;
+        }
+        // The fitted sums of squares of both coded filters: rr − 2 cᵀv + cᵀ M c.
+        let sse = |c: [f64; 5]| {
+            let mut e = rr;
+            for a in 0..5 {
+                e -= 2.0 * c[a] * v[a];
+                for b in 0..5 {
+                    e += c[a] * m[a][b] * c[b];
+                }
+            }
+            e.max(0.0)
+        };
+        let (ext, two) = (
+            sse(filter.extended_factors()),
+            sse(basic.extended_factors()),
+        );
+        let ratio = (ext / two).sqrt();
+        (ratio.is_finite()).then_some((filter, ratio))
+    });
+    FilterFit { basic, extended }
+}
+
+/// The normal equations of a two-field fit.
+#[derive(Default)]
+struct TwoFieldEquations {
+    m00: f64,
+    m01: f64,
+    m11: f64,
+    v0: f64,
+    v1: f64,
+}
+
+impl TwoFieldEquations {
+    fn add(&mut self, area: f64, r: f64, x0: f64, x1: f64) {
+        if !(r.is_finite() && x0.is_finite() && x1.is_finite()) {
+            return;
+        }
+        self.m00 += area * x0 * x0;
+        self.m01 += area * x0 * x1;
+        self.m11 += area * x1 * x1;
+        self.v0 += area * r * x0;
+        self.v1 += area * r * x1;
+    }
+
+    fn solve(&self) -> SurfaceFilter {
+        let TwoFieldEquations {
+            m00,
+            m01,
+            m11,
+            v0,
+            v1,
+        } = *self;
+        let det = m00 * m11 - m01 * m01;
+        // Nearly collinear fields (a uniform curvature): one factor carries the fit.
+        if det > 1e-9 * m00 * m11 && det.is_finite() {
+            let a = (v0 * m11 - v1 * m01) / det;
+            let b = (m00 * v1 - m01 * v0) / det;
+            SurfaceFilter::from_factors(a, b)
+        } else if m00 > 0.0 {
+            SurfaceFilter::from_factors(v0 / m00, 0.0)
+        } else {
+            SurfaceFilter::NONE
+        }
+    }
+}
+
+/// Solves `m c = v` for a symmetric positive semi-definite `m` (normal equations) by a
+/// Cholesky factorisation with a small ridge (a millionth of the mean diagonal), so that
+/// nearly collinear fields (on a sphere `s` and `s2` are nearly `d`) get bounded factors
+/// instead of a blow-up; `None` when the matrix is empty or not finite.
+fn solve_spd(mut m: [[f64; 5]; 5], v: [f64; 5]) -> Option<[f64; 5]> {
+    let trace: f64 = (0..5).map(|i| m[i][i]).sum();
+    if !(trace > 0.0 && trace.is_finite()) || v.iter().any(|x| !x.is_finite()) {
+        return None;
+    }
+    let ridge = 1e-6 * trace / 5.0;
+    for (i, row) in m.iter_mut().enumerate() {
+        row[i] += ridge;
+    }
+    // m = l lᵀ.
+    let mut l = [[0.0f64; 5]; 5];
+    for i in 0..5 {
+        for j in 0..=i {
+            let mut sum = m[i][j];
+            for k in 0..j {
+                sum -= l[i][k] * l[j][k];
+            }
+            if i == j {
+                if sum.is_nan() || sum <= 0.0 {
+                    return None;
+                }
+                l[i][i] = sum.sqrt();
+            } else {
+                l[i][j] = sum / l[j][j];
+            }
+        }
+    }
+    let mut y = [0.0f64; 5];
+    for i in 0..5 {
+        let mut sum = v[i];
+        for k in 0..i {
+            sum -= l[i][k] * y[k];
+        }
+        y[i] = sum / l[i][i];
+    }
+    let mut c = [0.0f64; 5];
+    for i in (0..5).rev() {
+        let mut sum = y[i];
+        for k in i + 1..5 {
+            sum -= l[k][i] * c[k];
+        }
+        c[i] = sum / l[i][i];
+    }
+    c.iter().all(|x| x.is_finite()).then_some(c)
+}
+
+/// Calls `f(area, r, x)` for the filter fit's samples of `mesh` (see the module docs): at
+/// most [`MAX_SAMPLES`] fixed barycentric points, each with its triangle's area, its signed
+/// distance `r` to the original along the triangle's normal and the mixes `x` of the
+/// `fields` there along that normal. Samples without a closest point, or on a triangle
+/// without a normal, are left out; `f` checks the rest for finiteness.
+fn sample_fields<const N: usize>(
+    decoded: &Mesh,
+    fields: [&[DVec3]; N],
+    mut closest: impl FnMut(DVec3) -> Option<DVec3>,
+    mut f: impl FnMut(f64, f64, [f64; N]),
+) {
     let pos = &decoded.positions;
-    if first.len() < pos.len() || second.len() < pos.len() {
-        return SurfaceFilter::NONE;
+    if fields.iter().any(|x| x.len() < pos.len()) {
+        return;
     }
     let total = decoded.triangles.len() * PATTERN.len();
     // An odd stride cycles through the four pattern points (an even one would keep to one
@@ -63,8 +247,6 @@ pub fn fit_displacements(
         0 | 1 => 1,
         s => s | 1,
     };
-    // Normal equations: m = Σ w x xᵀ, v = Σ w r x.
-    let (mut m00, mut m01, mut m11, mut v0, mut v1) = (0.0, 0.0, 0.0, 0.0, 0.0);
     let mut sample = 0usize;
     while sample < total {
         let t = sample / PATTERN.len();
@@ -81,31 +263,55 @@ pub fn fit_displacements(
         }
         let nf = cross / len;
         let area = 0.5 * len;
-        let mix = |f: &[DVec3]| (w[0] * f[i] + w[1] * f[j] + w[2] * f[k]).dot(nf);
         let p = w[0] * pos[i] + w[1] * pos[j] + w[2] * pos[k];
         let Some(c) = closest(p) else {
             continue;
         };
         let r = (c - p).dot(nf);
-        let (x0, x1) = (mix(first), mix(second));
-        if !(r.is_finite() && x0.is_finite() && x1.is_finite()) {
-            continue;
-        }
-        m00 += area * x0 * x0;
-        m01 += area * x0 * x1;
-        m11 += area * x1 * x1;
-        v0 += area * r * x0;
-        v1 += area * r * x1;
+        let x = fields.map(|f| (w[0] * f[i] + w[1] * f[j] + w[2] * f[k]).dot(nf));
+        f(area, r, x);
     }
-    let det = m00 * m11 - m01 * m01;
-    // Nearly collinear fields (a uniform curvature): one factor carries the fit.
-    if det > 1e-9 * m00 * m11 && det.is_finite() {
-        let a = (v0 * m11 - v1 * m01) / det;
-        let b = (m00 * v1 - m01 * v0) / det;
-        SurfaceFilter::from_factors(a, b)
-    } else if m00 > 0.0 {
-        SurfaceFilter::from_factors(v0 / m00, 0.0)
-    } else {
-        SurfaceFilter::NONE
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A unit icosphere with its vertices pushed off the sphere by a ripple, so the fit has
+    /// a bias and noise to remove; the original is the unit sphere.
+    fn rippled_sphere() -> Mesh {
+        let mut m = whet_testkit::meshes::icosphere(3);
+        for (i, p) in m.positions.iter_mut().enumerate() {
+            *p *= 1.0 + 0.004 * ((i * 7919 % 13) as f64 / 13.0 - 0.5);
+        }
+        m
+    }
+
+    #[test]
+    fn the_basic_filter_of_fit_filters_is_fit_displacements_to_the_bit() {
+        let m = rippled_sphere();
+        let closest = |p: DVec3| Some(p.normalize());
+        let (fields, extra) = FilterFields::extended(&m, 0.1);
+        let fit = fit_filters(&m, &fields, &extra, closest);
+        assert_eq!(
+            fit.basic,
+            fit_displacements(&m, &fields.normal, &fields.smoothed, closest)
+        );
+        assert!(!fit.basic.is_none());
+        let (_, ratio) = fit.extended.expect("a fit of five fields");
+        // Five fields fit the samples at least as well as two of them, up to the factors'
+        // rounding to 1/1024.
+        assert!(ratio <= 1.0 + 1e-3, "{ratio}");
+    }
+
+    #[test]
+    fn collinear_or_empty_equations_do_not_blow_up() {
+        // Identical rows: the ridge keeps the factors bounded.
+        let row = [1.0, 1.0, 1.0, 1.0, 1.0];
+        let c = solve_spd([row; 5], [2.0; 5]).unwrap();
+        assert!(c.iter().all(|x| x.is_finite() && x.abs() < 10.0), "{c:?}");
+        assert!((c.iter().sum::<f64>() - 2.0).abs() < 1e-3, "{c:?}");
+        assert_eq!(solve_spd([[0.0; 5]; 5], [0.0; 5]), None);
+        assert_eq!(solve_spd([[f64::NAN; 5]; 5], [1.0; 5]), None);
     }
 }

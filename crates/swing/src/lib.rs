@@ -32,7 +32,7 @@ pub use encoder::{
     SwingOutput, CURVED_WALL_FACTOR, MAX_COVERAGE_GAP, MAX_ERROR_WEIGHT, PLANAR_FACTOR,
     QUADRIC_FACTOR, TWO_PASSES,
 };
-pub use filter_fit::{fit_displacements, fit_surface_filter};
+pub use filter_fit::{fit_displacements, fit_filters, fit_surface_filter, FilterFit};
 pub use fuzz::fuzz_encode;
 pub use retiler::{retile, RetileStats, RetileTuning, Retiled};
 

@@ -192,6 +192,10 @@ pub struct Retiled {
     pub pillowed_vertices: Vec<bool>,
     /// The surface filter fitted to the original ([`SurfaceFilter::NONE`] unless asked for).
     pub filter: SurfaceFilter,
+    /// The extended surface filter fitted on the same samples, with the ratio of its fitted
+    /// RMS to that of [`Self::filter`] (`None` unless asked for, or when degenerate): the
+    /// encoder writes it when the gain is worth its header bytes.
+    pub extended_filter: Option<(SurfaceFilter, f64)>,
     /// The filters for after EdgeSharpener (`SurfaceFilter::apply_after_sharpening`), one
     /// per sharpening asked for, each fitted on the retiling sharpened that way, as `whet
     /// decode --sharpen` does ([`SurfaceFilter::NONE`] unless asked for; empty when none
@@ -481,7 +485,7 @@ pub(crate) fn retile_fitted(
         None => Vec::new(),
     };
     r.stats.deleted_triangles = deleted.iter().filter(|&&d| d).count();
-    let (filter, sharpened_filters) = if fit {
+    let (filter, extended_filter, sharpened_filters) = if fit {
         // The decoder's output: the kept triangles (unused vertices do not matter to the
         // filter). Closest points on the original only, not on the filler over its holes.
         let kept = whet_mesh::Mesh::new(
@@ -497,9 +501,11 @@ pub(crate) fn retile_fitted(
         let surf = &*r.surf;
         let closest =
             |p| surf.closest_point(p, 2.0 * l, |t| !filler.get(t).copied().unwrap_or(false));
-        // One set of fields serves both fits (fit_surface_filter computes the same).
-        let fields = whet_codec::FilterFields::new(&kept);
-        let filter = crate::fit_displacements(&kept, &fields.normal, &fields.smoothed, closest);
+        // One set of fields serves every fit (fit_surface_filter computes the same), and
+        // one set of samples both decoded filters.
+        let (fields, extra) = whet_codec::FilterFields::extended(&kept, l);
+        let fit = crate::fit_filters(&kept, &fields, &extra, closest);
+        let filter = fit.basic;
         // Candidates that sharpen to the same mesh (the papers' method with curved walls
         // that turn no edge smooth, a second pass that changes nothing) share one fit.
         // (Keyed by a hash, not by the meshes: 25 candidates' meshes need not stay in memory.)
@@ -520,10 +526,11 @@ pub(crate) fn retile_fitted(
                 f
             })
             .collect();
-        (filter, after)
+        (filter, fit.extended, after)
     } else {
         (
             SurfaceFilter::NONE,
+            None,
             vec![SurfaceFilter::NONE; sharpen.len()],
         )
     };
@@ -553,6 +560,7 @@ pub(crate) fn retile_fitted(
         stats: r.stats,
         pillowed_vertices,
         filter,
+        extended_filter,
         sharpened_filters,
     })
 }
