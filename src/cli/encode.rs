@@ -397,7 +397,7 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh, skipped: &whet::io::ReadRepor
                 "smoothed": out.surface_filter.extended_factors()[1],
                 "smoothed2": out.surface_filter.extended_factors()[2],
                 "quadratic": out.surface_filter.extended_factors()[3],
-                "umbrella": out.surface_filter.extended_factors()[4],
+                "tangential": out.surface_filter.extended_factors()[4],
             },
             "sharpened_filter": {
                 "normal": out.sharpened_filter.factors().0,

@@ -87,6 +87,56 @@ fn swing_payload_seeds_decode_like_their_streams() {
     }
 }
 
+/// The seeds of `swing_payloads_extended`: the same streams with the extended surface
+/// filter's three factors set in their headers (the small seed meshes do not fit one worth
+/// its bytes), which the seed conversion keeps. `WHET_WRITE_FUZZ_SEEDS=1` (re)writes them.
+#[test]
+fn swing_payload_extended_seeds_decode_like_their_streams() {
+    use whet_format::tag;
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fuzz/corpus/swing_payloads_extended");
+    for (name, stream) in swing_seed_streams() {
+        let mut c = whet_format::parse(&stream, &whet_format::Limits::DEFAULT).unwrap();
+        if c.header.get_i64(tag::FILTER_NORMAL).is_none() {
+            // The extended fields go with the two-field filter's.
+            continue;
+        }
+        c.header = c
+            .header
+            .clone()
+            .with_version(whet_codec::Version::new(1, 4))
+            .with(tag::FILTER_SMOOTHED2, -300i64)
+            .with(tag::FILTER_QUADRATIC, 200i64)
+            .with(tag::FILTER_TANGENTIAL, 150i64);
+        let stream = c.to_bytes().unwrap();
+        let seed = whet_codec::swing_payload_seed_extended(&stream).unwrap();
+        assert!(whet_codec::swing_payload_seed(&stream).is_none());
+        let direct = whet_codec::decode(&stream, &whet_codec::DecodeOptions::DEFAULT).unwrap();
+        let plain = whet_codec::fuzz_swing_payloads(
+            &whet_codec::swing_payload_seed_extended(&stream).unwrap()[6..],
+        )
+        .unwrap();
+        assert_ne!(plain, direct, "{name}: the extended fields move vertices");
+        let via_seed = whet_codec::fuzz_swing_payloads_extended(&seed).unwrap();
+        assert_eq!(via_seed, direct, "{name}");
+        if std::env::var_os("WHET_WRITE_FUZZ_SEEDS").is_some() {
+            std::fs::create_dir_all(&dir).unwrap();
+            std::fs::write(dir.join(format!("seed-{name}")), &seed).unwrap();
+        }
+    }
+}
+
+#[test]
+fn swing_payload_extended_regressions_and_seeds() {
+    let f = files("swing_payloads_extended");
+    assert!(
+        !f.is_empty(),
+        "fuzz/corpus/swing_payloads_extended has the seed inputs"
+    );
+    for p in f {
+        whet_codec::fuzz_swing_payloads_extended(&std::fs::read(&p).unwrap());
+    }
+}
+
 #[test]
 fn swing_payload_regressions_and_seeds() {
     let f = files("swing_payloads");

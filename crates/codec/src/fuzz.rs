@@ -76,6 +76,19 @@ const SWING_PREFIX: usize = 67;
 /// filter. [`swing_payload_seed`] turns a real stream into such an input. Returns the
 /// decoded mesh, if any (checked: indices in range, positions finite).
 pub fn fuzz_swing_payloads(data: &[u8]) -> Option<whet_mesh::Mesh> {
+    swing_payloads_with(data, [0; 3])
+}
+
+/// [`fuzz_swing_payloads`] with the extended surface filter: the input starts with its
+/// three factors (header fields 34, 36 and 38) as little-endian i16, then holds a
+/// [`fuzz_swing_payloads`] input. [`swing_payload_seed_extended`] makes one from a stream.
+pub fn fuzz_swing_payloads_extended(data: &[u8]) -> Option<whet_mesh::Mesh> {
+    let (factors, rest) = data.split_first_chunk::<6>()?;
+    let i16_at = |i: usize| i64::from(i16::from_le_bytes([factors[i], factors[i + 1]]));
+    swing_payloads_with(rest, [i16_at(0), i16_at(2), i16_at(4)])
+}
+
+fn swing_payloads_with(data: &[u8], extended: [i64; 3]) -> Option<whet_mesh::Mesh> {
     if data.len() < SWING_PREFIX {
         return None;
     }
@@ -96,6 +109,12 @@ pub fn fuzz_swing_payloads(data: &[u8]) -> Option<whet_mesh::Mesh> {
         .with(tag::ANGLE_BITS, data[0] as u64)
         .with(tag::FILTER_NORMAL, i16_at(59))
         .with(tag::FILTER_SMOOTHED, i16_at(61));
+    if extended != [0; 3] {
+        header = header
+            .with(tag::FILTER_SMOOTHED2, extended[0])
+            .with(tag::FILTER_QUADRATIC, extended[1])
+            .with(tag::FILTER_TANGENTIAL, extended[2]);
+    }
     header.set_bbox([bbox[0], bbox[1], bbox[2]], [bbox[3], bbox[4], bbox[5]]);
     let container = Container::new(header)
         .with_section(SectionKind::CONNECTIVITY, conn.to_vec())
@@ -110,21 +129,42 @@ pub fn fuzz_swing_payloads(data: &[u8]) -> Option<whet_mesh::Mesh> {
     Some(mesh)
 }
 
+/// The three extended surface filter fields.
+const EXTENDED_FILTER: [u64; 3] = [
+    tag::FILTER_SMOOTHED2,
+    tag::FILTER_QUADRATIC,
+    tag::FILTER_TANGENTIAL,
+];
+
+/// The [`fuzz_swing_payloads_extended`] input of a swing stream (`None` for other streams).
+pub fn swing_payload_seed_extended(stream: &[u8]) -> Option<Vec<u8>> {
+    let c = whet_format::parse(stream, &Limits::DEFAULT).ok()?;
+    let mut out = Vec::new();
+    for t in EXTENDED_FILTER {
+        let v = i16::try_from(c.header.get_i64(t).unwrap_or(0)).ok()?;
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    out.extend(swing_payload_input(&c)?);
+    Some(out)
+}
+
 /// The [`fuzz_swing_payloads`] input of a swing stream (`None` for other streams, and for
-/// streams with the extended surface filter, whose three factors the input's prefix does
-/// not hold: that target fuzzes the payloads; the `decode` target covers the filter).
+/// streams with the extended surface filter, whose three factors only
+/// [`swing_payload_seed_extended`]'s input holds).
 pub fn swing_payload_seed(stream: &[u8]) -> Option<Vec<u8>> {
     let c = whet_format::parse(stream, &Limits::DEFAULT).ok()?;
-    let h = &c.header;
-    if h.mode != Mode::Swing {
+    if EXTENDED_FILTER
+        .iter()
+        .any(|&t| c.header.get_i64(t).unwrap_or(0) != 0)
+    {
         return None;
     }
-    let extended = [
-        tag::FILTER_SMOOTHED2,
-        tag::FILTER_QUADRATIC,
-        tag::FILTER_UMBRELLA,
-    ];
-    if extended.iter().any(|&t| h.get_i64(t).unwrap_or(0) != 0) {
+    swing_payload_input(&c)
+}
+
+fn swing_payload_input(c: &Container) -> Option<Vec<u8>> {
+    let h = &c.header;
+    if h.mode != Mode::Swing {
         return None;
     }
     let byte = |t: u64| h.get_u64(t).and_then(|v| u8::try_from(v).ok());

@@ -46,7 +46,10 @@ pub use encoder::{
 };
 pub use exact::ExactPayloads;
 #[doc(hidden)]
-pub use fuzz::{fuzz_decode, fuzz_exact_payloads, fuzz_swing_payloads, swing_payload_seed};
+pub use fuzz::{
+    fuzz_decode, fuzz_exact_payloads, fuzz_swing_payloads, fuzz_swing_payloads_extended,
+    swing_payload_seed, swing_payload_seed_extended,
+};
 pub use parallelogram::{average, candidates, gate_fallback, MAX_CANDIDATES};
 pub use quantize::Quantizer;
 pub use sharpen_hint::SharpenHint;

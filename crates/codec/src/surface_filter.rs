@@ -18,6 +18,11 @@
 //! the smoothed one carries mostly the curvature, so their least-squares mix both restores
 //! the bulge and damps the noise. Boundary vertices (open fans) and vertices without a
 //! normal are not moved and contribute `d = 0`.
+//!
+//! The extended filter (format 1.4) adds three fields: `s2`, the one-ring mean of `s`;
+//! `q = d |d| / L`; and `t`, the tangential part of the umbrella Laplacian, which slides
+//! vertices along the surface towards an even spread (docs/swing.md section 2, "Extended
+//! surface filter").
 
 use whet_mesh::{DVec3, Mesh};
 
@@ -40,8 +45,9 @@ pub struct SurfaceFilter {
     pub smoothed2: i64,
     /// Factor of `q(v) = d(v) |d(v)| / L` (extended filter).
     pub quadratic: i64,
-    /// Factor of the umbrella Laplacian `u(v)`, a vector (extended filter).
-    pub umbrella: i64,
+    /// Factor of `t(v)`, the tangential part of the umbrella Laplacian, a vector (extended
+    /// filter).
+    pub tangential: i64,
 }
 
 impl SurfaceFilter {
@@ -51,7 +57,7 @@ impl SurfaceFilter {
         smoothed: 0,
         smoothed2: 0,
         quadratic: 0,
-        umbrella: 0,
+        tangential: 0,
     };
 
     /// The coded form of real factors: rounded, and clamped to the range the decoder
@@ -63,24 +69,24 @@ impl SurfaceFilter {
     /// The coded form of the five real factors of the extended filter, in the order of
     /// [`Self::extended_factors`].
     pub fn from_extended_factors(f: [f64; 5]) -> SurfaceFilter {
-        let [normal, smoothed, smoothed2, quadratic, umbrella] = f.map(code_factor);
+        let [normal, smoothed, smoothed2, quadratic, tangential] = f.map(code_factor);
         SurfaceFilter {
             normal,
             smoothed,
             smoothed2,
             quadratic,
-            umbrella,
+            tangential,
         }
     }
 
     /// True when the filter moves nothing.
     pub fn is_none(&self) -> bool {
-        self.normal == 0 && !self.is_extended() && self.smoothed == 0
+        self.normal == 0 && self.smoothed == 0 && !self.is_extended()
     }
 
     /// True when a factor of the extended filter (format 1.4) is not zero.
     pub fn is_extended(&self) -> bool {
-        self.smoothed2 != 0 || self.quadratic != 0 || self.umbrella != 0
+        self.smoothed2 != 0 || self.quadratic != 0 || self.tangential != 0
     }
 
     /// Every coded factor lies within `±MAX_CODED` (what a decoder accepts).
@@ -90,18 +96,18 @@ impl SurfaceFilter {
             .all(|c| (-MAX_CODED..=MAX_CODED).contains(c))
     }
 
-    /// The five coded factors: `d`, `s`, `s2`, `q`, `u`.
+    /// The five coded factors: `d`, `s`, `s2`, `q`, `t`.
     pub fn coded(&self) -> [i64; 5] {
         [
             self.normal,
             self.smoothed,
             self.smoothed2,
             self.quadratic,
-            self.umbrella,
+            self.tangential,
         ]
     }
 
-    /// The five factors as reals, in the order `d`, `s`, `s2`, `q`, `u`.
+    /// The five factors as reals, in the order `d`, `s`, `s2`, `q`, `t`.
     pub fn extended_factors(&self) -> [f64; 5] {
         self.coded().map(|c| c as f64 / SCALE)
     }
@@ -158,8 +164,15 @@ impl SurfaceFilter {
             }
             return;
         }
+        self.apply_extended(mesh, &normals, edge_length);
+    }
+
+    /// The extended filter's move (docs/format.md, tags 34 to 38): per vertex with a nonzero
+    /// normal, `p ← (p + along · n) + f · t` with `along = ((a d + b s) + c s2) + e q`, kept
+    /// only when all three coordinates are finite.
+    fn apply_extended(&self, mesh: &mut Mesh, normals: &[DVec3], edge_length: f64) {
         let [a, b, c, e, f] = self.extended_factors();
-        let x = fields(&mesh.positions, &mesh.triangles, &normals, true);
+        let x = fields(&mesh.positions, &mesh.triangles, normals, true);
         let s2 = one_ring_mean(&mesh.triangles, &x.s, &x.k);
         for (v, p) in mesh.positions.iter_mut().enumerate().take(s2.len()) {
             let n = normals[v];
@@ -168,9 +181,10 @@ impl SurfaceFilter {
                 // filter.
                 continue;
             }
-            let along =
-                a * x.d[v] + b * x.s[v] + c * s2[v] + e * quadratic_field(x.d[v], edge_length);
-            let moved = *p + along * n + f * umbrella_field(x.next_sum[v], x.k[v], *p, n);
+            let d = x.d[v];
+            let along = a * d + b * x.s[v] + c * s2[v] + e * quadratic_field(d, edge_length);
+            let t = tangential_field(x.next_sum[v], x.k[v], *p, n, d);
+            let moved = (*p + along * n) + f * t;
             if moved.is_finite() {
                 *p = moved;
             }
@@ -318,7 +332,7 @@ impl FilterFields {
                 .map(|&d| quadratic_field(d, edge_length))
                 .collect();
         let u: Vec<DVec3> = (0..s2.len())
-            .map(|v| umbrella_field(x.next_sum[v], x.k[v], mesh.positions[v], normals[v]))
+            .map(|v| tangential_field(x.next_sum[v], x.k[v], mesh.positions[v], normals[v], x.d[v]))
             .collect();
         (
             FilterFields {
@@ -469,13 +483,14 @@ fn quadratic_field(d: f64, edge_length: f64) -> f64 {
     }
 }
 
-/// `u(v)`: the mean of the next corners minus `v`; zero where the normal is zero, without
-/// triangles, or not finite.
+/// `t(v) = u + d n`, the tangential part of the umbrella Laplacian `u` (the mean of the next
+/// corners minus `v`; on a closed fan `n · u = −d`, so `t` keeps what `d n` does not say);
+/// zero where the normal is zero, without triangles, or not finite.
 #[inline]
-fn umbrella_field(next_sum: DVec3, k: u32, p: DVec3, normal: DVec3) -> DVec3 {
-    let u = next_sum / k as f64 - p;
-    if k > 0 && normal != DVec3::ZERO && u.is_finite() {
-        u
+fn tangential_field(next_sum: DVec3, k: u32, p: DVec3, normal: DVec3, d: f64) -> DVec3 {
+    let t = (next_sum / k as f64 - p) + d * normal;
+    if k > 0 && normal != DVec3::ZERO && t.is_finite() {
+        t
     } else {
         DVec3::ZERO
     }
@@ -605,29 +620,33 @@ mod tests {
 
     #[test]
     fn an_extended_filter_with_its_three_factors_zero_is_the_two_field_filter() {
+        // A lopsided octahedron, so that no field vanishes by symmetry.
         let mut two = octahedron();
+        two.positions[4] = DVec3::new(0.2, -0.1, 1.3);
+        two.positions[1] = DVec3::new(0.1, 0.8, 0.05);
         let mut five = two.clone();
         let f = SurfaceFilter::from_factors(0.3, -0.2);
+        assert!(!f.is_extended());
         f.apply(&mut two, 1.0);
-        // The extended path with zero extended factors is never taken (is_extended is
-        // false); its arithmetic must still agree with the two-field one to rounding.
-        let zero = SurfaceFilter::from_extended_factors([0.3, -0.2, 0.0, 0.0, 0.0]);
-        assert_eq!(zero, f);
-        assert!(!zero.is_extended());
-        zero.apply(&mut five, 1.0);
+        // The extended move with zero extended factors, run directly (the filter never
+        // takes it: is_extended is false), lands on the same positions.
+        let normals = unit_normals(&five.positions, &five.triangles);
+        f.apply_extended(&mut five, &normals, 1.0);
         assert_eq!(two.positions, five.positions);
+        assert_eq!(
+            SurfaceFilter::from_extended_factors([0.3, -0.2, 0.0, 0.0, 0.0]),
+            f
+        );
     }
 
     #[test]
     fn the_extended_fields_move_as_defined() {
         // The octahedron: every vertex has 4 triangles, d = 1 (the neighbours' mean is the
-        // origin), s = s2 = 1, q = d |d| / L = 1 / L, and the umbrella Laplacian is −v.
+        // origin), s = s2 = 1, q = d |d| / L = 1 / L, and the umbrella Laplacian −v is all
+        // normal: no tangential part.
         let m = octahedron();
-        for (field, factor, along) in [
-            (2usize, 0.25, 0.25),
-            (3, 0.25, 0.25 / 2.0),
-            (4, 0.25, -0.25),
-        ] {
+        for (field, factor, along) in [(2usize, 0.25, 0.25), (3, 0.25, 0.25 / 2.0), (4, 0.25, 0.0)]
+        {
             let mut f = [0.0; 5];
             f[field] = factor;
             let filter = SurfaceFilter::from_extended_factors(f);
@@ -642,15 +661,23 @@ mod tests {
             }
         }
         // The encoder's fields are the ones applied.
-        let (two, [s2, q, u]) = FilterFields::extended(&m, 2.0);
+        let (two, [s2, q, t]) = FilterFields::extended(&m, 2.0);
         let plain = FilterFields::new(&m);
         assert_eq!(two.normal, plain.normal);
         assert_eq!(two.smoothed, plain.smoothed);
         for (v, p) in m.positions.iter().enumerate() {
             assert!((s2[v] - *p).length() < 1e-12);
             assert!((q[v] - 0.5 * *p).length() < 1e-12);
-            assert!((u[v] + *p).length() < 1e-12);
+            assert!(t[v].length() < 1e-12);
         }
+        // The top vertex slid along the surface: its tangential field points back, in the
+        // tangent plane.
+        let mut slid = octahedron();
+        slid.positions[4] = DVec3::new(0.3, 0.0, 1.0);
+        let normals = unit_normals(&slid.positions, &slid.triangles);
+        let (_, [_, _, t]) = FilterFields::extended(&slid, 2.0);
+        assert!(t[4].x < -0.1, "{:?}", t[4]);
+        assert!(t[4].dot(normals[4]).abs() < 1e-12, "{:?}", t[4]);
     }
 
     #[test]

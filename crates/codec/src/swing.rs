@@ -1492,7 +1492,7 @@ fn write_stream(
             header = header
                 .with(tag::FILTER_SMOOTHED2, info.filter.smoothed2)
                 .with(tag::FILTER_QUADRATIC, info.filter.quadratic)
-                .with(tag::FILTER_UMBRELLA, info.filter.umbrella);
+                .with(tag::FILTER_TANGENTIAL, info.filter.tangential);
         }
     }
     if !info.sharpened_filter.is_none() {
@@ -1682,7 +1682,7 @@ pub(crate) fn decode_swing(
         smoothed: h.get_i64(tag::FILTER_SMOOTHED).unwrap_or(0),
         smoothed2: h.get_i64(tag::FILTER_SMOOTHED2).unwrap_or(0),
         quadratic: h.get_i64(tag::FILTER_QUADRATIC).unwrap_or(0),
-        umbrella: h.get_i64(tag::FILTER_UMBRELLA).unwrap_or(0),
+        tangential: h.get_i64(tag::FILTER_TANGENTIAL).unwrap_or(0),
     };
     if !filter.in_range() {
         return Err(Error::Corrupt(format!(
@@ -2141,7 +2141,7 @@ mod tests {
         for (t, v) in [
             (tag::FILTER_SMOOTHED2, filter.smoothed2),
             (tag::FILTER_QUADRATIC, filter.quadratic),
-            (tag::FILTER_UMBRELLA, filter.umbrella),
+            (tag::FILTER_TANGENTIAL, filter.tangential),
         ] {
             assert_eq!(t % 2, 0);
             assert_eq!(c.header.get_i64(t), Some(v));
@@ -2150,7 +2150,7 @@ mod tests {
             whet_format::parse(&two.bytes, &crate::Limits::DEFAULT)
                 .unwrap()
                 .header
-                .get_i64(tag::FILTER_UMBRELLA),
+                .get_i64(tag::FILTER_TANGENTIAL),
             None
         );
         // A factor beyond the range is refused by name.
@@ -2158,7 +2158,7 @@ mod tests {
         container.header = container
             .header
             .clone()
-            .with(tag::FILTER_UMBRELLA, -surface_filter::MAX_CODED - 1);
+            .with(tag::FILTER_TANGENTIAL, -surface_filter::MAX_CODED - 1);
         let bad = container.to_bytes().unwrap();
         let err = crate::decode(&bad, &crate::DecodeOptions::DEFAULT).unwrap_err();
         assert!(err.to_string().contains("surface filter"), "{err}");

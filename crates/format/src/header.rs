@@ -194,10 +194,10 @@ pub mod tag {
     /// i64 (format 1.4): factor of `q = d |d| / L` in the extended surface filter, in units
     /// of 1/1024 (swing; absent: 0).
     pub const FILTER_QUADRATIC: u64 = 36;
-    /// i64 (format 1.4): factor of the umbrella Laplacian (a vector: it also moves vertices
-    /// along the surface) in the extended surface filter, in units of 1/1024 (swing;
-    /// absent: 0).
-    pub const FILTER_UMBRELLA: u64 = 38;
+    /// i64 (format 1.4): factor of the tangential part of the umbrella Laplacian (a vector
+    /// in the tangent plane: it moves vertices along the surface) in the extended surface
+    /// filter, in units of 1/1024 (swing; absent: 0).
+    pub const FILTER_TANGENTIAL: u64 = 38;
 
     /// Every tag this crate knows, with its name and value type.
     pub const KNOWN: [(u64, &str, ValueType); 22] = [
@@ -234,7 +234,7 @@ pub mod tag {
         (SNAP_VETOES, "snap_vetoes", ValueType::Bytes),
         (FILTER_SMOOTHED2, "filter_smoothed2", ValueType::I64),
         (FILTER_QUADRATIC, "filter_quadratic", ValueType::I64),
-        (FILTER_UMBRELLA, "filter_umbrella", ValueType::I64),
+        (FILTER_TANGENTIAL, "filter_tangential", ValueType::I64),
     ];
 
     /// Name and type of a known tag.

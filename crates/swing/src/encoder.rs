@@ -3,7 +3,7 @@
 //! (`algorithms.md` 1.9: the size goes as `L^-2`, so a secant on `log L` converges in a few
 //! steps; the error goes roughly as `L^2`).
 
-use crate::retiler::{retile_fitted, RetileStats, RetileTuning};
+use crate::retiler::{retile_fitted, FilterFits, RetileStats, RetileTuning};
 use crate::Error;
 use whet_codec::{
     encode_retiled, prepare_mesh, EncodeReport, SharpenHint, SnapVetoes, SurfaceFilter,
@@ -959,7 +959,15 @@ impl SwingEncoder {
         let l = fraction * prep.diagonal;
         let params = SwingParams::new(l, o.angle_bits, &seed_box(&prep.mesh), o.quant_bits)?;
         let sharpen: Vec<_> = candidates.iter().map(Candidate::sharpen_options).collect();
-        let retiled = retile_fitted(&prep.mesh, &params, &o.tuning, o.surface_filter, &sharpen)?;
+        // The extended filter serves the decoded output: not fitted when it is not allowed,
+        // nor when the stream is optimized for the sharpened output (which starts from the
+        // unfiltered mesh, so its bytes would buy nothing there).
+        let fit = match (o.surface_filter, o.extended_filter, o.error_of) {
+            (false, _, _) => FilterFits::None,
+            (true, true, ErrorOf::Decoded) => FilterFits::Extended,
+            (true, _, _) => FilterFits::Basic,
+        };
+        let retiled = retile_fitted(&prep.mesh, &params, &o.tuning, fit, &sharpen)?;
         let mut outs = Vec::with_capacity(candidates.len());
         // The same decoded mesh for every candidate (they differ in header fields only).
         let mut coverage = None;
@@ -969,7 +977,7 @@ impl SwingEncoder {
         let mut filter = retiled.filter;
         let mut extended = retiled
             .extended_filter
-            .filter(|&(_, ratio)| o.extended_filter && ratio < 1.0 && !retiled.filter.is_none());
+            .filter(|&(_, ratio)| ratio < 1.0 && !retiled.filter.is_none());
         for (c, &sharpened_filter) in candidates.iter().zip(&retiled.sharpened_filters) {
             // What the stream cannot state, a decoder would not reproduce.
             let walls_ok = c
@@ -999,16 +1007,19 @@ impl SwingEncoder {
                     filter: ext,
                     ..info
                 };
-                let enc_ext = encode_retiled(&retiled.mesh, &params, &with_ext)?;
-                let growth = enc_ext.bytes.len() as f64 / enc.bytes.len() as f64 - 1.0;
-                // Half the fitted gain against the growth: the fit is forward and
-                // linearised, and measured with Metro it delivers its gain on smooth
-                // meshes but less on sharp ones (sharp_sphere at 1 bpv: fitted 1.6 %,
-                // measured −2.5 %; docs/results.md, "Extended surface filter").
-                if 1.0 - ratio > 2.0 * growth {
-                    filter = ext;
-                    info = with_ext;
-                    enc = enc_ext;
+                // A try: if its stream fails, the two-field one stands.
+                if let Ok(enc_ext) = encode_retiled(&retiled.mesh, &params, &with_ext) {
+                    let growth = enc_ext.bytes.len() as f64 / enc.bytes.len() as f64 - 1.0;
+                    // Half the fitted gain against the growth (RMS falls about as fast as
+                    // the bytes grow at these rates): the fit is forward and linearised,
+                    // and measured with Metro it delivers its gain on smooth meshes but
+                    // less on sharp ones (sharp_sphere at 1 bpv: fitted 1.6 %, measured
+                    // −2.5 %; docs/results.md, "Extended surface filter").
+                    if 1.0 - ratio > 2.0 * growth {
+                        filter = ext;
+                        info = with_ext;
+                        enc = enc_ext;
+                    }
                 }
             }
             let coverage_gap = *coverage.get_or_insert_with(|| {

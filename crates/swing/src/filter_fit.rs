@@ -10,13 +10,14 @@
 //! (the retiler's grid, within 2 L), weights them by the triangle's area and
 //! solves the 2 × 2 normal equations for `(a, b)`: the forward (decoded to original) RMS of
 //! the filtered mesh, linearised. Measured against the Metro error of factor sweeps, the fit
-//! lands on the sweep's optimum within its resolution (docs/results.md).
+//! lands on the sweep's optimum within its resolution (docs/results.md). The extended
+//! filter's five factors are fitted the same way on the same samples ([`fit_filters`]).
 
 use whet_codec::{FilterFields, SurfaceFilter};
 use whet_mesh::{DVec3, Mesh};
 
-/// Most surface samples of one fit: two unknowns need few, and the fit runs once per
-/// retiling of a rate search.
+/// Most surface samples of one fit: two (or five) unknowns need few, and the fit runs once
+/// per retiling of a rate search.
 const MAX_SAMPLES: usize = 1 << 14;
 
 /// Barycentric sample points of a triangle: the centroid and the centroids of the three
@@ -176,17 +177,21 @@ impl TwoFieldEquations {
 }
 
 /// Solves `m c = v` for a symmetric positive semi-definite `m` (normal equations) by a
-/// Cholesky factorisation with a small ridge (a millionth of the mean diagonal), so that
-/// nearly collinear fields (on a sphere `s` and `s2` are nearly `d`) get bounded factors
-/// instead of a blow-up; `None` when the matrix is empty or not finite.
-fn solve_spd(mut m: [[f64; 5]; 5], v: [f64; 5]) -> Option<[f64; 5]> {
-    let trace: f64 = (0..5).map(|i| m[i][i]).sum();
-    if !(trace > 0.0 && trace.is_finite()) || v.iter().any(|x| !x.is_finite()) {
+/// Cholesky factorisation, on the equations scaled to a unit diagonal (the fields differ in
+/// size: `q` is about `L / R` times `d`) and with a small ridge (a millionth), so that nearly
+/// collinear fields (on a sphere `s` and `s2` are nearly `d`) get bounded factors instead of
+/// a blow-up; `None` when a field is empty everywhere or a value is not finite.
+fn solve_spd(m: [[f64; 5]; 5], v: [f64; 5]) -> Option<[f64; 5]> {
+    let scale: [f64; 5] = std::array::from_fn(|i| m[i][i].sqrt());
+    if scale.iter().any(|x| !(x.is_finite() && *x > 0.0)) || v.iter().any(|x| !x.is_finite()) {
         return None;
     }
-    let ridge = 1e-6 * trace / 5.0;
+    // m' = D⁻¹ m D⁻¹ (unit diagonal), v' = D⁻¹ v, c = D⁻¹ c'.
+    let mut m: [[f64; 5]; 5] =
+        std::array::from_fn(|i| std::array::from_fn(|j| m[i][j] / (scale[i] * scale[j])));
+    let v: [f64; 5] = std::array::from_fn(|i| v[i] / scale[i]);
     for (i, row) in m.iter_mut().enumerate() {
-        row[i] += ridge;
+        row[i] += 1e-6;
     }
     // m = l lᵀ.
     let mut l = [[0.0f64; 5]; 5];
@@ -222,6 +227,7 @@ fn solve_spd(mut m: [[f64; 5]; 5], v: [f64; 5]) -> Option<[f64; 5]> {
         }
         c[i] = sum / l[i][i];
     }
+    let c: [f64; 5] = std::array::from_fn(|i| c[i] / scale[i]);
     c.iter().all(|x| x.is_finite()).then_some(c)
 }
 
@@ -311,6 +317,24 @@ mod tests {
         let c = solve_spd([row; 5], [2.0; 5]).unwrap();
         assert!(c.iter().all(|x| x.is_finite() && x.abs() < 10.0), "{c:?}");
         assert!((c.iter().sum::<f64>() - 2.0).abs() < 1e-3, "{c:?}");
+        // Fields of different sizes (as q is about L / R times d) are solved as well as
+        // equal ones (the ridge acts on the scaled equations).
+        let s = [1.0, 0.05, 20.0, 1.0, 0.1];
+        let m: [[f64; 5]; 5] = std::array::from_fn(|i| {
+            std::array::from_fn(|j| {
+                if i == j {
+                    s[i] * s[i]
+                } else {
+                    0.1 * s[i] * s[j]
+                }
+            })
+        });
+        let want = [0.5, -2.0, 0.25, 1.0, 3.0];
+        let v: [f64; 5] = std::array::from_fn(|i| (0..5).map(|j| m[i][j] * want[j]).sum());
+        let c = solve_spd(m, v).unwrap();
+        for (c, w) in c.iter().zip(want) {
+            assert!((c - w).abs() < 1e-3 * w.abs().max(1.0), "{c} against {w}");
+        }
         assert_eq!(solve_spd([[0.0; 5]; 5], [0.0; 5]), None);
         assert_eq!(solve_spd([[f64::NAN; 5]; 5], [1.0; 5]), None);
     }

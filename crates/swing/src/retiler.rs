@@ -342,18 +342,30 @@ pub fn retile(
     params: &SwingParams,
     tune: &RetileTuning,
 ) -> Result<Retiled, Error> {
-    retile_fitted(mesh, params, tune, false, &[])
+    retile_fitted(mesh, params, tune, FilterFits::None, &[])
 }
 
-/// [`retile`], and with `fit` also the surface filter fitted to `mesh`
-/// ([`crate::fit_surface_filter`], on the retiler's own grid of the original) and one for
-/// after sharpening per entry of `sharpen` (one retiling serves every sharpening the
-/// encoder's choice measures).
+/// Which surface filters [`retile_fitted`] fits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum FilterFits {
+    /// None.
+    None,
+    /// The two-field filter (and those for after sharpening).
+    Basic,
+    /// Also the extended one, on the same samples.
+    Extended,
+}
+
+/// [`retile`], and with `fits` also the surface filter fitted to `mesh`
+/// ([`crate::fit_surface_filter`], on the retiler's own grid of the original; with
+/// [`FilterFits::Extended`] the extended one too, [`crate::fit_filters`]) and one for after
+/// sharpening per entry of `sharpen` (one retiling serves every sharpening the encoder's
+/// choice measures).
 pub(crate) fn retile_fitted(
     mesh: &whet_mesh::Mesh,
     params: &SwingParams,
     tune: &RetileTuning,
-    fit: bool,
+    fits: FilterFits,
     sharpen: &[whet_sharpen::SharpenOptions],
 ) -> Result<Retiled, Error> {
     let l = params.edge_length;
@@ -485,7 +497,7 @@ pub(crate) fn retile_fitted(
         None => Vec::new(),
     };
     r.stats.deleted_triangles = deleted.iter().filter(|&&d| d).count();
-    let (filter, extended_filter, sharpened_filters) = if fit {
+    let (filter, extended_filter, sharpened_filters) = if fits != FilterFits::None {
         // The decoder's output: the kept triangles (unused vertices do not matter to the
         // filter). Closest points on the original only, not on the filler over its holes.
         let kept = whet_mesh::Mesh::new(
@@ -503,9 +515,15 @@ pub(crate) fn retile_fitted(
             |p| surf.closest_point(p, 2.0 * l, |t| !filler.get(t).copied().unwrap_or(false));
         // One set of fields serves every fit (fit_surface_filter computes the same), and
         // one set of samples both decoded filters.
-        let (fields, extra) = whet_codec::FilterFields::extended(&kept, l);
-        let fit = crate::fit_filters(&kept, &fields, &extra, closest);
-        let filter = fit.basic;
+        let (filter, extended, fields) = if fits == FilterFits::Extended {
+            let (fields, extra) = whet_codec::FilterFields::extended(&kept, l);
+            let fit = crate::fit_filters(&kept, &fields, &extra, closest);
+            (fit.basic, fit.extended, fields)
+        } else {
+            let fields = whet_codec::FilterFields::new(&kept);
+            let basic = crate::fit_displacements(&kept, &fields.normal, &fields.smoothed, closest);
+            (basic, None, fields)
+        };
         // Candidates that sharpen to the same mesh (the papers' method with curved walls
         // that turn no edge smooth, a second pass that changes nothing) share one fit.
         // (Keyed by a hash, not by the meshes: 25 candidates' meshes need not stay in memory.)
@@ -526,7 +544,7 @@ pub(crate) fn retile_fitted(
                 f
             })
             .collect();
-        (filter, fit.extended, after)
+        (filter, extended, after)
     } else {
         (
             SurfaceFilter::NONE,

@@ -208,7 +208,7 @@ fn the_extended_surface_filter_fits_better_and_round_trips_bit_exactly() {
         |bytes: &[u8]| decode(bytes, &DecodeOptions::DEFAULT.with_surface_filter(false)).unwrap();
     assert_eq!(bits(&raw(&basic.bytes)), bits(&raw(&extended.bytes)));
     assert!(extended.bytes.len() > basic.bytes.len());
-    assert!(extended.bytes.len() <= basic.bytes.len() + 12);
+    assert!(extended.bytes.len() <= basic.bytes.len() + 13);
     let m = whet_metro::MetroOptions::DEFAULT.with_samples(100_000);
     let rms = |out: &whet_swing::SwingOutput| {
         whet_metro::metro(&mesh, &out.retiled, &m)
@@ -218,7 +218,7 @@ fn the_extended_surface_filter_fits_better_and_round_trips_bit_exactly() {
     };
     let (b, e) = (rms(&basic), rms(&extended));
     // Measured when written (100 000 samples): 0.0536 % -> 0.0501 % (6.4 % lower) for 560 ->
-    // 571 bytes; the encoder writes the extended filter only for a fitted gain above the
-    // bytes it adds, 2 % here.
+    // 571 bytes; the encoder writes the extended filter only for a fitted gain above twice
+    // the relative bytes it adds (2 % here).
     assert!(e < 0.97 * b, "basic {b} %, extended {e} %");
 }
