@@ -959,25 +959,32 @@ impl SwingEncoder {
         let l = fraction * prep.diagonal;
         let params = SwingParams::new(l, o.angle_bits, &seed_box(&prep.mesh), o.quant_bits)?;
         let sharpen: Vec<_> = candidates.iter().map(Candidate::sharpen_options).collect();
-        // The extended filter serves the decoded output: not fitted when it is not allowed,
-        // nor when the stream is optimized for the sharpened output (which starts from the
-        // unfiltered mesh, so its bytes would buy nothing there).
-        let fit = match (o.surface_filter, o.extended_filter, o.error_of) {
-            (false, _, _) => FilterFits::None,
-            (true, true, ErrorOf::Decoded) => FilterFits::Extended,
-            (true, _, _) => FilterFits::Basic,
+        // The extended filter serves the decoded output: it goes into the streams whose
+        // decoded mesh is what the encoder optimizes (all of them for the decoded output;
+        // with --optimize-for sharpened, only those stating no sharpening, whose decoded
+        // mesh is their sharpened one: the others sharpen the unfiltered vertices, and its
+        // bytes would buy nothing there). Fitted only when some candidate can use it.
+        let extended_for = |c: &Candidate| {
+            o.error_of == ErrorOf::Decoded || c.hint == Some(SharpenHint::Unsharpened)
+        };
+        let fit = if !o.surface_filter {
+            FilterFits::None
+        } else if o.extended_filter && candidates.iter().any(extended_for) {
+            FilterFits::Extended
+        } else {
+            FilterFits::Basic
         };
         let retiled = retile_fitted(&prep.mesh, &params, &o.tuning, fit, &sharpen)?;
         let mut outs = Vec::with_capacity(candidates.len());
         // The same decoded mesh for every candidate (they differ in header fields only).
         let mut coverage = None;
-        // The decoded filter: the extended one where half its fitted gain beats the bytes
-        // its three header fields add (decided on the first candidate's stream; the fields
-        // and their bytes are the same in every candidate's).
-        let mut filter = retiled.filter;
-        let mut extended = retiled
+        // The decoded filter of those streams: the extended one where half its fitted gain
+        // beats the bytes its three header fields add, decided on the first such stream
+        // (the fields and their bytes are the same in every candidate's).
+        let extended = retiled
             .extended_filter
             .filter(|&(_, ratio)| ratio < 1.0 && !retiled.filter.is_none());
+        let mut use_extended: Option<bool> = None;
         for (c, &sharpened_filter) in candidates.iter().zip(&retiled.sharpened_filters) {
             // What the stream cannot state, a decoder would not reproduce.
             let walls_ok = c
@@ -988,11 +995,15 @@ impl SwingEncoder {
                     "a sharpening candidate the stream cannot state: {c:?}"
                 )));
             }
+            let ext = extended.filter(|_| extended_for(c));
             let mut info = SwingStreamInfo {
                 version: o.version,
                 repair: &prep.repair,
                 dropped_unused_vertices: prep.dropped,
-                filter,
+                filter: match (ext, use_extended) {
+                    (Some((f, _)), Some(true)) => f,
+                    _ => retiled.filter,
+                },
                 sharpened_filter,
                 sharpen_hint: c.hint,
                 // Always written with a hint, so that the size searches count its bytes (the
@@ -1002,12 +1013,13 @@ impl SwingEncoder {
                 sharpen_passes: c.hint.and((c.passes > 1).then_some(c.passes)),
             };
             let mut enc: SwingEncoded = encode_retiled(&retiled.mesh, &params, &info)?;
-            if let Some((ext, ratio)) = extended.take() {
+            if let (Some((ext, ratio)), None) = (ext, use_extended) {
                 let with_ext = SwingStreamInfo {
                     filter: ext,
                     ..info
                 };
                 // A try: if its stream fails, the two-field one stands.
+                let mut better = false;
                 if let Ok(enc_ext) = encode_retiled(&retiled.mesh, &params, &with_ext) {
                     let growth = enc_ext.bytes.len() as f64 / enc.bytes.len() as f64 - 1.0;
                     // Half the fitted gain against the growth (RMS falls about as fast as
@@ -1016,11 +1028,12 @@ impl SwingEncoder {
                     // less on sharp ones (sharp_sphere at 1 bpv: fitted 1.6 %, measured
                     // −2.5 %; docs/results.md, "Extended surface filter").
                     if 1.0 - ratio > 2.0 * growth {
-                        filter = ext;
+                        better = true;
                         info = with_ext;
                         enc = enc_ext;
                     }
                 }
+                use_extended = Some(better);
             }
             let coverage_gap = *coverage.get_or_insert_with(|| {
                 coverage_gap(&prep.mesh, &retiled.pillowed_vertices, &enc.decoded, l)
