@@ -129,8 +129,10 @@ pub struct EncodeArgs {
     no_surface_filter: bool,
     /// Swing: keep the surface filter to its two fields of format 1.1 (streams readable by
     /// whet before format 1.4, about 5 % faster to decode). By default the encoder writes
-    /// the extended filter, three more fields, where its fitted gain beats the bytes they
-    /// add (about 2 % less RMS error at equal bytes on smooth meshes).
+    /// the extended filter, three more fields, where half its fitted gain beats the bytes
+    /// they add (2-9 % less RMS error at equal bytes on smooth meshes), into the streams
+    /// whose decoded mesh is the output it optimizes (with --optimize-for sharpened: those
+    /// that state no sharpening).
     #[arg(long)]
     basic_surface_filter: bool,
     /// Swing: the most retiled triangles an edge length may ask for (estimated from the
