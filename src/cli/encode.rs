@@ -418,6 +418,7 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh, skipped: &whet::io::ReadRepor
                 "max_error_pct": t.max_pct,
                 "planar": t.planar,
                 "quadric": t.quadric,
+                "sharpened_filter": t.sharpened_filter,
             })).collect::<Vec<_>>(),
             "planar_tolerance": out.planar_factor,
             "quadric_projection": out.quadric_factor,

@@ -111,9 +111,26 @@ fn main() {
             }
             x
         };
-        let basic = apply(fit.basic.extended_factors());
+        // PROJECT=1: the planar and quadric projections after the filter, as `whet decode
+        // --sharpen` applies them when the stream states them.
+        let project = |mut x: Mesh| -> Mesh {
+            if std::env::var("PROJECT").is_ok() {
+                let b = out.angle_bits;
+                let _ = whet_sharpen::flatten_planar_regions(
+                    &mut x,
+                    &whet_sharpen::PlanarOptions::for_swing(b, whet_swing::PLANAR_FACTOR),
+                );
+                let _ = whet_sharpen::project_onto_local_quadrics(
+                    &mut x,
+                    &whet_sharpen::QuadricOptions::for_swing(b, whet_swing::QUADRIC_FACTOR),
+                );
+            }
+            x
+        };
+        let sharp = project(sharp.clone());
+        let basic = project(apply(fit.basic.extended_factors()));
         let (ext, ratio) = fit.extended.unwrap();
-        let extended = apply(ext.extended_factors());
+        let extended = project(apply(ext.extended_factors()));
         println!(
             "{} {bpv} bpv ({} B): sharpened {}, two fields {}, five fields {} (fitted ratio {ratio:.3})",
             args[0],
