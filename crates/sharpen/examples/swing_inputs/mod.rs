@@ -74,6 +74,8 @@ pub struct SwingInput {
     pub planar: bool,
     /// The stream states the local quadric projection after sharpening (field 31).
     pub quadric: bool,
+    /// The stream carries a filter for after sharpening (fields 17 and 19).
+    pub after_filter: bool,
     /// The stream.
     pub bytes: Vec<u8>,
 }
@@ -138,7 +140,7 @@ pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
         .unwrap_or_else(|e| panic!("{name}: {e}"));
     let dir = whet_testkit::workspace_root().join("target/sharpen-swing");
     let _ = std::fs::create_dir_all(&dir);
-    let path = dir.join(format!("v24-{name}-{bpv}-{}.whet", angles.tag()));
+    let path = dir.join(format!("v25-{name}-{bpv}-{}.whet", angles.tag()));
     let bytes = match std::fs::read(&path) {
         Ok(b) => b,
         Err(_) => {
@@ -172,6 +174,7 @@ pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
         smooth_factor: whet_codec::SharpenHint::stated(&header).map_or(2.0, |s| s.1),
         curved_walls: whet_codec::SharpenHint::curved_walls_of(&header),
         passes: whet_codec::SharpenHint::passes_of(&header).unwrap_or(1),
+        after_filter: !whet_codec::SurfaceFilter::after_sharpening_of(&header).is_none(),
         planar: whet_codec::SharpenHint::planar_of(&header).is_some(),
         quadric: whet_codec::SharpenHint::quadric_of(&header).is_some(),
         original,
