@@ -16,6 +16,12 @@
 //! `c |d|`. On joint at 3 bpv the five-field max (0.662 % against 0.418 %) comes from `q`:
 //! `DROP=1` gives 0.418 % (and keeps 0.2 % of the RMS gain instead of 3.1 %), `DROP=0` or
 //! `2`, more rings and caps of 0.5 or 1 do not remove it.
+//!
+//! `PROJECT=1`: the planar and quadric projections (`PLANAR_FACTOR`, `QUADRIC_FACTOR`) after
+//! the filter, as `whet decode --sharpen` runs them when a stream states them; the first
+//! column is then the projections without a filter. `PROJECT=2`: the projections first, then
+//! the filters fitted and applied on the vertices neither the sharpener nor the projections
+//! moved (docs/results.md, "The filter for after sharpening under the projections").
 #![allow(clippy::unwrap_used)] // a measurement tool
 
 use whet_codec::{decode, untouched_by_sharpening, DecodeOptions, FilterFields};
@@ -45,6 +51,24 @@ fn main() {
         let sharp = whet_sharpen::sharpen(&raw, &whet_sharpen::SharpenOptions::DEFAULT)
             .unwrap()
             .mesh;
+        // PROJECT=2: the projections first, then the filter fitted and applied on the
+        // vertices that neither the sharpener nor the projections moved.
+        let after = std::env::var("PROJECT").is_ok_and(|v| v == "2");
+        let sharp = if after {
+            let mut x = sharp;
+            let b = out.angle_bits;
+            let _ = whet_sharpen::flatten_planar_regions(
+                &mut x,
+                &whet_sharpen::PlanarOptions::for_swing(b, whet_swing::PLANAR_FACTOR),
+            );
+            let _ = whet_sharpen::project_onto_local_quadrics(
+                &mut x,
+                &whet_sharpen::QuadricOptions::for_swing(b, whet_swing::QUADRIC_FACTOR),
+            );
+            x
+        } else {
+            sharp
+        };
         let mut free = untouched_by_sharpening(&raw, &sharp);
         // RINGS=k: k more rings around the sharpened part stay put.
         let rings: usize = std::env::var("RINGS")
@@ -114,7 +138,7 @@ fn main() {
         // PROJECT=1: the planar and quadric projections after the filter, as `whet decode
         // --sharpen` applies them when the stream states them.
         let project = |mut x: Mesh| -> Mesh {
-            if std::env::var("PROJECT").is_ok() {
+            if std::env::var("PROJECT").is_ok_and(|v| v == "1") {
                 let b = out.angle_bits;
                 let _ = whet_sharpen::flatten_planar_regions(
                     &mut x,
