@@ -1,6 +1,8 @@
 //! Times the stages of the exact mode on a ~1.3M-triangle icosphere (a profiling aid:
 //! `cargo run --release -p whet-codec --example profile_exact -- [encodes] [decodes]`,
-//! e.g. `-- 0 20` to profile decoding alone).
+//! e.g. `-- 0 20` to profile decoding alone). The icosphere's vertices and triangles are
+//! shuffled (the worst memory order an encoder meets); `PROFILE_ORDER=natural` keeps the
+//! generator's order, and `PROFILE_MESH=<file>` profiles that mesh in its file's order.
 #![allow(clippy::unwrap_used)]
 
 use std::time::Instant;
@@ -14,7 +16,14 @@ fn main() {
             .unwrap_or(d)
     };
     let (encodes, decodes) = (arg(1, 1), arg(2, 1));
-    let mesh = whet_testkit::meshes::shuffle(&whet_testkit::meshes::icosphere(8), 1);
+    let mesh = match (
+        std::env::var_os("PROFILE_MESH"),
+        std::env::var("PROFILE_ORDER").as_deref(),
+    ) {
+        (Some(p), _) => whet_io::read_path(std::path::Path::new(&p), None).unwrap(),
+        (None, Ok("natural")) => whet_testkit::meshes::icosphere(8),
+        _ => whet_testkit::meshes::shuffle(&whet_testkit::meshes::icosphere(8), 1),
+    };
     if encodes > 0 {
         let t = Instant::now();
         let table = whet_mesh::CornerTable::new(&mesh).unwrap();
