@@ -761,8 +761,15 @@ impl SwingEncoder {
             // sharpening under the projections"). So the chosen sharpening is tried without
             // the filter too, then with the projections on that, and the better of the two
             // ends wins by the margin.
-            if !chosen.sharpened_filter.is_none() {
-                let bare = restate_without_sharpened_filter(chosen)?;
+            let bare = if chosen.sharpened_filter.is_none() {
+                None
+            } else {
+                // A size target's lower bound still holds without the fields' bytes (a
+                // small stream can land near it), or the filter stays.
+                Some(restate_without_sharpened_filter(chosen)?)
+                    .filter(|b| self.above_size_floor(prep, b.bytes.len()))
+            };
+            if let Some(bare) = bare {
                 let ((rms, max), _) = self.measure_sharpened(
                     prep,
                     &bare,
@@ -799,6 +806,17 @@ impl SwingEncoder {
         chosen.sharpen_trials = trials;
         chosen.sharpen_input_max_pct = Some(input_max);
         Ok(chosen)
+    }
+
+    /// Whether a stream of `bytes` is not under the lower bound of the options' size target
+    /// (`--bpv`, `--target-bytes`: the target less the tolerance); true without one.
+    fn above_size_floor(&self, prep: &Prepared, bytes: usize) -> bool {
+        let target = match self.opts.rate {
+            Rate::BitsPerVertex(r) => (r * prep.mesh.positions.len() as f64 / 8.0).round(),
+            Rate::TargetBytes(n) => n as f64,
+            Rate::EdgeLength(_) | Rate::MaxError(_) => return true,
+        };
+        bytes as f64 >= (1.0 - self.opts.tolerance) * target.max(1.0)
     }
 
     /// The projections after sharpening tried on `start` (a stream stating a sharpening and
