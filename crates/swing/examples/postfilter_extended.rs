@@ -22,6 +22,8 @@
 //! column is then the projections without a filter. `PROJECT=2`: the projections first, then
 //! the filters fitted and applied on the vertices neither the sharpener nor the projections
 //! moved (docs/results.md, "The filter for after sharpening under the projections").
+//! `PRE=1` also prints the decoded mesh with its own surface filter sharpened, then
+//! projected as `PROJECT` says.
 #![allow(clippy::unwrap_used)] // a measurement tool
 
 use whet_codec::{decode, untouched_by_sharpening, DecodeOptions, FilterFields};
@@ -155,6 +157,19 @@ fn main() {
         let basic = project(apply(fit.basic.extended_factors()));
         let (ext, ratio) = fit.extended.unwrap();
         let extended = project(apply(ext.extended_factors()));
+        // PRE=1: also the decoded mesh with its own surface filter sharpened, then projected
+        // (no filter after sharpening).
+        if std::env::var("PRE").is_ok() {
+            let filtered = decode(&out.bytes, &DecodeOptions::DEFAULT).unwrap();
+            let s = whet_sharpen::sharpen(&filtered, &whet_sharpen::SharpenOptions::DEFAULT)
+                .unwrap()
+                .mesh;
+            println!(
+                "{} {bpv} bpv: filtered then sharpened {}",
+                args[0],
+                e(&project(s))
+            );
+        }
         println!(
             "{} {bpv} bpv ({} B): sharpened {}, two fields {}, five fields {} (fitted ratio {ratio:.3})",
             args[0],
