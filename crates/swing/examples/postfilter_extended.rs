@@ -55,22 +55,23 @@ fn main() {
             .mesh;
         // PROJECT=2: the projections first, then the filter fitted and applied on the
         // vertices that neither the sharpener nor the projections moved.
-        let after = std::env::var("PROJECT").is_ok_and(|v| v == "2");
-        let sharp = if after {
-            let mut x = sharp;
+        // Both projections, as `whet decode --sharpen` applies them when a stream states them
+        // (a mesh they refuse stays as it is, as in the decoder).
+        let projections = |x: &mut Mesh| {
             let b = out.angle_bits;
             let _ = whet_sharpen::flatten_planar_regions(
-                &mut x,
+                x,
                 &whet_sharpen::PlanarOptions::for_swing(b, whet_swing::PLANAR_FACTOR),
             );
             let _ = whet_sharpen::project_onto_local_quadrics(
-                &mut x,
+                x,
                 &whet_sharpen::QuadricOptions::for_swing(b, whet_swing::QUADRIC_FACTOR),
             );
-            x
-        } else {
-            sharp
         };
+        let mut sharp = sharp;
+        if std::env::var("PROJECT").is_ok_and(|v| v == "2") {
+            projections(&mut sharp);
+        }
         let mut free = untouched_by_sharpening(&raw, &sharp);
         // RINGS=k: k more rings around the sharpened part stay put.
         let rings: usize = std::env::var("RINGS")
@@ -141,15 +142,7 @@ fn main() {
         // --sharpen` applies them when the stream states them.
         let project = |mut x: Mesh| -> Mesh {
             if std::env::var("PROJECT").is_ok_and(|v| v == "1") {
-                let b = out.angle_bits;
-                let _ = whet_sharpen::flatten_planar_regions(
-                    &mut x,
-                    &whet_sharpen::PlanarOptions::for_swing(b, whet_swing::PLANAR_FACTOR),
-                );
-                let _ = whet_sharpen::project_onto_local_quadrics(
-                    &mut x,
-                    &whet_sharpen::QuadricOptions::for_swing(b, whet_swing::QUADRIC_FACTOR),
-                );
+                projections(&mut x);
             }
             x
         };

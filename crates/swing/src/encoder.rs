@@ -97,6 +97,10 @@ impl SharpenTrial {
 /// keeps RMS the main figure.
 pub const MAX_ERROR_WEIGHT: f64 = 0.25;
 
+/// What a later sharpening candidate or refinement must beat the score before it by: more
+/// than the sampling noise of a measurement (about 0.3 % at 300 000 samples).
+const SHARPEN_MARGIN: f64 = 0.995;
+
 /// The planar-region projection's tolerance, in angle steps, that the encoder tries after
 /// the best sharpening (`whet_sharpen::PlanarOptions::for_swing`; docs/swing.md section 2):
 /// 2: of 0.6, 1, 1.5, 2 and 3 on the 48 swing rows of the sharpening figures (`planar_sweep`
@@ -565,9 +569,7 @@ impl SwingEncoder {
     /// each.
     fn choose_sharpening(&self, prep: &Prepared, out: SwingOutput) -> Result<SwingOutput, Error> {
         // A candidate's score must beat the ones before it (the default first, no
-        // sharpening last) by more than the sampling noise of a measurement (about 0.3 % at
-        // 300 000 samples).
-        const MARGIN: f64 = 0.995;
+        // sharpening last) by SHARPEN_MARGIN.
         // (method, smooth factor, curved-wall factor; `None`: off). The sharpenings with
         // curved walls come after the others, and every sharpening in two passes after all of
         // them in one, so that each extension is chosen only where it beats what comes before
@@ -673,14 +675,14 @@ impl SwingEncoder {
                 && rms <= none.rms_pct
                 && best
                     .as_ref()
-                    .is_none_or(|(b, _)| trial.score() < MARGIN * b.score())
+                    .is_none_or(|(b, _)| trial.score() < SHARPEN_MARGIN * b.score())
             {
                 best = Some((trial, stream));
             }
         }
         trials.push(none);
         let (mut chosen_trial, stream) = match best {
-            Some((b, s)) if none.score() >= MARGIN * b.score() => (b, s),
+            Some((b, s)) if none.score() >= SHARPEN_MARGIN * b.score() => (b, s),
             _ => (none, None),
         };
         let mut chosen = match stream {
@@ -794,7 +796,7 @@ impl SwingEncoder {
                     bounds,
                     &mut trials,
                 )?;
-                if without_trial.score() < MARGIN * with_trial.score()
+                if without_trial.score() < SHARPEN_MARGIN * with_trial.score()
                     && bounds.admit(&without_trial)
                 {
                     with = without;
@@ -835,7 +837,6 @@ impl SwingEncoder {
         bounds: TrialBounds,
         trials: &mut Vec<SharpenTrial>,
     ) -> Result<(SwingOutput, SharpenTrial), Error> {
-        const MARGIN: f64 = 0.995;
         let (mut chosen, mut current) = start;
         let restated: [fn(SwingOutput) -> Result<SwingOutput, Error>; 2] = [
             |o| restate_planar(o, PLANAR_FACTOR),
@@ -853,7 +854,7 @@ impl SwingEncoder {
                 ..current
             };
             trials.push(trial);
-            if trial.score() < MARGIN * current.score() && bounds.admit(&trial) {
+            if trial.score() < SHARPEN_MARGIN * current.score() && bounds.admit(&trial) {
                 chosen = projected;
                 chosen.rms_pct = Some(rms);
                 current = trial;
@@ -1723,15 +1724,11 @@ fn restate_quadric(mut out: SwingOutput, factor: f64) -> Result<SwingOutput, Err
 /// `out` without header fields 17 and 19 (no surface filter for after sharpening); the
 /// stream shrinks by their bytes.
 fn restate_without_sharpened_filter(mut out: SwingOutput) -> Result<SwingOutput, Error> {
-    let mut container = whet_format::parse(&out.bytes, &whet_codec::Limits::UNLIMITED)
-        .map_err(whet_codec::Error::from)?;
-    container
-        .header
-        .remove(whet_format::tag::SHARPENED_FILTER_NORMAL);
-    container
-        .header
-        .remove(whet_format::tag::SHARPENED_FILTER_SMOOTHED);
-    out.bytes = container.to_bytes().map_err(whet_codec::Error::from)?;
+    out.bytes = with_header(&out.bytes, |mut h| {
+        h.remove(whet_format::tag::SHARPENED_FILTER_NORMAL);
+        h.remove(whet_format::tag::SHARPENED_FILTER_SMOOTHED);
+        h
+    })?;
     out.report.bytes = out.bytes.len();
     out.sharpened_filter = SurfaceFilter::NONE;
     Ok(out)
@@ -1782,9 +1779,18 @@ fn with_header_field(
     tag: u64,
     value: impl Into<whet_format::HeaderValue>,
 ) -> Result<Vec<u8>, Error> {
+    with_header(bytes, |h| h.with(tag, value))
+}
+
+/// The encoder's own stream `bytes` with its header changed by `edit` (the payload is
+/// copied unchanged; the container's checksums are recomputed).
+fn with_header(
+    bytes: &[u8],
+    edit: impl FnOnce(whet_format::Header) -> whet_format::Header,
+) -> Result<Vec<u8>, Error> {
     let mut container = whet_format::parse(bytes, &whet_codec::Limits::UNLIMITED)
         .map_err(whet_codec::Error::from)?;
-    container.header = container.header.clone().with(tag, value);
+    container.header = edit(container.header.clone());
     Ok(container.to_bytes().map_err(whet_codec::Error::from)?)
 }
 
