@@ -124,19 +124,25 @@ impl SurfaceFilter {
             return;
         }
         let normals = unit_normals(&mesh.positions, &mesh.triangles);
-        self.apply_with_normals(mesh, normals, edge_length);
+        self.apply_with_normals(mesh, normals, Given::default(), edge_length);
     }
 
-    /// [`Self::apply`] on a closed mesh (every fan closed) whose per-vertex sums of the
-    /// triangles' cross products `(p1 − p0) × (p2 − p0)` the caller has already: the swing
-    /// walk keeps them for its prediction, so the decoder need not sum them again. The
-    /// walk sums the same products in the same triangle order, but its arithmetic is its own
-    /// code: encoder and decoder pick the same entry point by rule (docs/swing.md section
-    /// 2), so the two never need to agree to the bit.
-    pub(crate) fn apply_closed(&self, mesh: &mut Mesh, mut fan_sums: Vec<DVec3>, edge_length: f64) {
+    /// [`Self::apply`] on a closed mesh (every fan closed) whose per-vertex sums the walk
+    /// that rebuilt it gathered as it added the triangles (`sums`; the walk keeps the cross
+    /// products for its prediction). The walk sums the same products in the same triangle
+    /// order, but its arithmetic is its own code: encoder and decoder pick the same entry
+    /// point by rule (docs/swing.md section 2), so the two never need to agree to the bit.
+    /// The triangle counts and next-corner sums, when given, are the very sums this filter
+    /// makes (integer counts; vector adds in triangle order), so they change no bit.
+    pub(crate) fn apply_closed(&self, mesh: &mut Mesh, sums: WalkSums, edge_length: f64) {
         if self.is_none() {
             return;
         }
+        let WalkSums {
+            fan: mut fan_sums,
+            triangles_at,
+            next_corners,
+        } = sums;
         fan_sums.resize(mesh.positions.len(), DVec3::ZERO);
         for n in &mut fan_sums {
             let len = n.length();
@@ -146,14 +152,29 @@ impl SurfaceFilter {
                 DVec3::ZERO
             };
         }
-        self.apply_with_normals(mesh, fan_sums, edge_length);
+        self.apply_with_normals(
+            mesh,
+            fan_sums,
+            Given {
+                triangles_at,
+                next_corners,
+            },
+            edge_length,
+        );
     }
 
-    fn apply_with_normals(&self, mesh: &mut Mesh, normals: Vec<DVec3>, edge_length: f64) {
+    fn apply_with_normals(
+        &self,
+        mesh: &mut Mesh,
+        normals: Vec<DVec3>,
+        given: Given,
+        edge_length: f64,
+    ) {
         if !self.is_extended() {
             // The two-field filter of format 1.1, to the bit as it always was.
             let (a, b) = self.factors();
-            let (d, s) = normal_fields(&mesh.positions, &mesh.triangles, &normals);
+            let x = fields(&mesh.positions, &mesh.triangles, &normals, false, given);
+            let (d, s) = (x.d, x.s);
             for (((p, n), d), s) in mesh.positions.iter_mut().zip(&normals).zip(&d).zip(&s) {
                 // Finite in, finite out: sums of huge coordinates may overflow, and such a
                 // vertex then stays where it is (on both sides alike).
@@ -164,17 +185,18 @@ impl SurfaceFilter {
             }
             return;
         }
-        self.apply_extended(mesh, &normals, edge_length);
+        self.apply_extended(mesh, &normals, given, edge_length);
     }
 
     /// The extended filter's move (docs/format.md, tags 34 to 38): per vertex with a nonzero
     /// normal, `p ← (p + along · n) + f · t` with `along = ((a d + b s) + c s2) + e q`, kept
     /// only when all three coordinates are finite.
-    fn apply_extended(&self, mesh: &mut Mesh, normals: &[DVec3], edge_length: f64) {
+    fn apply_extended(&self, mesh: &mut Mesh, normals: &[DVec3], given: Given, edge_length: f64) {
         let [a, b, c, e, f] = self.extended_factors();
-        let x = fields(&mesh.positions, &mesh.triangles, normals, true);
-        let s2 = one_ring_mean(&mesh.triangles, &x.s, &x.k);
-        for (v, p) in mesh.positions.iter_mut().enumerate().take(s2.len()) {
+        let x = fields(&mesh.positions, &mesh.triangles, normals, true, given);
+        // `s2` is divided here, vertex by vertex, as `one_ring_mean` would (one pass less).
+        let s2_sums = one_ring_sums(&mesh.triangles, &x.s, &x.k);
+        for (v, p) in mesh.positions.iter_mut().enumerate().take(s2_sums.len()) {
             let n = normals[v];
             if n == DVec3::ZERO {
                 // Boundary vertices and vanishing normals stay put, as in the two-field
@@ -182,7 +204,8 @@ impl SurfaceFilter {
                 continue;
             }
             let d = x.d[v];
-            let along = a * d + b * x.s[v] + c * s2[v] + e * quadratic_field(d, edge_length);
+            let s2 = ring_mean(s2_sums[v], x.k[v]);
+            let along = a * d + b * x.s[v] + c * s2 + e * quadratic_field(d, edge_length);
             let t = tangential_field(x.next_sum[v], x.k[v], *p, n, d);
             let moved = (*p + along * n) + f * t;
             if moved.is_finite() {
@@ -290,7 +313,14 @@ impl FilterFields {
     /// The fields of `mesh`.
     pub fn new(mesh: &Mesh) -> FilterFields {
         let normals = unit_normals(&mesh.positions, &mesh.triangles);
-        let (d, s) = normal_fields(&mesh.positions, &mesh.triangles, &normals);
+        let x = fields(
+            &mesh.positions,
+            &mesh.triangles,
+            &normals,
+            false,
+            Given::default(),
+        );
+        let (d, s) = (x.d, x.s);
         FilterFields {
             normal: normals.iter().zip(&d).map(|(n, d)| *d * *n).collect(),
             smoothed: normals.iter().zip(&s).map(|(n, s)| *s * *n).collect(),
@@ -323,7 +353,13 @@ impl FilterFields {
     /// vertex; the encoder fits the five factors on them.
     pub fn extended(mesh: &Mesh, edge_length: f64) -> (FilterFields, [Vec<DVec3>; 3]) {
         let normals = unit_normals(&mesh.positions, &mesh.triangles);
-        let x = fields(&mesh.positions, &mesh.triangles, &normals, true);
+        let x = fields(
+            &mesh.positions,
+            &mesh.triangles,
+            &normals,
+            true,
+            Given::default(),
+        );
         let s2 = one_ring_mean(&mesh.triangles, &x.s, &x.k);
         let along =
             |f: &[f64]| -> Vec<DVec3> { normals.iter().zip(f).map(|(n, x)| *x * *n).collect() };
@@ -388,21 +424,46 @@ fn unit_normals(pos: &[DVec3], triangles: &[[u32; 3]]) -> Vec<DVec3> {
     normals
 }
 
-/// `d(v)` and `s(v)` of every vertex given its unit normal (zero: `d = 0`), summed in
-/// triangle order in f64, so the encoder and the decoder compute the same bits.
-///
-/// `d(v) = −n · (mean of the neighbours − v) = n · (3k v − Σ corner sums) / 2k`, where the
-/// corner sum of a triangle is `p0 + p1 + p2` and `k` the triangles at `v`: an interior vertex
-/// meets each neighbour twice. `s(v)` is the mean of `d` over `v` and its neighbours (each
-/// once, as the next corner of a triangle).
-fn normal_fields(pos: &[DVec3], triangles: &[[u32; 3]], normals: &[DVec3]) -> (Vec<f64>, Vec<f64>) {
-    let f = fields(pos, triangles, normals, false);
-    (f.d, f.s)
+/// Per-vertex sums of a closed mesh that the swing walk gathered while it added the
+/// triangles, in triangle order (docs/swing.md section 2): what the surface filter would
+/// otherwise sum in a pass of its own.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct WalkSums {
+    /// The sum of the triangles' cross products `(p1 − p0) × (p2 − p0)`.
+    pub(crate) fan: Vec<DVec3>,
+    /// The triangles at the vertex (empty: the filter counts them).
+    pub(crate) triangles_at: Vec<u32>,
+    /// The sum of the next corners of the vertex's triangles, as vectors in triangle order
+    /// (empty: the filter sums them).
+    pub(crate) next_corners: Vec<DVec3>,
+}
+
+impl WalkSums {
+    /// Only the cross products (the filter counts and sums the rest).
+    pub(crate) fn of_fan(fan: Vec<DVec3>) -> WalkSums {
+        WalkSums {
+            fan,
+            ..WalkSums::default()
+        }
+    }
+}
+
+/// Sums [`fields`] takes as given instead of making them (each used only at the mesh's
+/// vertex count; otherwise made).
+#[derive(Default)]
+struct Given {
+    triangles_at: Vec<u32>,
+    next_corners: Vec<DVec3>,
 }
 
 /// The per-vertex sums the filters read.
 struct Fields {
+    /// `d(v) = −n · (mean of the neighbours − v) = n · (3k v − Σ corner sums) / 2k`, where the
+    /// corner sum of a triangle is `p0 + p1 + p2` and `k` the triangles at `v`: an interior
+    /// vertex meets each neighbour twice (0 where the normal is zero or `d` not finite).
     d: Vec<f64>,
+    /// `s(v)`, the mean of `d` over `v` and its neighbours (each once, as the next corner of
+    /// a triangle).
     s: Vec<f64>,
     /// Triangles at each vertex.
     k: Vec<u32>,
@@ -411,30 +472,46 @@ struct Fields {
     next_sum: Vec<DVec3>,
 }
 
-/// `d`, `s` and the triangle counts (see [`normal_fields`]), and with `umbrella` the sums of
-/// next corners too, summed in the same pass (which leaves `d` and `s` as they are without).
-fn fields(pos: &[DVec3], triangles: &[[u32; 3]], normals: &[DVec3], umbrella: bool) -> Fields {
+/// `d`, `s` and the triangle counts of every vertex given its unit normal, and with
+/// `umbrella` the sums of next corners too; all summed in triangle order in f64, so the
+/// encoder and the decoder compute the same bits. Counts and next-corner sums in `given`
+/// (the walk's, [`WalkSums`]) are used as they are, which leaves every bit the same.
+fn fields(
+    pos: &[DVec3],
+    triangles: &[[u32; 3]],
+    normals: &[DVec3],
+    umbrella: bool,
+    given: Given,
+) -> Fields {
     let n = pos.len().min(normals.len());
     let mut d = vec![0.0f64; n];
-    let mut k = vec![0u32; n];
-    let mut next_sum = if umbrella {
+    let count = given.triangles_at.len() != n;
+    let mut k = if count {
+        vec![0u32; n]
+    } else {
+        given.triangles_at
+    };
+    let sum_next = umbrella && given.next_corners.len() != n;
+    let next_sum = if sum_next {
         vec![DVec3::ZERO; n]
+    } else if umbrella {
+        given.next_corners
     } else {
         Vec::new()
     };
-    for t in triangles {
-        let Some([i, j, l]) = corners(t, n) else {
-            continue;
-        };
-        let sum = pos[i] + pos[j] + pos[l];
-        for v in [i, j, l] {
-            d[v] += normals[v].dot(sum);
-            k[v] += 1;
+    let mut next_sum = next_sum;
+    match (count, sum_next) {
+        (true, true) => {
+            corner_sums::<true, true>(pos, triangles, normals, &mut d, &mut k, &mut next_sum)
         }
-        if umbrella {
-            next_sum[i] += pos[j];
-            next_sum[j] += pos[l];
-            next_sum[l] += pos[i];
+        (true, false) => {
+            corner_sums::<true, false>(pos, triangles, normals, &mut d, &mut k, &mut next_sum)
+        }
+        (false, true) => {
+            corner_sums::<false, true>(pos, triangles, normals, &mut d, &mut k, &mut next_sum)
+        }
+        (false, false) => {
+            corner_sums::<false, false>(pos, triangles, normals, &mut d, &mut k, &mut next_sum)
         }
     }
     for v in 0..n {
@@ -450,9 +527,51 @@ fn fields(pos: &[DVec3], triangles: &[[u32; 3]], normals: &[DVec3], umbrella: bo
     Fields { d, s, k, next_sum }
 }
 
+/// The triangle pass of [`fields`]: per corner `n · (p0 + p1 + p2)` into `d`, and with
+/// `COUNT` and `NEXT` the triangle counts and next-corner sums (`d`, `k` and `next_sum` hold
+/// `n` vertices, `normals` at least as many).
+#[inline(always)]
+fn corner_sums<const COUNT: bool, const NEXT: bool>(
+    pos: &[DVec3],
+    triangles: &[[u32; 3]],
+    normals: &[DVec3],
+    d: &mut [f64],
+    k: &mut [u32],
+    next_sum: &mut [DVec3],
+) {
+    let n = d.len();
+    for t in triangles {
+        let Some([i, j, l]) = corners(t, n) else {
+            continue;
+        };
+        let sum = pos[i] + pos[j] + pos[l];
+        for v in [i, j, l] {
+            d[v] += normals[v].dot(sum);
+            if COUNT {
+                k[v] += 1;
+            }
+        }
+        if NEXT {
+            next_sum[i] += pos[j];
+            next_sum[j] += pos[l];
+            next_sum[l] += pos[i];
+        }
+    }
+}
+
 /// `(f(v) + Σ f(next corner)) / (1 + k)` per vertex, 0 where not finite: `s` of `d`, and
 /// `s2` of `s`.
 fn one_ring_mean(triangles: &[[u32; 3]], f: &[f64], k: &[u32]) -> Vec<f64> {
+    let mut s = one_ring_sums(triangles, f, k);
+    for (s, &k) in s.iter_mut().zip(k) {
+        *s = ring_mean(*s, k);
+    }
+    s
+}
+
+/// `f(v) + Σ f(next corner)` per vertex, summed in triangle order (over the first
+/// `min(f.len(), k.len())` vertices).
+fn one_ring_sums(triangles: &[[u32; 3]], f: &[f64], k: &[u32]) -> Vec<f64> {
     let n = f.len().min(k.len());
     let mut s = f[..n].to_vec();
     for t in triangles {
@@ -463,13 +582,19 @@ fn one_ring_mean(triangles: &[[u32; 3]], f: &[f64], k: &[u32]) -> Vec<f64> {
         s[j] += f[l];
         s[l] += f[i];
     }
-    for (s, k) in s.iter_mut().zip(k) {
-        *s /= (1 + k) as f64;
-        if !s.is_finite() {
-            *s = 0.0;
-        }
-    }
     s
+}
+
+/// A one-ring sum over `v` and the next corners of its `k` triangles divided by `1 + k`, 0
+/// where not finite.
+#[inline]
+fn ring_mean(sum: f64, k: u32) -> f64 {
+    let s = sum / (1 + k) as f64;
+    if s.is_finite() {
+        s
+    } else {
+        0.0
+    }
 }
 
 /// `q(v) = d |d| / L`, 0 where not finite.
@@ -631,12 +756,53 @@ mod tests {
         // The extended move with zero extended factors, run directly (the filter never
         // takes it: is_extended is false), lands on the same positions.
         let normals = unit_normals(&five.positions, &five.triangles);
-        f.apply_extended(&mut five, &normals, 1.0);
+        f.apply_extended(&mut five, &normals, Given::default(), 1.0);
         assert_eq!(two.positions, five.positions);
         assert_eq!(
             SurfaceFilter::from_extended_factors([0.3, -0.2, 0.0, 0.0, 0.0]),
             f
         );
+    }
+
+    #[test]
+    fn a_walks_counts_and_next_corner_sums_change_no_bit() {
+        // What the swing walk hands over (cross products, triangle counts, next-corner sums,
+        // gathered in triangle order) against the filter counting and summing them itself.
+        let mut m = octahedron();
+        m.positions[4] = DVec3::new(0.2, -0.1, 1.3);
+        m.positions[1] = DVec3::new(0.1, 0.8, 0.05);
+        let n = m.positions.len();
+        let mut sums = WalkSums {
+            fan: vec![DVec3::ZERO; n],
+            triangles_at: vec![0; n],
+            next_corners: vec![DVec3::ZERO; n],
+        };
+        for t in &m.triangles {
+            let [i, j, k] = t.map(|v| v as usize);
+            let p = [m.positions[i], m.positions[j], m.positions[k]];
+            let c = (p[1] - p[0]).cross(p[2] - p[0]);
+            for (v, next) in [(i, p[1]), (j, p[2]), (k, p[0])] {
+                sums.fan[v] += c;
+                sums.triangles_at[v] += 1;
+                sums.next_corners[v] += next;
+            }
+        }
+        for f in [
+            SurfaceFilter::from_factors(0.3, -0.2),
+            SurfaceFilter::from_extended_factors([0.3, -0.2, 0.15, 0.4, -0.35]),
+        ] {
+            let (mut given, mut counted) = (m.clone(), m.clone());
+            f.apply_closed(&mut given, sums.clone(), 1.0);
+            f.apply_closed(&mut counted, WalkSums::of_fan(sums.fan.clone()), 1.0);
+            let bits = |m: &Mesh| -> Vec<[u64; 3]> {
+                m.positions
+                    .iter()
+                    .map(|p| p.to_array().map(f64::to_bits))
+                    .collect()
+            };
+            assert_eq!(bits(&given), bits(&counted));
+            assert_ne!(given.positions, m.positions, "the filter moved nothing");
+        }
     }
 
     #[test]

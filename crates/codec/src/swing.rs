@@ -52,7 +52,7 @@
 //! Not handled here: the retiling itself (whet-swing).
 
 use crate::exact::{code_positions, ResidualReader, ResidualWriter};
-use crate::surface_filter::{self, SurfaceFilter};
+use crate::surface_filter::{self, SurfaceFilter, WalkSums};
 use crate::{EncodeReport, Error, Quantizer};
 use whet_bits::{BitModel, BitSink, BitTree, RangeDecoder, RangeEncoder, SymbolModel};
 use whet_edgebreaker::{Clers, Connectivity, ConnectivityLimits, Step};
@@ -1284,7 +1284,7 @@ fn encode_forward(
         info.filter.apply(&mut mesh, params.edge_length);
     } else {
         info.filter
-            .apply_closed(&mut mesh, walked.fan, params.edge_length);
+            .apply_closed(&mut mesh, walked.sums, params.edge_length);
     }
     let mut geometry = vec![coding.kind(cutting)];
     geometry.extend_from_slice(&range.finish());
@@ -1380,7 +1380,8 @@ fn encode_retiled_as(
                 mesh = cut(mesh, &retiled.deleted);
                 info.filter.apply(&mut mesh, params.edge_length);
             } else if let (Ok(fan), true) = (walked, coding != IndexCoding::Order0) {
-                info.filter.apply_closed(&mut mesh, fan, params.edge_length);
+                info.filter
+                    .apply_closed(&mut mesh, WalkSums::of_fan(fan), params.edge_length);
             } else {
                 info.filter.apply(&mut mesh, params.edge_length);
             }
@@ -1768,7 +1769,7 @@ pub(crate) fn decode_swing(
                 // As the encoder does: the walk's fan sums on a closed (uncut) predicted
                 // mesh, else the filter's own normals.
                 if !cutting && coding != IndexCoding::Order0 {
-                    filter.apply_closed(&mut mesh, fan, params.edge_length);
+                    filter.apply_closed(&mut mesh, WalkSums::of_fan(fan), params.edge_length);
                 } else {
                     filter.apply(&mut mesh, params.edge_length);
                 }
@@ -1905,7 +1906,7 @@ fn decode_forward(
         if cutting {
             filter.apply(&mut mesh, params.edge_length);
         } else {
-            filter.apply_closed(&mut mesh, walked.fan, params.edge_length);
+            filter.apply_closed(&mut mesh, walked.sums, params.edge_length);
         }
     }
     Ok(mesh)

@@ -240,6 +240,11 @@ struct Rebuilt {
     /// Per vertex, its triangles (at most the triangle count, which the caller bounds far
     /// below `u32::MAX`).
     built: Vec<u32>,
+    /// Per vertex, the sum of the next corners of its triangles, in triangle order: the
+    /// surface filter's umbrella sums, gathered here where the walk holds the positions
+    /// anyway (the walk waits on its chain of divisions and roots, so these adds cost it
+    /// little, and the filter saves a gathering pass).
+    next: Vec<DVec3>,
     /// Per vertex, the residual of its swing index in kinds 9 and 10 (0 for seeds and in
     /// kinds 7 and 8).
     residual: Vec<i32>,
@@ -254,6 +259,7 @@ impl Rebuilt {
             triangles: Vec::with_capacity(triangles),
             fan: Vec::with_capacity(vertices),
             built: Vec::with_capacity(vertices),
+            next: Vec::with_capacity(vertices),
             residual: Vec::with_capacity(vertices),
         }
     }
@@ -263,6 +269,7 @@ impl Rebuilt {
         self.positions.push(p);
         self.fan.push(DVec3::ZERO);
         self.built.push(0);
+        self.next.push(DVec3::ZERO);
         self.residual.push(0);
     }
 
@@ -280,6 +287,9 @@ impl Rebuilt {
             self.fan[v] = add(self.fan[v], n);
             self.built[v] += 1;
         }
+        self.next[i] = add(self.next[i], p1);
+        self.next[j] = add(self.next[j], p2);
+        self.next[k] = add(self.next[k], p0);
         self.triangles.push(t);
         Ok(())
     }
@@ -294,8 +304,9 @@ fn repeated_vertex() -> Error {
 pub(super) struct FrontWalk {
     pub(super) positions: Vec<DVec3>,
     pub(super) triangles: Vec<[u32; 3]>,
-    /// Per vertex, the sum of its triangles' cross products (the surface filter's normals).
-    pub(super) fan: Vec<DVec3>,
+    /// Per vertex, the sums the surface filter reads: its triangles' cross products (the
+    /// normals), their count and their next corners, in triangle order.
+    pub(super) sums: crate::surface_filter::WalkSums,
 }
 
 /// Walks `components` components of `triangles` triangles in all, coding labels, S tips,
@@ -514,6 +525,10 @@ pub(super) fn front_walk<I: FrontIo>(
     Ok(FrontWalk {
         positions: out.positions,
         triangles: out.triangles,
-        fan: out.fan,
+        sums: crate::surface_filter::WalkSums {
+            fan: out.fan,
+            triangles_at: out.built,
+            next_corners: out.next,
+        },
     })
 }
