@@ -323,6 +323,7 @@ impl SwingFrame {
     /// target edge length `edge_length`. `None` when the swing does not exist: the gate is
     /// not shorter than `2 L` (up to a relative 1e-9), the gate has no length, or `c` lies on
     /// the gate's line. Encoder and decoder both call this, so they agree on `None` too.
+    #[inline(always)]
     pub fn new(a: DVec3, b: DVec3, c: DVec3, edge_length: f64) -> Option<SwingFrame> {
         let d = sub(b, a);
         let g2 = dot(d, d);

@@ -148,7 +148,7 @@ impl Predictor {
 
     /// The predicted swing index of the tip over the gate of `frame` and its residual's
     /// contexts: `normal` is `F(a) + F(b)`, `front` the position of the front vertex past `b`.
-    #[inline]
+    #[inline(always)]
     pub(super) fn predict(
         &self,
         frame: &SwingFrame,
