@@ -80,14 +80,39 @@ pub fn resolve_shared_reference(path: &str) -> PathBuf {
     }
 }
 
-/// A scratch folder unique to one test, emptied on creation, under the target directory.
-pub fn scratch_dir(test_name: &str) -> PathBuf {
-    let base = std::env::var_os("CARGO_TARGET_TMPDIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(std::env::temp_dir);
-    let dir = base.join(format!("whet-{}-{}", test_name, std::process::id()));
+/// A scratch folder unique to one test (under the system's temporary folder, named after the
+/// test and the process), emptied on creation and removed when the value is dropped — kept
+/// when the test fails (the thread is panicking), or when `WHET_KEEP_SCRATCH` is set, so the
+/// files can be looked at. Dereferences to its [`Path`](std::path::Path).
+pub fn scratch_dir(test_name: &str) -> ScratchDir {
+    let dir = std::env::temp_dir().join(format!("whet-{}-{}", test_name, std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir)
         .unwrap_or_else(|e| panic!("cannot create {}: {e}", dir.display()));
-    dir
+    ScratchDir(dir)
+}
+
+/// See [`scratch_dir`].
+#[derive(Debug)]
+pub struct ScratchDir(PathBuf);
+
+impl std::ops::Deref for ScratchDir {
+    type Target = std::path::Path;
+    fn deref(&self) -> &std::path::Path {
+        &self.0
+    }
+}
+
+impl AsRef<std::path::Path> for ScratchDir {
+    fn as_ref(&self) -> &std::path::Path {
+        &self.0
+    }
+}
+
+impl Drop for ScratchDir {
+    fn drop(&mut self) {
+        if !std::thread::panicking() && std::env::var_os("WHET_KEEP_SCRATCH").is_none() {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
 }
