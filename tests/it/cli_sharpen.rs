@@ -366,9 +366,10 @@ fn decode_sharpen_follows_the_streams_hint() {
         "sharpened",
         "--json",
     ]);
-    // The encoder measured 25 candidates (both methods at three factors without and with
-    // curved walls, every sharpening in one pass and in two, and none) and kept the lowest
-    // error; then the chosen sharpening once more with the planar-region projection, kept
+    // The encoder measured 24 candidates (both methods at three factors without and with
+    // curved walls, every sharpening in one pass and in two), then the best of them refined
+    // (its smooth factor a quarter up and down, with curved walls each also with the wall
+    // factor one up and one down: 2 or 8 more), and none, and kept the lowest error; then the chosen sharpening once more with the planar-region projection, kept
     // when it beat it, and once more with the local quadric projection on top; then, when
     // its stream carried a filter for after sharpening, the same three without that filter.
     let all = j["sharpen_trials"].as_array().unwrap();
@@ -394,7 +395,7 @@ fn decode_sharpen_follows_the_streams_hint() {
         .filter(|t| t["quadric"] == true)
         .filter(|t| on_path(&t))
         .collect();
-    assert_eq!(trials.len(), 25, "{j}");
+    assert!([25, 27, 33].contains(&trials.len()), "{j}");
     let chosen = j["sharpen_method"].as_str().unwrap();
     assert_eq!(planar.len(), usize::from(chosen != "none"), "{j}");
     assert_eq!(quadric.len(), planar.len(), "{j}");

@@ -680,6 +680,43 @@ impl SwingEncoder {
                 best = Some((trial, stream));
             }
         }
+        // Then the grid refined around its best: the smooth factor a quarter up and down,
+        // and with curved walls the wall factor one up and one down (docs/swing.md section
+        // 2, "Which sharpening": the best of the grid is often between its points, and the
+        // two factors interact). Each must beat the best so far by the margin, as above.
+        if let Some(centre) = best.as_ref().map(|(b, _)| *b) {
+            let refined = refinements(&centre);
+            let streams = match at_bits.encode_at_for(prep, fraction, &refined) {
+                Ok(s) if s.first().is_some_and(|p| p.retiled == out.retiled) => s,
+                Ok(_) | Err(Error::Stuck(_)) => Vec::new(),
+                Err(e) => return Err(e),
+            };
+            for (c, p) in refined.iter().zip(streams) {
+                let opts = c.sharpen_options();
+                let ((rms, max), _) =
+                    self.measure_sharpened(prep, &p, &input, &opts, &mut measured, false)?;
+                let trial = SharpenTrial {
+                    hint: centre.hint,
+                    smooth_factor: c.smooth_factor,
+                    curved_walls: opts.curved_walls(),
+                    passes: opts.passes,
+                    rms_pct: rms,
+                    max_pct: max,
+                    planar: false,
+                    quadric: false,
+                    sharpened_filter: true,
+                };
+                trials.push(trial);
+                if max <= input_max
+                    && rms <= none.rms_pct
+                    && best
+                        .as_ref()
+                        .is_none_or(|(b, _)| trial.score() < SHARPEN_MARGIN * b.score())
+                {
+                    best = Some((trial, Some(p)));
+                }
+            }
+        }
         trials.push(none);
         let (mut chosen_trial, stream) = match best {
             Some((b, s)) if none.score() >= SHARPEN_MARGIN * b.score() => (b, s),
@@ -1690,6 +1727,48 @@ impl Candidate {
             None => opts,
         }
     }
+}
+
+/// Step of the refinement of the chosen smooth factor (`refinements`).
+const SMOOTH_FACTOR_STEP: f64 = 0.25;
+
+/// Step of the refinement of the chosen curved-wall factor (`refinements`); the factors stay
+/// within what a stream can state (1 to 4).
+const CURVED_WALL_STEP: f64 = 1.0;
+
+/// The sharpenings around `centre`, the best of the candidates' grid: the same method and
+/// passes, the smooth factor `SMOOTH_FACTOR_STEP` up and down, and with curved walls each of
+/// those with the wall factor `CURVED_WALL_STEP` up and down too (8 around a sharpening with
+/// curved walls, 2 around one without).
+fn refinements(centre: &SharpenTrial) -> Vec<Candidate> {
+    let s = centre.smooth_factor;
+    let smooth = [s - SMOOTH_FACTOR_STEP, s, s + SMOOTH_FACTOR_STEP];
+    let walls: Vec<Option<f64>> = if centre.curved_walls > 0.0 {
+        let w = centre.curved_walls;
+        [w - CURVED_WALL_STEP, w, w + CURVED_WALL_STEP]
+            .into_iter()
+            .filter(|&w| SharpenHint::curved_walls_code(w).is_some_and(|h| h > 0))
+            .map(Some)
+            .collect()
+    } else {
+        vec![None]
+    };
+    let mut out = Vec::new();
+    for &smooth_factor in &smooth {
+        for &curved_walls in &walls {
+            let same = smooth_factor == s && curved_walls.unwrap_or(0.0) == centre.curved_walls;
+            let stated = SharpenHint::smooth_factor_code(smooth_factor).is_some();
+            if !same && stated {
+                out.push(Candidate {
+                    hint: Some(centre.hint),
+                    smooth_factor,
+                    curved_walls,
+                    passes: centre.passes,
+                });
+            }
+        }
+    }
+    out
 }
 
 /// Most bytes the sharpening choice (`--optimize-for sharpened`) adds to the size search's
