@@ -48,8 +48,10 @@ impl Default for DecodeOptions {
 
 /// What the exact and swing decoders hold at their peak per declared triangle, and per
 /// declared vertex, rounded up from measurements (`whet decode` of a 848k-triangle exact
-/// stream: 58.5 MB resident; of a 1.05M-triangle swing stream: 57.8 MB; 2026-12-02). Their
-/// sum over the header's counts is held against [`Limits::max_alloc_bytes`] before decoding.
+/// stream: 58.5 MB resident; of a 1.05M-triangle swing stream: 57.8 MB; 2026-12-02; of a
+/// 1.107M-triangle, 553k-vertex swing stream with the extended surface filter: 76.1 MB,
+/// 2026-12-05, against the 93 MB this estimate gives). Their sum over the header's counts is
+/// held against [`Limits::max_alloc_bytes`] before decoding.
 pub const DECODE_BYTES_PER_TRIANGLE: u64 = 60;
 /// See [`DECODE_BYTES_PER_TRIANGLE`].
 pub const DECODE_BYTES_PER_VERTEX: u64 = 48;

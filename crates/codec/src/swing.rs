@@ -1838,8 +1838,16 @@ fn decode_forward(
             "connectivity section has trailing bytes".into(),
         ));
     }
+    // Every component has at least two triangles (a pillow: the seed and its back face).
+    if components == 0 || components.saturating_mul(2) > n {
+        return Err(Error::Corrupt(format!(
+            "{components} components cannot hold {n} triangles"
+        )));
+    }
     // The walk may hold more triangles than the output (those deleted over holes): bounded
-    // by the caller's face limit, and by its byte limit at the decoders' peak per triangle.
+    // by the caller's face limit, and by its byte limit at the decoders' peak per triangle
+    // and per vertex of the closed mesh it builds (at most half its triangles plus two per
+    // component: Euler's formula, genus 0 the most).
     let max = opts.limits.max_faces;
     if n > max {
         return Err(whet_format::Error::LimitExceeded {
@@ -1849,7 +1857,10 @@ fn decode_forward(
         }
         .into());
     }
-    let peak = n.saturating_mul(crate::DECODE_BYTES_PER_TRIANGLE);
+    let vertices = (n / 2).saturating_add(components.saturating_mul(2));
+    let peak = n
+        .saturating_mul(crate::DECODE_BYTES_PER_TRIANGLE)
+        .saturating_add(vertices.saturating_mul(crate::DECODE_BYTES_PER_VERTEX));
     if peak > opts.limits.max_alloc_bytes {
         return Err(whet_format::Error::LimitExceeded {
             what: crate::DECODE_PEAK_LIMIT,
@@ -1866,12 +1877,6 @@ fn decode_forward(
             value: n,
         }
         .into());
-    }
-    // Every component has at least two triangles (a pillow: the seed and its back face).
-    if components == 0 || components.saturating_mul(2) > n {
-        return Err(Error::Corrupt(format!(
-            "{components} components cannot hold {n} triangles"
-        )));
     }
     let mut dec = RangeDecoder::new(payload).map_err(|_| Error::Truncated("geometry"))?;
     let mut io = FrontReader {
@@ -2160,6 +2165,47 @@ mod tests {
         let bad = container.to_bytes().unwrap();
         let err = crate::decode(&bad, &crate::DecodeOptions::DEFAULT).unwrap_err();
         assert!(err.to_string().contains("surface filter"), "{err}");
+    }
+
+    #[test]
+    fn the_walks_filter_sums_decode_the_bits_the_filters_own_counting_does() {
+        // A real stream with the extended filter (the fuzz seed of a synth torus-box): its
+        // decode, whose filter takes the walk's triangle counts and next-corner sums, against
+        // the filter counting and summing them itself on the unfiltered decode, from the
+        // same fan sums (the walk's cross products, in triangle order).
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../fuzz/corpus/decode/seed-swing-extended-filter.whet");
+        let bytes = std::fs::read(path).unwrap();
+        let decoded = crate::decode(&bytes, &crate::DecodeOptions::DEFAULT).unwrap();
+        let raw = crate::decode(
+            &bytes,
+            &crate::DecodeOptions::DEFAULT.with_surface_filter(false),
+        )
+        .unwrap();
+        let c = whet_format::parse(&bytes, &crate::Limits::DEFAULT).unwrap();
+        let h = &c.header;
+        let filter = SurfaceFilter {
+            normal: h.get_i64(tag::FILTER_NORMAL).unwrap_or(0),
+            smoothed: h.get_i64(tag::FILTER_SMOOTHED).unwrap_or(0),
+            smoothed2: h.get_i64(tag::FILTER_SMOOTHED2).unwrap_or(0),
+            quadratic: h.get_i64(tag::FILTER_QUADRATIC).unwrap_or(0),
+            tangential: h.get_i64(tag::FILTER_TANGENTIAL).unwrap_or(0),
+        };
+        assert!(filter.is_extended());
+        let mut fan = vec![DVec3::ZERO; raw.positions.len()];
+        for t in &raw.triangles {
+            let [i, j, k] = t.map(|v| v as usize);
+            let p = &raw.positions;
+            let n = cross(sub(p[j], p[i]), sub(p[k], p[i]));
+            for v in [i, j, k] {
+                fan[v] = add(fan[v], n);
+            }
+        }
+        let mut counted = raw.clone();
+        let l = h.get_f64(tag::EDGE_LENGTH).unwrap();
+        filter.apply_closed(&mut counted, WalkSums::of_fan(fan), l);
+        assert_eq!(position_bits(&counted), position_bits(&decoded));
+        assert_ne!(position_bits(&raw), position_bits(&decoded));
     }
 
     #[test]
