@@ -278,6 +278,19 @@ impl SurfaceFilter {
         }
     }
 
+    /// The filter a swing stream's header states (fields 14, 16, 34, 36 and 38; an absent
+    /// field is 0), as coded: the caller checks [`Self::in_range`].
+    pub fn of_header(header: &whet_format::Header) -> SurfaceFilter {
+        let get = |t| header.get_i64(t).unwrap_or(0);
+        SurfaceFilter {
+            normal: get(whet_format::tag::FILTER_NORMAL),
+            smoothed: get(whet_format::tag::FILTER_SMOOTHED),
+            smoothed2: get(whet_format::tag::FILTER_SMOOTHED2),
+            quadratic: get(whet_format::tag::FILTER_QUADRATIC),
+            tangential: get(whet_format::tag::FILTER_TANGENTIAL),
+        }
+    }
+
     /// The filter a swing stream's header gives for after sharpening (fields 17 and 19);
     /// [`Self::NONE`] for other streams, without the fields, or with a factor out of
     /// range.
@@ -492,14 +505,13 @@ fn fields(
         given.triangles_at
     };
     let sum_next = umbrella && given.next_corners.len() != n;
-    let next_sum = if sum_next {
+    let mut next_sum = if sum_next {
         vec![DVec3::ZERO; n]
     } else if umbrella {
         given.next_corners
     } else {
         Vec::new()
     };
-    let mut next_sum = next_sum;
     match (count, sum_next) {
         (true, true) => {
             corner_sums::<true, true>(pos, triangles, normals, &mut d, &mut k, &mut next_sum)

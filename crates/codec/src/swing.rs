@@ -1679,13 +1679,7 @@ pub(crate) fn decode_swing(
             "edge length {edge_length} is not positive and finite"
         )));
     }
-    let filter = SurfaceFilter {
-        normal: h.get_i64(tag::FILTER_NORMAL).unwrap_or(0),
-        smoothed: h.get_i64(tag::FILTER_SMOOTHED).unwrap_or(0),
-        smoothed2: h.get_i64(tag::FILTER_SMOOTHED2).unwrap_or(0),
-        quadratic: h.get_i64(tag::FILTER_QUADRATIC).unwrap_or(0),
-        tangential: h.get_i64(tag::FILTER_TANGENTIAL).unwrap_or(0),
-    };
+    let filter = SurfaceFilter::of_header(h);
     if !filter.in_range() {
         return Err(Error::Corrupt(format!(
             "surface filter factors {:?} out of range (at most {} in magnitude)",
@@ -2184,13 +2178,7 @@ mod tests {
         .unwrap();
         let c = whet_format::parse(&bytes, &crate::Limits::DEFAULT).unwrap();
         let h = &c.header;
-        let filter = SurfaceFilter {
-            normal: h.get_i64(tag::FILTER_NORMAL).unwrap_or(0),
-            smoothed: h.get_i64(tag::FILTER_SMOOTHED).unwrap_or(0),
-            smoothed2: h.get_i64(tag::FILTER_SMOOTHED2).unwrap_or(0),
-            quadratic: h.get_i64(tag::FILTER_QUADRATIC).unwrap_or(0),
-            tangential: h.get_i64(tag::FILTER_TANGENTIAL).unwrap_or(0),
-        };
+        let filter = SurfaceFilter::of_header(h);
         assert!(filter.is_extended());
         let mut fan = vec![DVec3::ZERO; raw.positions.len()];
         for t in &raw.triangles {

@@ -645,10 +645,18 @@ impl SwingEncoder {
         // Candidates whose output is the same mesh (curved walls that turn no edge smooth, a
         // second pass that changes nothing) are measured once.
         let mut measured = Vec::new();
+        // A candidate takes the place of the best so far when it keeps the max within the
+        // input's and the RMS within no sharpening's, and beats it by the margin.
+        let improves = |t: &SharpenTrial, best: &Option<(SharpenTrial, Option<SwingOutput>)>| {
+            t.max_pct <= input_max
+                && t.rms_pct <= none.rms_pct
+                && best
+                    .as_ref()
+                    .is_none_or(|(b, _)| t.score() < SHARPEN_MARGIN * b.score())
+        };
         for (i, c) in candidates.iter().enumerate() {
-            let (hint, smooth_factor) = (c.hint.unwrap_or(SharpenHint::Extended), c.smooth_factor);
             let opts = c.sharpen_options();
-            let (((rms, max), _), stream) = if i == 0 {
+            let ((figures, _), stream) = if i == 0 {
                 // `out` was encoded for this one.
                 let f = self.measure_sharpened(prep, &out, &input, &opts, &mut measured, false)?;
                 (f, None)
@@ -659,24 +667,9 @@ impl SwingEncoder {
                     Some(p),
                 )
             };
-            let trial = SharpenTrial {
-                hint,
-                smooth_factor,
-                curved_walls: opts.curved_walls(),
-                passes: opts.passes,
-                rms_pct: rms,
-                max_pct: max,
-                planar: false,
-                quadric: false,
-                sharpened_filter: true,
-            };
+            let trial = c.trial(figures);
             trials.push(trial);
-            if max <= input_max
-                && rms <= none.rms_pct
-                && best
-                    .as_ref()
-                    .is_none_or(|(b, _)| trial.score() < SHARPEN_MARGIN * b.score())
-            {
+            if improves(&trial, &best) {
                 best = Some((trial, stream));
             }
         }
@@ -693,26 +686,11 @@ impl SwingEncoder {
             };
             for (c, p) in refined.iter().zip(streams) {
                 let opts = c.sharpen_options();
-                let ((rms, max), _) =
+                let (figures, _) =
                     self.measure_sharpened(prep, &p, &input, &opts, &mut measured, false)?;
-                let trial = SharpenTrial {
-                    hint: centre.hint,
-                    smooth_factor: c.smooth_factor,
-                    curved_walls: opts.curved_walls(),
-                    passes: opts.passes,
-                    rms_pct: rms,
-                    max_pct: max,
-                    planar: false,
-                    quadric: false,
-                    sharpened_filter: true,
-                };
+                let trial = c.trial(figures);
                 trials.push(trial);
-                if max <= input_max
-                    && rms <= none.rms_pct
-                    && best
-                        .as_ref()
-                        .is_none_or(|(b, _)| trial.score() < SHARPEN_MARGIN * b.score())
-                {
+                if improves(&trial, &best) {
                     best = Some((trial, Some(p)));
                 }
             }
@@ -1725,6 +1703,23 @@ impl Candidate {
         match self.curved_walls {
             Some(w) => opts.with_curved_wall_factor(w),
             None => opts,
+        }
+    }
+
+    /// Its record, from its measured `(RMS, max)` (% of the diagonal): unprojected, with
+    /// its filter for after sharpening.
+    fn trial(&self, (rms_pct, max_pct): (f64, f64)) -> SharpenTrial {
+        let opts = self.sharpen_options();
+        SharpenTrial {
+            hint: self.hint.unwrap_or(SharpenHint::Extended),
+            smooth_factor: self.smooth_factor,
+            curved_walls: opts.curved_walls(),
+            passes: opts.passes,
+            rms_pct,
+            max_pct,
+            planar: false,
+            quadric: false,
+            sharpened_filter: true,
         }
     }
 }
