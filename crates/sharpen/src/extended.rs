@@ -531,9 +531,14 @@ fn deep_vertices(run: &Run) -> (Vec<bool>, Vec<u32>) {
 /// An inner edge of a region (both triangles in it) that turns by more than this many smooth
 /// thresholds is a crease the region reaches around: see [`demote_strip_arms`]. Measured on
 /// the synth table (docs/results.md, "Strip arms"): 4 found only fandisk 64 r1's and the
-/// pyramid's arms; 3 also fandisk 48 r1's; 2.5 found a narrow corner region of the pyramid at
-/// 48 r1 (max 2.16x -> 1.06x) and cube 32 r0 lost max.
-pub(crate) const STRONG_INNER_TURN: f64 = 3.0;
+/// pyramid's arms; 3 also part of fandisk 48 r1's, whose rest turns from its face by 25
+/// degrees, 2.5 thresholds (on 2026-12-03, before the rule that exactly one side be thin, 2.5
+/// demoted a narrow corner region of the pyramid at 48 r1). Swept again on 2026-12-05
+/// ("Strip arms, a lower turn"): 2.4 leaves fandisk 48 r1 at 2.95x RMS; 2.2 to 1.8 take it
+/// over 3x and lower the RMS of 8 to 12 other rows, no max gain falling under 2x; 1.6
+/// demotes real faces (pyramid 96 r0 max 3.36x -> 1.87x, fandisk 64 r1 2.13x -> 1.87x). 2 is
+/// the middle of the range that works.
+pub(crate) const STRONG_INNER_TURN: f64 = 2.0;
 
 /// How many triangles [`demote_strip_arms`] grows from one side of a strong inner edge,
 /// through smooth edges of the region, looking for a deep vertex.

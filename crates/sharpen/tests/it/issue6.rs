@@ -470,12 +470,15 @@ fn issue6_a_cluster_refused_for_its_neighbours_sliver_is_welded_after_it() {
     // onto the crease. Refused clusters now get one more try after the others (docs/
     // sharpen.md, "What we extend", step 10; docs/results.md, "A second try for refused
     // clusters", 1M samples: max gain 1.62x -> 2.22x). Measured here at 50k samples before
-    // and after: 1.62x -> 2.22x, 39 -> 42 welded vertices; the bound sits between.
+    // and after: 1.62x -> 2.22x, 39 -> 42 welded vertices; the bound sits between. The
+    // count is of vertices still welded after the run (the clusters it left untouched are
+    // put back): with strip arms found from a turn of 2 smooth thresholds instead of 3
+    // (2026-12-05) the run sharpens more around clusters and 48 stay welded.
     let (max_gain, _) = sound_gains(ShapeKind::Cube, 32, 0);
     assert!(max_gain >= 2.0, "{max_gain:.2}x");
     let (_, input) = sampled(ShapeKind::Cube, 32, 0);
     let out = sharpen(&input, &SharpenOptions::DEFAULT).unwrap();
-    assert_eq!(out.report.welded_vertices, 42);
+    assert_eq!(out.report.welded_vertices, 48);
 }
 
 #[test]
