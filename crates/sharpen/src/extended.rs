@@ -991,6 +991,12 @@ fn gray_vertices(run: &mut Run) {
 #[inline(never)] // one call per run; kept out of line so profiles show it
 fn crease_vertices(run: &mut Run) {
     let nv = run.mesh.positions.len();
+    // The mesh's mean edge serves chamfer (gray) vertices only: one pass where there are any.
+    let mesh_mean = if run.s.vflags.iter().any(|&f| f & V_CHAMFER != 0) {
+        run.table.mean_edge_length(&run.mesh.positions)
+    } else {
+        0.0
+    };
     let mut extra: Vec<(u32, LabelPlane)> = Vec::new();
     let mut found: Vec<LabelPlane> = Vec::new();
     for v in 0..nv as u32 {
@@ -1025,7 +1031,18 @@ fn crease_vertices(run: &mut Run) {
         } else {
             RED_CREASE_TOLERANCE
         };
-        let tol = factor * len / k as f64;
+        let local = len / k as f64;
+        let tol = factor * local;
+        // Marching cubes cuts a chamfer as deep as its grid cell whatever the local
+        // triangles, so a chamfer vertex among short edges is also measured against the
+        // mesh's mean edge; a label admitted only that way must not complete a corner (a
+        // triangle around the vertex reaching a third surface), whose point could lie off
+        // the part.
+        let wide = if chamfer {
+            factor * local.max(mesh_mean)
+        } else {
+            tol
+        };
         for &lp in &found {
             // A chamfer vertex inside an acute cut lies deeper under both planes (marching
             // cubes cuts a wedge `acute_reach` times deeper than a right angle): synth pyramid,
@@ -1037,7 +1054,8 @@ fn crease_vertices(run: &mut Run) {
             } else {
                 1.0
             };
-            if (p - lp.plane.point).dot(lp.plane.normal).abs() <= tol * reach {
+            let d = (p - lp.plane.point).dot(lp.plane.normal).abs();
+            if d <= tol * reach || (d <= wide * reach && !completes_corner(run, v, &lp)) {
                 extra.push((v, lp));
             }
         }
@@ -1063,6 +1081,27 @@ fn crease_vertices(run: &mut Run) {
         run.s.lp_len[v] = len as u8;
     }
     run.s.lps = lps;
+}
+
+/// Whether giving `v` the label `lp` makes a triangle around it reach three surfaces that its
+/// vertices' labels did not reach before.
+fn completes_corner(run: &Run, v: u32, lp: &LabelPlane) -> bool {
+    let mut seen: Vec<LabelPlane> = Vec::new();
+    for c in run.table.vertex_corners(VertexId(v)) {
+        seen.clear();
+        let t = c.index() / 3;
+        for &u in &run.mesh.triangles[t] {
+            for q in planes_of(run, u) {
+                if seen.iter().all(|o| !same_surface(run, o, q)) {
+                    seen.push(*q);
+                }
+            }
+        }
+        if seen.len() == 2 && seen.iter().all(|o| !same_surface(run, o, lp)) {
+            return true;
+        }
+    }
+    false
 }
 
 /// Planes a vertex may be moved onto must meet at angles of at least twice the smooth
