@@ -991,8 +991,9 @@ fn gray_vertices(run: &mut Run) {
 #[inline(never)] // one call per run; kept out of line so profiles show it
 fn crease_vertices(run: &mut Run) {
     let nv = run.mesh.positions.len();
-    // The mesh's mean edge serves chamfer (gray) vertices only: one pass where there are any.
-    let mesh_mean = if run.s.vflags.iter().any(|&f| f & V_CHAMFER != 0) {
+    // The mesh's mean edge serves chamfer (gray) vertices only, which `gray_vertices` has
+    // just counted: one pass where there are any.
+    let mesh_mean = if run.report.chamfer_vertices > 0 {
         run.table.mean_edge_length(&run.mesh.positions)
     } else {
         0.0
