@@ -21,7 +21,8 @@
 //! reference, into how many pieces it was cut) and the vertices there in the frame of the two
 //! nearest reference faces; `DIAG_V=<vertex>` prints that input vertex's input and output
 //! positions; `DIAG_AT=x,y,z` dumps the neighbourhood of that point instead of the worst
-//! place; `DIAG_NO_WELD=1` turns off the extended method's cluster welding (`--no-weld`).
+//! place; `DIAG_NO_WELD=1` turns off the extended method's cluster welding (`--no-weld`);
+//! `DIAG_SAMPLES=<n>` sets Metro's samples a direction (300k; `0`: the default of `sharpen_figures`).
 
 mod support;
 mod swing_inputs;
@@ -139,7 +140,16 @@ fn main() {
             }
         }
     }
-    let opts = MetroOptions::DEFAULT.with_samples(300_000);
+    // 300k samples a direction unless `DIAG_SAMPLES` says otherwise (`0`: Metro's default,
+    // what `sharpen_figures` measures with).
+    let opts = match std::env::var("DIAG_SAMPLES")
+        .ok()
+        .and_then(|s| s.parse().ok())
+    {
+        Some(0) => MetroOptions::DEFAULT,
+        Some(n) => MetroOptions::DEFAULT.with_samples(n),
+        None => MetroOptions::DEFAULT.with_samples(300_000),
+    };
     let before = or_die(metro(&reference, &input, &opts), "metro");
     let after = or_die(metro(&reference, &out.mesh, &opts), "metro");
     println!(
@@ -148,6 +158,11 @@ fn main() {
         after.symmetric.rms_pct,
         before.symmetric.max_pct,
         after.symmetric.max_pct
+    );
+    println!(
+        "gains: RMS {:.3}x, max {:.3}x",
+        before.symmetric.rms_pct / after.symmetric.rms_pct,
+        before.symmetric.max_pct / after.symmetric.max_pct
     );
     println!(
         "after: forward (output to reference) max {:.3}%, backward max {:.3}%",

@@ -77,6 +77,7 @@ const JOIN_TOLERANCE: f64 = 0.05;
 
 /// Pieces thinner than this (degrees) are left to the sliver pass by the orientation check of
 /// `settle_positions`: their normal is dominated by rounding and snapping noise.
+const MAX_RETREATS: u8 = 2;
 const SETTLE_MIN_ANGLE: f64 = 5.0;
 
 /// How far settling may move an input vertex that a snap folds over, in mean edges around it
@@ -1458,15 +1459,16 @@ impl<'a> Run<'a> {
         folded
     }
 
-    /// Extended method: whether `tri` is input triangle `parent` itself (no piece of it) and
-    /// faced against the plane its vertices lie on best ([`Run::expected_normal`]) at their
-    /// rest positions already: a triangle marching cubes folded, not one the moves turned.
+    /// Extended method: whether `tri`, input triangle `parent` or a piece of it, faced against
+    /// the plane its vertices lie on best ([`Run::expected_normal`]) at their rest positions
+    /// already: a triangle marching cubes folded, not one the moves turned. At rest a piece
+    /// lies in its parent's plane, so this is the parent facing against that plane: a chamfer
+    /// triangle across a corner can face a third surface more than either plane of its
+    /// crease (synth fandisk 128 r0: a split snapped onto the crease turned its piece towards
+    /// the plane, from -0.53 to -0.33, and was unsnapped for it, leaving the max error at its
+    /// rest position).
     fn folded_at_rest(&self, tri: &[u32; 3], parent: usize) -> bool {
         if self.opts.method == Method::Papers {
-            return false;
-        }
-        let m = self.mesh.triangles[parent];
-        if !(0..3).any(|k| *tri == [m[k], m[(k + 1) % 3], m[(k + 2) % 3]]) {
             return false;
         }
         let n = self.expected_normal(tri, parent);
@@ -1752,6 +1754,7 @@ impl<'a> Run<'a> {
         reset(&mut self.s.settled_ok, self.s.touched.len(), 0);
         let mut projected: Vec<u32> = Vec::new();
         let mut cornered: Vec<u32> = Vec::new();
+        let mut retreats: Vec<u8> = Vec::new();
         while let Some(t) = stack.pop() {
             let t = t as usize;
             self.choose_diagonal(t);
@@ -1783,9 +1786,11 @@ impl<'a> Run<'a> {
                         // folded against it (synth pyramid 64 r1, fandisk 64 r0).
                         let nv = self.mesh.positions.len();
                         if victim.is_some_and(|(v, _)| (v as usize) < nv)
-                            && piece
-                                .iter()
-                                .any(|&u| u as usize >= nv && !self.is_snapped(u))
+                            && piece.iter().any(|&u| {
+                                u as usize >= nv
+                                    && (!self.is_snapped(u)
+                                        || retreats.get(u as usize - nv).is_some_and(|&r| r > 0))
+                            })
                         {
                             victim = None;
                         }
@@ -1831,7 +1836,9 @@ impl<'a> Run<'a> {
             let i = self.s.touched_index[t] as usize;
             self.s.settled_ok[i] = ok;
             if let Some((v, reason)) = victim {
-                self.unsnap(v, reason);
+                if !self.retreat(v, reason, &mut retreats) {
+                    self.unsnap(v, reason);
+                }
                 for u in self.triangles_of(v) {
                     if self.s.tflags[u as usize] & T_TOUCHED != 0 {
                         stack.push(u);
@@ -1840,6 +1847,31 @@ impl<'a> Run<'a> {
             }
         }
         self.s.stack = stack;
+    }
+
+    /// Settling's last alternative to unsnapping a new vertex whose move reverses a piece
+    /// (extended method): move it back half way towards its rest position, up to
+    /// `MAX_RETREATS` times, before giving the move up (docs/sharpen.md, step 16).
+    fn retreat(&mut self, v: u32, reason: UnmovedReason, retreats: &mut Vec<u8>) -> bool {
+        let nv = self.mesh.positions.len();
+        if self.opts.method == Method::Papers
+            || reason != UnmovedReason::Flipped
+            || (v as usize) < nv
+        {
+            return false;
+        }
+        if retreats.is_empty() {
+            retreats.resize(self.s.new_vertices.len(), 0);
+        }
+        let count = &mut retreats[v as usize - nv];
+        if *count >= MAX_RETREATS {
+            return false;
+        }
+        *count += 1;
+        let rest = self.s.new_vertices[v as usize - nv].rest;
+        let p = &mut self.positions[v as usize];
+        *p = rest + (*p - rest) * 0.5;
+        true
     }
 
     /// Settling's other alternative to unsnapping a split (extended method): a split snapped
