@@ -11,6 +11,9 @@
 //! - the papers' one: collapse the edge opposite the smallest angle, removing its new end
 //!   (input vertices are never removed); taken whenever it is valid and leaves no thin
 //!   triangle;
+//! - if it is not valid, merging a new vertex into a neighbour at the same point (of the
+//!   triangle's vertices or of theirs), which changes no geometry: a cluster of three
+//!   coincident corner vertices has no valid collapse inside one of its triangles;
 //! - otherwise the best valid one (largest smallest angle among the triangles it makes) of:
 //!   collapsing any edge of the triangle with a new end, collapsing a new vertex back into an
 //!   end of the edge it split (undoing the split), and flipping an edge of the triangle. Flips
@@ -231,6 +234,10 @@ enum Op {
     /// Flip the edge of slot `s` opposite its corner `k`; `s2` is the slot across.
     Flip { s: u32, k: u8, s2: u32 },
 }
+
+/// Two vertices closer than this fraction of a triangle's longest edge are one point to the
+/// sliver pass's coincident merge (vertices moved onto one corner point differ by rounding).
+const COINCIDENT: f64 = 1e-6;
 
 /// Triangle equality up to rotation (same orientation).
 #[inline]
@@ -512,6 +519,17 @@ impl Output {
                 return Some(op);
             }
         }
+        // A new vertex coinciding with a neighbour merges into it first, whether or not that
+        // neighbour is in this triangle: it changes no geometry. Where three vertices of a
+        // corner coincide (a moved corner vertex, a split joined to the corner and a centre)
+        // no pair of them in one triangle may collapse first (a third common neighbour), and
+        // the best of the rest moved the split onto an end of its edge, cutting the corner
+        // again (synth fandisk 64 r0).
+        if best.is_none() {
+            if let Some(op) = self.coincident_merge(run, local, &tri, &p) {
+                return Some(op);
+            }
+        }
         // Everything else.
         for &(_, k) in &order[1..] {
             let (a, b) = (tri[(k + 1) % 3], tri[(k + 2) % 3]);
@@ -550,6 +568,44 @@ impl Output {
                         },
                         &mut best,
                     );
+                }
+            }
+        }
+        best.map(|(_, op)| op)
+    }
+
+    /// A valid collapse of a new vertex into a neighbour at the same position, for a vertex of
+    /// `tri` (positions `p`) or a neighbour of one: the one whose triangles come out best.
+    fn coincident_merge(
+        &self,
+        run: &Run,
+        local: &Local,
+        tri: &[u32; 3],
+        p: &[DVec3; 3],
+    ) -> Option<Op> {
+        let nv = run.mesh.positions.len() as u32;
+        let longest = (0..3)
+            .map(|k| p[k].distance_squared(p[(k + 1) % 3]))
+            .fold(0.0f64, f64::max);
+        let tol2 = COINCIDENT * COINCIDENT * longest;
+        let mut best: Option<(f64, Op)> = None;
+        let mut around = Vec::new();
+        for &x in tri {
+            self.triangles_at(run, local, x, &mut around);
+            let px = run.positions[x as usize];
+            for y in Self::neighbours(&around, x) {
+                if run.positions[y as usize].distance_squared(px) > tol2 {
+                    continue;
+                }
+                for (u, w) in [(x, y), (y, x)] {
+                    if u < nv {
+                        continue;
+                    }
+                    if let Some(q) = self.collapse_quality(run, local, u, w) {
+                        if best.as_ref().is_none_or(|(bq, _)| q > *bq) {
+                            best = Some((q, Op::Collapse { u, w }));
+                        }
+                    }
                 }
             }
         }
