@@ -77,8 +77,14 @@ const JOIN_TOLERANCE: f64 = 0.05;
 
 /// Pieces thinner than this (degrees) are left to the sliver pass by the orientation check of
 /// `settle_positions`: their normal is dominated by rounding and snapping noise.
-const MAX_RETREATS: u8 = 2;
 const SETTLE_MIN_ANGLE: f64 = 5.0;
+
+/// How many times settling moves a new vertex whose move reverses a piece back half way
+/// towards its rest position before it unsnaps it ([`Run::retreat`]), leaving 1/16 of the
+/// move at most. Swept on the synth table (docs/results.md, "How many half moves"): one
+/// loses fandisk 64 r0 and 96 r0 their max gain over 2x, two reach 28 of 30 rows, four
+/// lower the max on three more rows (cube 96 r0 2.46x -> 2.71x), six give what four give.
+const MAX_RETREATS: u8 = 4;
 
 /// How far settling may move an input vertex that a snap folds over, in mean edges around it
 /// (`Run::project_inside_vertex`), unless a snapped vertex of the folding piece moved farther:
