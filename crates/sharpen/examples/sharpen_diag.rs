@@ -22,7 +22,8 @@
 //! nearest reference faces; `DIAG_V=<vertex>` prints that input vertex's input and output
 //! positions; `DIAG_AT=x,y,z` dumps the neighbourhood of that point instead of the worst
 //! place; `DIAG_NO_WELD=1` turns off the extended method's cluster welding (`--no-weld`);
-//! `DIAG_SAMPLES=<n>` sets Metro's samples a direction (300k; `0`: the default of `sharpen_figures`).
+//! `DIAG_SAMPLES=<n>` sets Metro's samples a direction (300k; `0`: the default of `sharpen_figures`);
+//! `DIAG_ROT=x,y,z,angle` turns a synth shape about that axis by that many radians instead.
 
 mod support;
 mod swing_inputs;
@@ -78,11 +79,18 @@ fn main() {
         let res: usize = arg(&args, 2, 64);
         // 0 and 1: the tables' generic rotations; 2: none (creases along the grid); 3: a
         // small turn (creases drift slowly across the grid).
-        let rotation = match arg::<usize>(&args, 3, 0) {
+        // `DIAG_ROT=x,y,z,angle` (radians) overrides the rotation argument.
+        let custom = std::env::var("DIAG_ROT").ok().and_then(|s| {
+            let v: Vec<f64> = s.split(',').filter_map(|x| x.trim().parse().ok()).collect();
+            (v.len() == 4).then(|| {
+                glam::DQuat::from_axis_angle(glam::DVec3::new(v[0], v[1], v[2]).normalize(), v[3])
+            })
+        });
+        let rotation = custom.unwrap_or_else(|| match arg::<usize>(&args, 3, 0) {
             2 => glam::DQuat::IDENTITY,
             3 => glam::DQuat::from_axis_angle(glam::DVec3::new(0.3, 0.2, 1.0).normalize(), 0.05),
             r => support::rotations()[r.min(1)],
-        };
+        });
         let params = ShapeParams::default().with_rotation(rotation);
         let shape = or_die(Shape::new(kind, &params), "shape");
         (

@@ -138,3 +138,59 @@ fn near_axis_aligned_rotations_keep_the_output_guarantees() {
     let failed = failures(12345, 300, 0.01);
     assert!(failed.is_empty(), "{} failures: {failed:#?}", failed.len());
 }
+
+#[test]
+#[ignore = "known gap: 4 of 120 near-axis samplings at 24-37 cells come out with a larger max error"]
+fn near_axis_aligned_rotations_never_make_the_error_worse() {
+    // Measured 2026-12-05 (Metro, 100k samples a direction): 4 of these 120 cases have a
+    // larger max than their input (fandisk at 24, 33 and 37 cells: 0.70x, 0.76x, 0.86x;
+    // torus-box at 25: 0.76x, RMS 0.93x), none a larger RMS otherwise. Traced on fandisk 48
+    // turned by 0.16 degrees (max 0.79x, `sharpen_diag` with `DIAG_ROT`): a cone split into
+    // two smooth regions by a staircase along a grid line, whose two tangent planes and the
+    // top face's meet 1.15 edges from the crease vertex that the unlabelled-corner rule moved
+    // there (docs/results.md, "Near-axis samplings"). Run with `cargo test --release -p
+    // whet-sharpen --test it -- --ignored never_make --nocapture`.
+    let mut rng = Lcg(4242);
+    let kinds = [
+        ShapeKind::Cube,
+        ShapeKind::Fandisk,
+        ShapeKind::Pyramid,
+        ShapeKind::TorusBox,
+    ];
+    let mut worse = Vec::new();
+    for i in 0..120 {
+        let kind = kinds[i % kinds.len()];
+        let res = 24 + (rng.unit() * 60.0) as usize;
+        let axis = DVec3::new(
+            rng.unit() * 2.0 - 1.0,
+            rng.unit() * 2.0 - 1.0,
+            rng.unit() * 2.0 - 1.0 + 1e-3,
+        )
+        .normalize();
+        let angle = rng.unit() * std::f64::consts::PI * 0.01;
+        let params = ShapeParams::default().with_rotation(DQuat::from_axis_angle(axis, angle));
+        let shape = Shape::new(kind, &params).unwrap();
+        let input = marching_cubes(&shape, res).unwrap();
+        let out = sharpen(&input, &SharpenOptions::DEFAULT).unwrap();
+        let truth = shape.truth_mesh();
+        let before = crate::support::error(&truth, &input, Some(100_000));
+        let after = crate::support::error(&truth, &out.mesh, Some(100_000));
+        let line = format!(
+            "{} res {res} DIAG_ROT={},{},{},{}: RMS {:.4} -> {:.4} %, max {:.3} -> {:.3} %",
+            kind.name(),
+            axis.x,
+            axis.y,
+            axis.z,
+            angle,
+            before.rms_pct,
+            after.rms_pct,
+            before.max_pct,
+            after.max_pct
+        );
+        eprintln!("{line}");
+        if after.rms_pct > before.rms_pct || after.max_pct > before.max_pct {
+            worse.push(line);
+        }
+    }
+    assert!(worse.is_empty(), "{} worse: {worse:#?}", worse.len());
+}
