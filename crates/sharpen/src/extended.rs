@@ -78,8 +78,11 @@ pub(crate) struct LabelPlane {
 pub(crate) fn classify(run: &mut Run) {
     run.surface_samples = is_surface_sampling(run.mesh);
     if !run.surface_samples {
-        demote_corridors(run);
-        demote_strip_arms(run);
+        // Deep vertices depend on filter 1's core flags alone, which demotion leaves as they
+        // are: one pass serves both demotions.
+        let (deep, of) = deep_vertices(run);
+        demote_corridors(run, &deep, &of);
+        demote_strip_arms(run, &deep);
     }
     border_planes(run);
     if run.surface_samples {
@@ -437,7 +440,7 @@ pub(crate) const CORRIDOR_ON_PLANE: f64 = 0.1;
 /// vertices are classified like any chamfer vertex. This reaches what the papers' core test
 /// (filter 1) misses on coarse samplings.
 #[inline(never)] // one call per run; kept out of line so profiles show it
-fn demote_corridors(run: &mut Run) {
+fn demote_corridors(run: &mut Run, deep: &[bool], of: &[u32]) {
     let nv = run.mesh.positions.len();
     let nt = run.mesh.triangles.len();
     let nregions = run
@@ -451,7 +454,6 @@ fn demote_corridors(run: &mut Run) {
         return;
     }
     // A region is thick when it has a deep vertex.
-    let (deep, of) = deep_vertices(run);
     let mut thick = vec![false; nregions];
     for v in 0..nv {
         if deep[v] && of[v] != NONE {
@@ -510,18 +512,17 @@ fn demote_corridors(run: &mut Run) {
 /// lies in one region) whose neighbours are all core too, and the region of each (`NONE` for
 /// the others). One pass over the corners.
 fn deep_vertices(run: &Run) -> (Vec<bool>, Vec<u32>) {
-    let nv = run.mesh.positions.len();
-    let core = |v: usize| run.s.vflags[v] & V_CORE != 0;
-    let mut deep: Vec<bool> = (0..nv).map(core).collect();
-    let mut of: Vec<u32> = vec![NONE; nv];
-    for (t, tri) in run.mesh.triangles.iter().enumerate() {
-        for k in 0..3 {
-            let v = tri[k] as usize;
+    let flags = &run.s.vflags[..];
+    let mut deep: Vec<bool> = flags.iter().map(|&f| f & V_CORE != 0).collect();
+    let mut of: Vec<u32> = vec![NONE; flags.len()];
+    for (tri, &region) in run.mesh.triangles.iter().zip(&run.s.region) {
+        let [a, b, c] = tri.map(|v| v as usize);
+        let core = [a, b, c].map(|v| flags[v] & V_CORE != 0);
+        // Each vertex and the one after it: a core vertex next to a non-core one is not deep.
+        for (v, next_core) in [(a, core[1]), (b, core[2]), (c, core[0])] {
             if deep[v] {
-                of[v] = run.s.region[t];
-                if !core(tri[(k + 1) % 3] as usize) {
-                    deep[v] = false;
-                }
+                of[v] = region;
+                deep[v] = next_core;
             }
         }
     }
@@ -561,7 +562,7 @@ pub(crate) const ARM_RINGS: usize = 4;
 /// through smooth edges over the region's triangles that hold no deep vertex and touch a
 /// strong inner edge or the region's border, and taken out of the region like a corridor.
 #[inline(never)] // one call per run; kept out of line so profiles show it
-fn demote_strip_arms(run: &mut Run) {
+fn demote_strip_arms(run: &mut Run, deep: &[bool]) {
     let nt = run.mesh.triangles.len();
     let nv = run.mesh.positions.len();
     let threshold = (STRONG_INNER_TURN * run.smooth_threshold) as f32;
@@ -581,7 +582,6 @@ fn demote_strip_arms(run: &mut Run) {
     if strong.is_empty() {
         return;
     }
-    let (deep, _) = deep_vertices(run);
     // Vertices of a strong inner edge, or on the border of their region (a triangle around
     // them in another region, or in none): the vertices an arm's triangles touch.
     let mut edge_vertex = vec![false; nv];
