@@ -272,7 +272,18 @@ fn prepare_with(mesh: &Mesh, repair: bool, walk_fans: bool) -> Result<Prepared, 
             whet_mesh::MeshError::NonFiniteCoordinate { vertex: v as u32 },
         ));
     }
-    let mut work = mesh.clone();
+    // The fast path works on a copy in spatial order when the input's memory order is poor:
+    // building the table and traversing it then read memory in order (the reordering costs
+    // less than the misses it saves on a mesh in random order; docs/codec.md, "Speed").
+    let reordered = if walk_fans {
+        None
+    } else {
+        spatial_order(mesh, REORDER_MIN_TRIANGLES)
+    };
+    let (mut work, reorder) = match reordered {
+        Some((m, order)) => (m, Some(order)),
+        None => (mesh.clone(), None),
+    };
     let input_vertices = work.positions.len();
     let mut rep = ManifoldRepair::default();
     // The table of a valid input is built once and kept unless vertices are dropped below.
@@ -283,6 +294,9 @@ fn prepare_with(mesh: &Mesh, repair: bool, walk_fans: bool) -> Result<Prepared, 
     };
     let mut table = match built {
         Ok(t) => Some(t),
+        // A reordered copy is never repaired: the caller's full path repairs and reports the
+        // input in its own numbering.
+        Err(e) if reorder.is_some() => return Err(Error::InvalidInput(e)),
         Err(e) => {
             if !repair {
                 return Err(Error::InvalidInput(e));
@@ -294,7 +308,8 @@ fn prepare_with(mesh: &Mesh, repair: bool, walk_fans: bool) -> Result<Prepared, 
     // Repair appends copies; remember which input vertex each one copies by position (the
     // repair copies positions exactly, and the first input vertex at that position is the
     // one it split from or an identical one).
-    let mut original: Vec<u32> = (0..work.positions.len() as u32).collect();
+    let mut original: Vec<u32> =
+        reorder.unwrap_or_else(|| (0..work.positions.len() as u32).collect());
     if work.positions.len() > input_vertices {
         let mut by_bits: std::collections::HashMap<[u64; 3], u32> = Default::default();
         for (i, p) in mesh.positions.iter().enumerate() {
@@ -351,4 +366,175 @@ fn prepare_with(mesh: &Mesh, repair: bool, walk_fans: bool) -> Result<Prepared, 
         repair: rep,
         dropped_unused,
     })
+}
+
+/// Meshes under this many triangles are left in their order: their arrays stay in the
+/// caches whatever the order.
+const REORDER_MIN_TRIANGLES: usize = 1 << 18;
+
+/// Consecutive triangles per window of [`scattered`].
+const WINDOW: usize = 256;
+
+/// Whether the triangles of `mesh` reference their vertices in scattered memory order: over
+/// a few windows of [`WINDOW`] consecutive triangles, the median number of distinct blocks
+/// of 1024 vertex numbers they touch. A mesh in file order (a scan, a subdivision, marching
+/// cubes) touches a handful per window, however far apart its numbers run (a subdivision
+/// reads its old vertices and its new midpoints as two streams); one in random order
+/// touches nearly one block per corner. `None` when an index is out of range.
+fn scattered(tris: &[[u32; 3]], nv: usize) -> Option<bool> {
+    const WINDOWS: usize = 9;
+    let blocks = nv.div_ceil(1024);
+    let mut counts = Vec::with_capacity(WINDOWS);
+    let mut seen: Vec<u32> = Vec::with_capacity(3 * WINDOW);
+    for w in 0..WINDOWS {
+        let first = w * (tris.len() - WINDOW) / (WINDOWS - 1);
+        seen.clear();
+        for t in &tris[first..first + WINDOW] {
+            for &v in t {
+                if v as usize >= nv {
+                    return None;
+                }
+                seen.push(v >> 10);
+            }
+        }
+        seen.sort_unstable();
+        seen.dedup();
+        counts.push(seen.len());
+    }
+    counts.sort_unstable();
+    // Random order: about min(768, blocks) distinct blocks; file order: a few.
+    Some(counts[WINDOWS / 2] > 64.min(blocks / 2).max(8))
+}
+
+/// Bit `i` of `x` (10 bits) to bit `3 i`.
+fn spread_bits(x: u32) -> u32 {
+    let mut x = x & 0x3ff;
+    x = (x | x << 16) & 0x030000ff;
+    x = (x | x << 8) & 0x0300f00f;
+    x = (x | x << 4) & 0x030c30c3;
+    (x | x << 2) & 0x09249249
+}
+
+/// `mesh` renumbered in spatial order, with the input vertex of each new vertex, when it
+/// has at least `min_triangles` triangles in [`scattered`] order: vertices by the Morton
+/// cell of their position (a counting sort over about one cell per four vertices), triangles
+/// by their lowest new vertex (each keeps its corners' rotation). `None`
+/// otherwise, or when an index is out of range (the caller reports it).
+fn spatial_order(mesh: &Mesh, min_triangles: usize) -> Option<(Mesh, Vec<u32>)> {
+    let (nv, nt) = (mesh.positions.len(), mesh.triangles.len());
+    if nt < min_triangles.max(WINDOW) || nv == 0 || !scattered(&mesh.triangles, nv)? {
+        return None;
+    }
+    let bits = ((((nv / 4).max(1) as f64).log2() / 3.0).round() as u32).clamp(1, 10);
+    let cells = 1usize << (3 * bits);
+    let bbox = mesh.bounding_box();
+    let extent = (bbox.max - bbox.min).max_element().max(f64::MIN_POSITIVE);
+    let scale = ((1u32 << bits) as f64 - 1e-6) / extent;
+    let top = (1u32 << bits) - 1;
+    let cell: Vec<u32> = mesh
+        .positions
+        .iter()
+        .map(|p| {
+            let q = ((*p - bbox.min) * scale)
+                .to_array()
+                .map(|x| (x as u32).min(top));
+            spread_bits(q[0]) | spread_bits(q[1]) << 1 | spread_bits(q[2]) << 2
+        })
+        .collect();
+    let mut start = vec![0u32; cells + 1];
+    for &c in &cell {
+        start[c as usize + 1] += 1;
+    }
+    for i in 0..cells {
+        start[i + 1] += start[i];
+    }
+    let mut new_id = vec![0u32; nv];
+    let mut original = vec![0u32; nv];
+    let mut positions = vec![whet_mesh::DVec3::ZERO; nv];
+    for (v, (&c, p)) in cell.iter().zip(&mesh.positions).enumerate() {
+        let slot = &mut start[c as usize];
+        new_id[v] = *slot;
+        original[*slot as usize] = v as u32;
+        positions[*slot as usize] = *p;
+        *slot += 1;
+    }
+    // Triangles by their lowest new vertex, a few vertices to a bucket (new numbers follow
+    // the cells).
+    let shift = (nv / cells).max(1).ilog2();
+    let buckets = (nv >> shift) + 1;
+    let renamed: Vec<([u32; 3], u32)> = mesh
+        .triangles
+        .iter()
+        .map(|t| {
+            let r = t.map(|v| new_id[v as usize]);
+            (r, r[0].min(r[1]).min(r[2]) >> shift)
+        })
+        .collect();
+    drop(new_id);
+    let mut first = vec![0u32; buckets + 1];
+    for &(_, b) in &renamed {
+        first[b as usize + 1] += 1;
+    }
+    for i in 0..buckets {
+        first[i + 1] += first[i];
+    }
+    let mut triangles = vec![[0u32; 3]; nt];
+    for (t, b) in renamed {
+        let slot = &mut first[b as usize];
+        triangles[*slot as usize] = t;
+        *slot += 1;
+    }
+    Some((Mesh::new(positions, triangles), original))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{scattered, spatial_order};
+    use whet_testkit::meshes::{icosphere, shuffle};
+
+    #[test]
+    fn random_order_is_told_from_file_order() {
+        let ico = icosphere(5);
+        let nv = ico.positions.len();
+        assert_eq!(scattered(&ico.triangles, nv), Some(false));
+        assert_eq!(scattered(&shuffle(&ico, 1).triangles, nv), Some(true));
+        let mut bad = ico.triangles.clone();
+        bad[0][1] = nv as u32;
+        assert_eq!(scattered(&bad, nv), None);
+    }
+
+    #[test]
+    fn the_spatial_order_is_a_renumbering() {
+        let mesh = shuffle(&icosphere(5), 2);
+        assert!(
+            spatial_order(&mesh, 1 << 30).is_none(),
+            "under the size bound"
+        );
+        let (m, original) = spatial_order(&mesh, 0).expect("a shuffled mesh is reordered");
+        let mut seen = vec![false; mesh.positions.len()];
+        for (new, &old) in original.iter().enumerate() {
+            assert!(!std::mem::replace(&mut seen[old as usize], true));
+            assert_eq!(m.positions[new], mesh.positions[old as usize]);
+        }
+        assert!(seen.iter().all(|&s| s));
+        // The same triangles, each with its corners' rotation.
+        let mut want = mesh.triangles.clone();
+        let mut got: Vec<[u32; 3]> = m
+            .triangles
+            .iter()
+            .map(|t| t.map(|v| original[v as usize]))
+            .collect();
+        want.sort_unstable();
+        got.sort_unstable();
+        assert_eq!(got, want);
+        // In spatial order: consecutive triangles' lowest vertices are close.
+        let lowest = |t: &[u32; 3]| t[0].min(t[1]).min(t[2]);
+        let far = m
+            .triangles
+            .windows(2)
+            .filter(|w| lowest(&w[0]).abs_diff(lowest(&w[1])) > 64)
+            .count();
+        assert!(far * 20 < m.triangles.len(), "{far} far jumps");
+        assert_eq!(scattered(&m.triangles, m.positions.len()), Some(false));
+    }
 }
