@@ -462,14 +462,20 @@ fn spatial_order(mesh: &Mesh, min_triangles: usize) -> Option<(Mesh, Vec<u32>)> 
     // the cells).
     let shift = (nv / cells).max(1).ilog2();
     let buckets = (nv >> shift) + 1;
+    // An index out of range anywhere (the windows sample only some triangles) leaves the
+    // mesh to the table's check, which names it.
     let renamed: Vec<([u32; 3], u32)> = mesh
         .triangles
         .iter()
         .map(|t| {
-            let r = t.map(|v| new_id[v as usize]);
-            (r, r[0].min(r[1]).min(r[2]) >> shift)
+            let r = [
+                *new_id.get(t[0] as usize)?,
+                *new_id.get(t[1] as usize)?,
+                *new_id.get(t[2] as usize)?,
+            ];
+            Some((r, r[0].min(r[1]).min(r[2]) >> shift))
         })
-        .collect();
+        .collect::<Option<_>>()?;
     drop(new_id);
     let mut first = vec![0u32; buckets + 1];
     for &(_, b) in &renamed {
@@ -501,6 +507,21 @@ mod tests {
         let mut bad = ico.triangles.clone();
         bad[0][1] = nv as u32;
         assert_eq!(scattered(&bad, nv), None);
+    }
+
+    #[test]
+    fn an_index_out_of_range_is_left_to_the_table() {
+        // In a triangle no window samples: the renumbering must refuse, not panic.
+        let mut mesh = shuffle(&icosphere(5), 4);
+        let nv = mesh.positions.len() as u32;
+        mesh.triangles[300][2] = nv + 7;
+        assert!(spatial_order(&mesh, 0).is_none());
+        // Without repair the encoder names the index; with it (the default) it cuts the
+        // triangle and reports that, as it always did.
+        let strict = crate::EncodeOptions::DEFAULT.with_repair(false);
+        assert!(crate::encode(&mesh, &strict).is_err());
+        let repaired = crate::encode(&mesh, &crate::EncodeOptions::DEFAULT).unwrap();
+        assert_eq!(repaired.report.triangles, mesh.triangles.len() - 1);
     }
 
     #[test]
