@@ -425,7 +425,8 @@ fn spatial_order(mesh: &Mesh, min_triangles: usize) -> Option<(Mesh, Vec<u32>)> 
     if nt < min_triangles.max(WINDOW) || nv == 0 || !scattered(&mesh.triangles, nv)? {
         return None;
     }
-    let bits = ((((nv / 4).max(1) as f64).log2() / 3.0).round() as u32).clamp(1, 10);
+    // At most 2^24 cells (64 MB of counts), reached at about 67M vertices.
+    let bits = ((((nv / 4).max(1) as f64).log2() / 3.0).round() as u32).clamp(1, 8);
     let cells = 1usize << (3 * bits);
     let bbox = mesh.bounding_box();
     let extent = (bbox.max - bbox.min).max_element().max(f64::MIN_POSITIVE);
