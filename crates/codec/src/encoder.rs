@@ -425,7 +425,7 @@ fn spatial_order(mesh: &Mesh, min_triangles: usize) -> Option<(Mesh, Vec<u32>)> 
     if nt < min_triangles.max(WINDOW) || nv == 0 || !scattered(&mesh.triangles, nv)? {
         return None;
     }
-    // At most 2^24 cells (64 MB of counts), reached at about 67M vertices.
+    // At most 2^24 cells (64 MB of counts), from about 24M vertices on.
     let bits = ((((nv / 4).max(1) as f64).log2() / 3.0).round() as u32).clamp(1, 8);
     let cells = 1usize << (3 * bits);
     let bbox = mesh.bounding_box();
