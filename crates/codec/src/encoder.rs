@@ -406,6 +406,19 @@ fn scattered(tris: &[[u32; 3]], nv: usize) -> Option<bool> {
     Some(counts[WINDOWS / 2] > 64.min(blocks / 2).max(8))
 }
 
+/// Where each of `buckets` buckets starts in a counting sort of `keys` (each below
+/// `buckets`).
+fn bucket_starts(keys: impl Iterator<Item = usize>, buckets: usize) -> Vec<u32> {
+    let mut start = vec![0u32; buckets + 1];
+    for k in keys {
+        start[k + 1] += 1;
+    }
+    for i in 0..buckets {
+        start[i + 1] += start[i];
+    }
+    start
+}
+
 /// Bit `i` of `x` (10 bits) to bit `3 i`.
 fn spread_bits(x: u32) -> u32 {
     let mut x = x & 0x3ff;
@@ -442,13 +455,7 @@ fn spatial_order(mesh: &Mesh, min_triangles: usize) -> Option<(Mesh, Vec<u32>)> 
             spread_bits(q[0]) | spread_bits(q[1]) << 1 | spread_bits(q[2]) << 2
         })
         .collect();
-    let mut start = vec![0u32; cells + 1];
-    for &c in &cell {
-        start[c as usize + 1] += 1;
-    }
-    for i in 0..cells {
-        start[i + 1] += start[i];
-    }
+    let mut start = bucket_starts(cell.iter().map(|&c| c as usize), cells);
     let mut new_id = vec![0u32; nv];
     let mut original = vec![0u32; nv];
     let mut positions = vec![whet_mesh::DVec3::ZERO; nv];
@@ -478,13 +485,7 @@ fn spatial_order(mesh: &Mesh, min_triangles: usize) -> Option<(Mesh, Vec<u32>)> 
         })
         .collect::<Option<_>>()?;
     drop(new_id);
-    let mut first = vec![0u32; buckets + 1];
-    for &(_, b) in &renamed {
-        first[b as usize + 1] += 1;
-    }
-    for i in 0..buckets {
-        first[i + 1] += first[i];
-    }
+    let mut first = bucket_starts(renamed.iter().map(|&(_, b)| b as usize), buckets);
     let mut triangles = vec![[0u32; 3]; nt];
     for (t, b) in renamed {
         let slot = &mut first[b as usize];
