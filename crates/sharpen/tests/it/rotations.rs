@@ -21,6 +21,35 @@ impl Lcg {
     }
 }
 
+/// The shapes the sweeps cycle through.
+const KINDS: [ShapeKind; 4] = [
+    ShapeKind::Cube,
+    ShapeKind::Fandisk,
+    ShapeKind::Pyramid,
+    ShapeKind::TorusBox,
+];
+
+/// The next random case of a sweep: case `i`'s shape, a resolution from 24 to
+/// `24 + res_span - 1`, a random axis and an angle up to `angle_scale` half-turns.
+fn next_case(
+    rng: &mut Lcg,
+    i: usize,
+    res_span: f64,
+    angle_scale: f64,
+) -> (Shape, usize, DVec3, f64) {
+    let kind = KINDS[i % KINDS.len()];
+    let res = 24 + (rng.unit() * res_span) as usize;
+    let axis = DVec3::new(
+        rng.unit() * 2.0 - 1.0,
+        rng.unit() * 2.0 - 1.0,
+        rng.unit() * 2.0 - 1.0 + 1e-3,
+    )
+    .normalize();
+    let angle = rng.unit() * std::f64::consts::PI * angle_scale;
+    let params = ShapeParams::default().with_rotation(DQuat::from_axis_angle(axis, angle));
+    (Shape::new(kind, &params).unwrap(), res, axis, angle)
+}
+
 /// Sharpens `cases` marching-cubes samplings (resolutions 24-63) rotated by random angles
 /// scaled by `angle_scale` about random axes, and returns the failures of the output
 /// guarantees: manifold, same boundary, no new angle under 1 degree, under 1 % of the new
@@ -29,26 +58,11 @@ impl Lcg {
 /// fifth of the longest edge of its plane) and facing within 26 degrees of its opposite.
 fn failures(seed: u64, cases: usize, angle_scale: f64) -> Vec<String> {
     let mut rng = Lcg(seed);
-    let kinds = [
-        ShapeKind::Cube,
-        ShapeKind::Fandisk,
-        ShapeKind::Pyramid,
-        ShapeKind::TorusBox,
-    ];
     let mut failed = Vec::new();
     let (mut folds, mut new) = (0usize, 0usize);
     for i in 0..cases {
-        let kind = kinds[i % kinds.len()];
-        let res = 24 + (rng.unit() * 40.0) as usize;
-        let axis = DVec3::new(
-            rng.unit() * 2.0 - 1.0,
-            rng.unit() * 2.0 - 1.0,
-            rng.unit() * 2.0 - 1.0 + 1e-3,
-        )
-        .normalize();
-        let angle = rng.unit() * std::f64::consts::PI * angle_scale;
-        let params = ShapeParams::default().with_rotation(DQuat::from_axis_angle(axis, angle));
-        let shape = Shape::new(kind, &params).unwrap();
+        let (shape, res, axis, angle) = next_case(&mut rng, i, 40.0, angle_scale);
+        let kind = shape.kind();
         let input = marching_cubes(&shape, res).unwrap();
         let out = sharpen(&input, &SharpenOptions::DEFAULT).unwrap();
         let truth = shape.truth_mesh();
@@ -151,25 +165,10 @@ fn near_axis_aligned_rotations_never_make_the_error_worse() {
     // there (docs/results.md, "Near-axis samplings"). Run with `cargo test --release -p
     // whet-sharpen --test it -- --ignored never_make --nocapture`.
     let mut rng = Lcg(4242);
-    let kinds = [
-        ShapeKind::Cube,
-        ShapeKind::Fandisk,
-        ShapeKind::Pyramid,
-        ShapeKind::TorusBox,
-    ];
     let mut worse = Vec::new();
     for i in 0..120 {
-        let kind = kinds[i % kinds.len()];
-        let res = 24 + (rng.unit() * 60.0) as usize;
-        let axis = DVec3::new(
-            rng.unit() * 2.0 - 1.0,
-            rng.unit() * 2.0 - 1.0,
-            rng.unit() * 2.0 - 1.0 + 1e-3,
-        )
-        .normalize();
-        let angle = rng.unit() * std::f64::consts::PI * 0.01;
-        let params = ShapeParams::default().with_rotation(DQuat::from_axis_angle(axis, angle));
-        let shape = Shape::new(kind, &params).unwrap();
+        let (shape, res, axis, angle) = next_case(&mut rng, i, 60.0, 0.01);
+        let kind = shape.kind();
         let input = marching_cubes(&shape, res).unwrap();
         let out = sharpen(&input, &SharpenOptions::DEFAULT).unwrap();
         let truth = shape.truth_mesh();
