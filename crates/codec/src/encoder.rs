@@ -4,7 +4,7 @@
 use crate::exact::encode_exact;
 use crate::Error;
 use whet_format::{tag, Container, Header, Mode, SectionKind, Version};
-use whet_mesh::{ManifoldRepair, Mesh};
+use whet_mesh::{morton_spread, ManifoldRepair, Mesh};
 
 /// Options of [`Encoder`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -419,15 +419,6 @@ fn bucket_starts(keys: impl Iterator<Item = usize>, buckets: usize) -> Vec<u32> 
     start
 }
 
-/// Bit `i` of `x` (10 bits) to bit `3 i`.
-fn spread_bits(x: u32) -> u32 {
-    let mut x = x & 0x3ff;
-    x = (x | x << 16) & 0x030000ff;
-    x = (x | x << 8) & 0x0300f00f;
-    x = (x | x << 4) & 0x030c30c3;
-    (x | x << 2) & 0x09249249
-}
-
 /// `mesh` renumbered in spatial order, with the input vertex of each new vertex, when it
 /// has at least `min_triangles` triangles in [`scattered`] order: vertices by the Morton
 /// cell of their position (a counting sort over about one cell per four vertices), triangles
@@ -444,15 +435,15 @@ fn spatial_order(mesh: &Mesh, min_triangles: usize) -> Option<(Mesh, Vec<u32>)> 
     let bbox = mesh.bounding_box();
     let extent = (bbox.max - bbox.min).max_element().max(f64::MIN_POSITIVE);
     let scale = ((1u32 << bits) as f64 - 1e-6) / extent;
-    let top = (1u32 << bits) - 1;
+    let top = (1u64 << bits) - 1;
     let cell: Vec<u32> = mesh
         .positions
         .iter()
         .map(|p| {
             let q = ((*p - bbox.min) * scale)
                 .to_array()
-                .map(|x| (x as u32).min(top));
-            spread_bits(q[0]) | spread_bits(q[1]) << 1 | spread_bits(q[2]) << 2
+                .map(|x| (x as u64).min(top));
+            (morton_spread(q[0]) | morton_spread(q[1]) << 1 | morton_spread(q[2]) << 2) as u32
         })
         .collect();
     let mut start = bucket_starts(cell.iter().map(|&c| c as usize), cells);

@@ -31,7 +31,7 @@ mod topology;
 pub use corner_table::{CornerTable, VertexCorners};
 pub use ids::{CornerId, FaceId, VertexId};
 pub use make_manifold::ManifoldRepair;
-pub use mesh::{angle_between, edge_key, Aabb, EdgeLengthStats, Mesh};
+pub use mesh::{angle_between, edge_key, morton_spread, Aabb, EdgeLengthStats, Mesh};
 pub use topology::{MeshError, TopologyReport};
 
 pub use glam::DVec3;

@@ -14,6 +14,19 @@ pub struct Aabb {
     pub max: DVec3,
 }
 
+/// Spreads the low 21 bits of `v` to every third bit (bit `i` to bit `3 i`): one axis of a
+/// 63-bit Morton code, as spatial sorts interleave three quantized coordinates.
+#[inline]
+pub fn morton_spread(v: u64) -> u64 {
+    let mut x = v & 0x1F_FFFF;
+    x = (x | (x << 32)) & 0x001F_0000_0000_FFFF;
+    x = (x | (x << 16)) & 0x001F_0000_FF00_00FF;
+    x = (x | (x << 8)) & 0x100F_00F0_0F00_F00F;
+    x = (x | (x << 4)) & 0x10C3_0C30_C30C_30C3;
+    x = (x | (x << 2)) & 0x1249_2492_4924_9249;
+    x
+}
+
 impl Aabb {
     /// The box of no points: `min` is +inf and `max` is -inf, so any point grows it.
     pub const EMPTY: Aabb = Aabb {
@@ -277,4 +290,20 @@ pub fn angle_between(a: DVec3, b: DVec3) -> f64 {
 pub fn edge_key(a: u32, b: u32) -> u64 {
     let (lo, hi) = if a < b { (a, b) } else { (b, a) };
     ((lo as u64) << 32) | hi as u64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::morton_spread;
+
+    #[test]
+    fn morton_spread_moves_bit_i_to_bit_3i() {
+        assert_eq!(morton_spread(0b101), 1 | 1 << 6);
+        assert_eq!(morton_spread(1 << 20), 1 << 60);
+        // Bits above the 21st are dropped.
+        assert_eq!(morton_spread(1 << 21), 0);
+        let all = morton_spread(0x1F_FFFF);
+        assert_eq!(all.count_ones(), 21);
+        assert_eq!(all & (all << 1), 0);
+    }
 }

@@ -27,7 +27,7 @@ use std::cmp::Ordering;
 
 use glam::DVec3;
 use rayon::prelude::*;
-use whet_mesh::{Aabb, Mesh};
+use whet_mesh::{morton_spread, Aabb, Mesh};
 
 use crate::triangle_distance::{
     closest_point_on_proper_triangle, closest_point_on_triangle, is_degenerate,
@@ -282,18 +282,6 @@ fn bounds_of(prims: &[Prim]) -> (Box3, Box3) {
     (bounds, centroids)
 }
 
-/// Spreads the low 21 bits of `v` to every third bit.
-#[inline]
-fn spread_bits(v: u64) -> u64 {
-    let mut x = v & 0x1F_FFFF;
-    x = (x | (x << 32)) & 0x001F_0000_0000_FFFF;
-    x = (x | (x << 16)) & 0x001F_0000_FF00_00FF;
-    x = (x | (x << 8)) & 0x100F_00F0_0F00_F00F;
-    x = (x | (x << 4)) & 0x10C3_0C30_C30C_30C3;
-    x = (x | (x << 2)) & 0x1249_2492_4924_9249;
-    x
-}
-
 /// 63-bit Morton codes of the prims' centroids, quantised on a cube over `centroids` (so a
 /// code bit splits space at a geometric midpoint).
 fn morton_codes(prims: &[Prim], centroids: &Box3) -> Vec<u64> {
@@ -312,7 +300,7 @@ fn morton_codes(prims: &[Prim], centroids: &Box3) -> Vec<u64> {
             let c = p.centroid();
             // The float-to-int cast saturates, so rounding overshoot stays in range.
             let q = |k: usize| (((c[k] - origin[k]) * scale) as u64).min((1 << 21) - 1);
-            (spread_bits(q(0)) << 2) | (spread_bits(q(1)) << 1) | spread_bits(q(2))
+            (morton_spread(q(0)) << 2) | (morton_spread(q(1)) << 1) | morton_spread(q(2))
         })
         .collect()
 }
