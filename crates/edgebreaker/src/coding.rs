@@ -17,7 +17,7 @@ use crate::Error;
 use whet_bits::{
     BitModel, BitSink, CostCounter, RangeDecoder, RangeEncoder, SymbolModel, UnsignedIntModel,
 };
-use whet_mesh::{CornerId, CornerTable, VertexId};
+use whet_mesh::{CornerId, CornerTable, MeshError, VertexId};
 
 /// The label models: one adaptive 5-symbol model per (valence, previous label) context.
 struct LabelModels {
@@ -586,9 +586,14 @@ pub fn decode_connectivity(
     let o = std::mem::take(&mut rev.o);
     drop(rev);
     // The reverse decoder builds fans by construction; walks over the table stay bounded
-    // even if a corrupt stream produced a split fan, so the fan check is skipped.
-    let table = CornerTable::from_raw(v, o, vertex_ids, false)
-        .map_err(|_| Error::Corrupt("the decoded mesh is not a manifold"))?;
+    // even if a corrupt stream produced a split fan, so the fan check is skipped. The table
+    // must be closed (the holes open later): a corner left unglued or without a vertex is
+    // found here, in the pass that checks the pairs.
+    let table = CornerTable::from_raw_closed(v, o, vertex_ids, false).map_err(|e| match e {
+        MeshError::OpenEdge { .. } => Error::Corrupt("the decoded mesh is not closed"),
+        MeshError::IndexOutOfRange { .. } => Error::Corrupt("a corner has no vertex"),
+        _ => Error::Corrupt("the decoded mesh is not a manifold"),
+    })?;
     let starts: Vec<CornerId> = starts.into_iter().map(CornerId).collect();
     // The traversal's vertex order without traversing again: per component, the start
     // triangle's vertices, then the tip of each C in encoding order; decoder step i made

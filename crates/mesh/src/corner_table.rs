@@ -290,6 +290,27 @@ impl CornerTable {
         vertex_count: usize,
         check_fans: bool,
     ) -> Result<CornerTable, MeshError> {
+        Self::from_raw_checked::<false>(corner_vertex, opposite, vertex_count, check_fans)
+    }
+
+    /// [`CornerTable::from_raw`] for a table that must be closed: an opposite left at the
+    /// boundary marker is [`MeshError::OpenEdge`]. Found in the pass that checks the pairs,
+    /// so a decoder need not scan its arrays for the marker first.
+    pub fn from_raw_closed(
+        corner_vertex: Vec<u32>,
+        opposite: Vec<u32>,
+        vertex_count: usize,
+        check_fans: bool,
+    ) -> Result<CornerTable, MeshError> {
+        Self::from_raw_checked::<true>(corner_vertex, opposite, vertex_count, check_fans)
+    }
+
+    fn from_raw_checked<const CLOSED: bool>(
+        corner_vertex: Vec<u32>,
+        opposite: Vec<u32>,
+        vertex_count: usize,
+        check_fans: bool,
+    ) -> Result<CornerTable, MeshError> {
         let nc = check_corner_arrays(&corner_vertex, &opposite, vertex_count)?;
         // One pass over the triangles: vertex indices, repeated vertices, and each corner's
         // opposite (mutual, facing the same edge reversed); without the fan check the start
@@ -322,6 +343,13 @@ impl CornerTable {
             for j in 0..3 {
                 let o = to[j];
                 if o == NONE {
+                    if CLOSED {
+                        let (x, y) = (tv[(j + 1) % 3], tv[(j + 2) % 3]);
+                        return Err(MeshError::OpenEdge {
+                            a: x.min(y),
+                            b: x.max(y),
+                        });
+                    }
                     continue;
                 }
                 let oi = o as usize;
@@ -776,6 +804,35 @@ mod tests {
     }
 
     #[test]
+    fn a_closed_build_accepts_a_closed_table_and_names_an_unglued_corner() {
+        let t = CornerTable::new(&tetrahedron()).unwrap();
+        let (v, o) = (t.corner_vertices().to_vec(), t.opposites().to_vec());
+        assert_eq!(
+            CornerTable::from_raw_closed(v.clone(), o.clone(), 4, false),
+            CornerTable::from_raw(v.clone(), o.clone(), 4, false)
+        );
+        // Unglue one pair (the edge opposite corner 0 of triangle [0, 2, 1] is (1, 2)).
+        let mut cut = o.clone();
+        let twin = cut[0] as usize;
+        cut[0] = NONE;
+        cut[twin] = NONE;
+        assert_eq!(
+            CornerTable::from_raw_closed(v.clone(), cut.clone(), 4, false),
+            Err(MeshError::OpenEdge { a: 1, b: 2 })
+        );
+        // The open build takes it as a boundary.
+        assert!(CornerTable::from_raw(v.clone(), cut, 4, false).is_ok());
+        // A corner without a vertex is out of range, as before (in the first triangle, whose
+        // own check comes before any pair's).
+        let mut lost = v;
+        lost[1] = NONE;
+        assert!(matches!(
+            CornerTable::from_raw_closed(lost, o, 4, false),
+            Err(MeshError::IndexOutOfRange { .. })
+        ));
+    }
+
+    #[test]
     fn mean_edge_length_matches_the_mesh_s() {
         let mesh = Mesh::new(
             vec![
@@ -1027,6 +1084,24 @@ mod tests {
                 true,
             );
             proptest::prop_assert_eq!(raw, Ok(t.clone()));
+            // A grid is open: the closed build names one of its boundary edges.
+            let closed = CornerTable::from_raw_closed(
+                t.corner_vertices().to_vec(),
+                t.opposites().to_vec(),
+                nv,
+                false,
+            );
+            let Err(MeshError::OpenEdge { a, b }) = closed else {
+                return Err(proptest::test_runner::TestCaseError::fail(format!(
+                    "an open grid built closed: {closed:?}"
+                )));
+            };
+            let open = (0..t.corner_count()).any(|c| {
+                let c = CornerId(c as u32);
+                let (x, y) = (t.vertex(t.next(c)).0, t.vertex(t.prev(c)).0);
+                t.opposite(c).is_none() && (x.min(y), x.max(y)) == (a, b)
+            });
+            proptest::prop_assert!(open, "({}, {}) is not a boundary edge", a, b);
             // Arrays of a checked table: the sequential constructor picks the same starts.
             let relabelled = CornerTable::from_relabelled(
                 t.corner_vertices().to_vec(),

@@ -64,6 +64,15 @@ pub enum MeshError {
         /// Number of incident triangles.
         count: u32,
     },
+    /// An edge with one incident triangle where the table must be closed (a decoder's
+    /// rebuilt mesh, before its holes are opened).
+    #[error("edge ({a}, {b}) has one incident triangle in a mesh that must be closed")]
+    OpenEdge {
+        /// Lower vertex index.
+        a: u32,
+        /// Higher vertex index.
+        b: u32,
+    },
     /// Two triangles traverse their shared edge in the same direction.
     #[error("edge ({a}, {b}) is traversed in the same direction by triangles {t0} and {t1} (inconsistent orientation)")]
     InconsistentOrientation {
@@ -122,6 +131,7 @@ impl MeshError {
             MeshError::ZeroAreaTriangle { .. } => "zero_area_triangle",
             MeshError::DuplicateTriangle { .. } => "duplicate_triangle",
             MeshError::NonManifoldEdge { .. } => "non_manifold_edge",
+            MeshError::OpenEdge { .. } => "open_edge",
             MeshError::InconsistentOrientation { .. } => "inconsistent_orientation",
             MeshError::NonManifoldVertex { .. } => "non_manifold_vertex",
             MeshError::UnreferencedVertices { .. } => "unreferenced_vertices",
