@@ -12,7 +12,7 @@
 //! x bit length of the previous axis's residual of the same vertex (0..=5), which captures that
 //! a vertex badly predicted on one axis is usually badly predicted on the others.
 
-use crate::parallelogram::{average, gate_midpoint, mean, MAX_CANDIDATES};
+use crate::parallelogram::{average, gate_midpoint, masked_sum, mean, MAX_CANDIDATES};
 use whet_bits::{BitModel, RangeDecoder, ResidualModel, SignedIntModel};
 use whet_edgebreaker::{Connectivity, TraversalError};
 
@@ -696,7 +696,8 @@ pub(crate) fn code_positions<I: ResidualIo>(
                 let prediction = if mask == (1u32 << k) - 1 {
                     grid(mean(sum, k as i64))
                 } else {
-                    grid(average(&cands[..k], mask))
+                    let (sum, n) = masked_sum(&cands[..k], mask);
+                    grid(mean(sum, n))
                 };
                 (class_of(mask), prediction)
             };

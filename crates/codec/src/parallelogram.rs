@@ -65,6 +65,16 @@ pub fn candidates(
 /// The average of the candidates selected by the bits of `mask` (non-zero), rounded half
 /// away from zero.
 pub fn average(cands: &[[i64; 3]], mask: u32) -> [i32; 3] {
+    let (sum, n) = masked_sum(cands, mask);
+    mean(sum, n)
+}
+
+/// The sum and count of the candidates selected by the bits of `mask`: [`average`] is
+/// their [`mean`]. Inlined where a prediction is made, so the prediction stays in registers
+/// (an out-of-line `average` returned it through memory lane by lane, and the wider load
+/// that read it back could not be store-forwarded: a stall per vertex).
+#[inline(always)]
+pub(crate) fn masked_sum(cands: &[[i64; 3]], mask: u32) -> ([i64; 3], i64) {
     let mut sum = [0i64; 3];
     let mut n = 0i64;
     for (i, c) in cands.iter().enumerate() {
@@ -75,7 +85,7 @@ pub fn average(cands: &[[i64; 3]], mask: u32) -> [i32; 3] {
             n += 1;
         }
     }
-    mean(sum, n)
+    (sum, n)
 }
 
 /// `sum / n` per axis rounded half away from zero and clamped to `i32`, as [`average`]
