@@ -1713,10 +1713,36 @@ pub(crate) fn corner_vertices(run: &mut Run) -> Vec<u32> {
 /// max 1.7x worse.
 pub(crate) const CORNER_SURFACE_GAP: f64 = 0.5;
 
+/// Fewest triangles a smooth region needs for [`unlabelled_corner_vertices`] to extrapolate
+/// its plane to a corner: the rule moves a vertex up to [`CORNER_MOVE_LIMIT`] edges on three
+/// planes taken from neighbours, and the plane of a region about one fan across (a coarse
+/// sampling's curved face cut into small regions) does not hold that far. Near-axis fandisk
+/// at 24 cells (docs/results.md, "Near-axis samplings"): a crease vertex on the true surface
+/// moved 1.07 edges onto the point of three regions of 8, 8 and 9 triangles, 4.09 % of the
+/// diagonal from the surface (max 2.85 % before sharpening). From 12 to 24 it changes no row
+/// of the synth or noise tables and only fandisk at 24, 38 (and 67 at 24) of the 120
+/// near-axis cases, each for the better.
+pub(crate) const MIN_CORNER_REGION: u32 = 16;
+
+/// Triangles per smooth region label (`run.s.region`), indexed by label.
+fn region_sizes(run: &Run) -> Vec<u32> {
+    let mut size: Vec<u32> = Vec::new();
+    for &r in &run.s.region {
+        if r == NONE {
+            continue;
+        }
+        if r as usize >= size.len() {
+            size.resize(r as usize + 1, 0);
+        }
+        size[r as usize] += 1;
+    }
+    size
+}
+
 /// Corner vertices that no corner triangle finds (marching cubes): a gray vertex with no label
 /// plane (it lies on none of its neighbours' planes: it is inside the cut-off corner) whose
 /// neighbours carry three or more surfaces moves onto the three-plane point of the best
-/// triple and takes their labels, under the rules of [`corner_vertices`] (the move limit
+/// triple (of regions of at least [`MIN_CORNER_REGION`] triangles each) and takes their labels, under the rules of [`corner_vertices`] (the move limit
 /// widened by [`acute_reach`] like the support test). The corner triangles of the papers need
 /// a label at each of their vertices, so a corner whose cut left such a vertex in its middle
 /// had none (synth fandisk at 96-128). A vertex with a corner triangle in its two-ring is left
@@ -1724,6 +1750,7 @@ pub(crate) const CORNER_SURFACE_GAP: f64 = 0.5;
 /// moved nearest first (ties by index), so the result does not depend on the vertex order.
 fn unlabelled_corner_vertices(run: &mut Run, placed: &mut Vec<DVec3>, moved: &mut Vec<u32>) {
     let nv = run.mesh.positions.len();
+    let region_size = region_sizes(run);
     let mut kept: Vec<(u32, LabelPlane)> = Vec::new();
     // (distance, vertex, target, the three label planes, the vertex's mean edge)
     let mut candidates: Vec<(f64, u32, DVec3, [LabelPlane; 3], f64)> = Vec::new();
@@ -1761,6 +1788,12 @@ fn unlabelled_corner_vertices(run: &mut Run, placed: &mut Vec<DVec3>, moved: &mu
                 for l in j + 1..kept.len() {
                     let (x, y, z) = (&kept[i].1, &kept[j].1, &kept[l].1);
                     if !well_separated(run, &[x.plane, y.plane, z.plane]) {
+                        continue;
+                    }
+                    let small = |lp: &LabelPlane| {
+                        region_size.get(lp.label as usize).copied().unwrap_or(0) < MIN_CORNER_REGION
+                    };
+                    if small(x) || small(y) || small(z) {
                         continue;
                     }
                     let Ok(q) = snap::corner_point(&x.plane, &y.plane, &z.plane, p, &run.limits)
