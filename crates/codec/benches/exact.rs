@@ -1,9 +1,10 @@
 //! Exact-mode encode and decode throughput on a ~1M-triangle mesh (issue target: decode at
-//! 20 M triangles/s, encode at 5 M triangles/s on one core).
+//! 20 M triangles/s, encode at 5 M triangles/s on one core), with the default prediction
+//! and with the traversal prediction (`*_traversal`).
 #![allow(clippy::unwrap_used)] // benches may panic on their own setup
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
-use whet_codec::{decode, encode, DecodeOptions, EncodeOptions};
+use whet_codec::{decode, encode, DecodeOptions, EncodeOptions, ExactPrediction};
 use whet_testkit::meshes::{icosphere, shuffle};
 
 fn bench(c: &mut Criterion) {
@@ -25,6 +26,15 @@ fn bench(c: &mut Criterion) {
     });
     g.bench_function("decode_1.3M", |b| {
         b.iter(|| black_box(decode(&enc.bytes, &DecodeOptions::DEFAULT).unwrap()))
+    });
+    let fast = opts.with_prediction(ExactPrediction::Traversal);
+    let enc_fast = encode(&mesh, &fast).unwrap();
+    eprintln!("traversal prediction: {} bytes", enc_fast.bytes.len());
+    g.bench_function("encode_1.3M_traversal", |b| {
+        b.iter(|| black_box(encode(&mesh, &fast).unwrap()))
+    });
+    g.bench_function("decode_1.3M_traversal", |b| {
+        b.iter(|| black_box(decode(&enc_fast.bytes, &DecodeOptions::DEFAULT).unwrap()))
     });
     g.finish();
 }

@@ -1,12 +1,13 @@
 //! Times the stages of the exact mode on a ~1.3M-triangle icosphere (a profiling aid:
 //! `cargo run --release -p whet-codec --example profile_exact -- [encodes] [decodes]`,
 //! e.g. `-- 0 20` to profile decoding alone). The icosphere's vertices and triangles are
-//! shuffled (the worst memory order an encoder meets); `PROFILE_ORDER=natural` keeps the
+//! shuffled (the worst memory order an encoder meets); `PROFILE_PREDICTION=traversal` codes
+//! with the traversal prediction; `PROFILE_ORDER=natural` keeps the
 //! generator's order, and `PROFILE_MESH=<file>` profiles that mesh in its file's order.
 #![allow(clippy::unwrap_used)]
 
 use std::time::Instant;
-use whet_codec::{decode, encode, DecodeOptions, EncodeOptions};
+use whet_codec::{decode, encode, DecodeOptions, EncodeOptions, ExactPrediction};
 
 fn main() {
     let arg = |i: usize, d: usize| {
@@ -39,10 +40,14 @@ fn main() {
         let (_d, _) = whet_edgebreaker::decode_connectivity(&c.bytes, &Default::default()).unwrap();
         eprintln!("decode_connectivity: {:?}", t.elapsed());
     }
+    let opts = match std::env::var("PROFILE_PREDICTION").as_deref() {
+        Ok("traversal") => EncodeOptions::DEFAULT.with_prediction(ExactPrediction::Traversal),
+        _ => EncodeOptions::DEFAULT,
+    };
     let mut e = None;
     for _ in 0..encodes.max(1) {
         let t = Instant::now();
-        e = Some(encode(&mesh, &EncodeOptions::DEFAULT).unwrap());
+        e = Some(encode(&mesh, &opts).unwrap());
         if encodes > 0 {
             eprintln!("encode: {:?}", t.elapsed());
         }

@@ -1,10 +1,11 @@
 //! Prints the size and a digest of the exact-mode stream of every shared fixture at
-//! Q = 11 and 14 and of the bench icosphere, and checks each round trip: a refactoring aid
+//! Q = 11 and 14 and of the bench icosphere, with the default prediction and then (lines
+//! marked `traversal`) the traversal prediction, and checks each round trip: a refactoring aid
 //! (`cargo run --release -p whet-codec --example stream_digest`), since a change that should
 //! not alter the stream must leave every line the same.
 #![allow(clippy::unwrap_used)]
 
-use whet_codec::{decode, encode, DecodeOptions, EncodeOptions};
+use whet_codec::{decode, encode, DecodeOptions, EncodeOptions, ExactPrediction};
 
 fn digest(bytes: &[u8]) -> u64 {
     // FNV-1a, 64 bits.
@@ -35,13 +36,25 @@ fn main() {
         "icosphere8-shuffled".into(),
         whet_testkit::meshes::shuffle(&whet_testkit::meshes::icosphere(8), 1),
     ));
-    for (name, mesh) in &meshes {
+    for (prediction, label) in [
+        (ExactPrediction::Degree, ""),
+        (ExactPrediction::Traversal, " traversal"),
+    ] {
+        print_streams(&meshes, prediction, label);
+    }
+}
+
+fn print_streams(meshes: &[(String, whet_mesh::Mesh)], prediction: ExactPrediction, label: &str) {
+    for (name, mesh) in meshes {
         for bits in [11, 14] {
-            let enc = encode(mesh, &EncodeOptions::DEFAULT.with_quant_bits(bits)).unwrap();
+            let opts = EncodeOptions::DEFAULT
+                .with_quant_bits(bits)
+                .with_prediction(prediction);
+            let enc = encode(mesh, &opts).unwrap();
             let back = decode(&enc.bytes, &DecodeOptions::DEFAULT).unwrap();
             assert_eq!(back.triangles.len(), enc.report.triangles, "{name}");
             println!(
-                "{name} q{bits}: {} B (conn {} + geom {} bytes) {:016x}",
+                "{name} q{bits}{label}: {} B (conn {} + geom {} bytes) {:016x}",
                 enc.bytes.len(),
                 enc.report.connectivity_bits / 8,
                 enc.report.geometry_bits / 8,

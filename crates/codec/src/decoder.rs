@@ -1,7 +1,7 @@
 //! The public decoders: from a slice, from any `Read`, and sans-IO chunk by chunk; all three
 //! parse the container with whet-format and hand its sections to the mode's decoder.
 
-use crate::exact::decode_exact;
+use crate::exact::{decode_exact, ExactPrediction};
 use crate::{Error, Quantizer};
 use std::io::Read;
 use whet_edgebreaker::ConnectivityLimits;
@@ -136,7 +136,16 @@ pub fn decode_container(container: &Container, opts: &DecodeOptions) -> Result<M
                     .saturating_add(64)
                     .min(opts.limits.max_alloc_bytes / DECODE_BYTES_PER_TRIANGLE),
             );
-            decode_exact(conn, geom, &quantizer, &limits)?
+            let prediction = match h.get_u64(tag::EXACT_PREDICTION) {
+                None => ExactPrediction::Degree,
+                Some(code) => ExactPrediction::from_code(code).ok_or_else(|| {
+                    Error::Corrupt(format!(
+                        "unknown exact prediction {code} (this whet reads 0 and 1; a newer whet may \
+                         have written it)"
+                    ))
+                })?,
+            };
+            decode_exact(conn, geom, &quantizer, &limits, prediction)?
         }
         Mode::Swing => {
             check_peak()?;

@@ -1,10 +1,13 @@
 //! The public encoder: options, preparation of the input (validation, manifold repair,
 //! unused vertices), the mode's payloads, and the container.
 
-use crate::exact::encode_exact;
+use crate::exact::{encode_exact, ExactPrediction};
 use crate::Error;
 use whet_format::{tag, Container, Header, Mode, SectionKind, Version};
 use whet_mesh::{morton_spread, ManifoldRepair, Mesh};
+
+/// The format version of header field `exact_prediction`.
+const VERSION_1_5: Version = Version::new(1, 5);
 
 /// Options of [`Encoder`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -18,6 +21,10 @@ pub struct EncodeOptions {
     pub version: Version,
     /// Cut non-manifold input with `Mesh::make_manifold` instead of refusing it.
     pub repair: bool,
+    /// Exact mode: the order and predictor of the positions (the degree order by default;
+    /// the traversal order decodes about twice as fast for a few percent more bytes and
+    /// writes format 1.5).
+    pub prediction: ExactPrediction,
 }
 
 impl EncodeOptions {
@@ -27,6 +34,7 @@ impl EncodeOptions {
         quant_bits: 14,
         version: Version::CURRENT,
         repair: true,
+        prediction: ExactPrediction::Degree,
     };
 
     /// Sets the mode.
@@ -50,6 +58,12 @@ impl EncodeOptions {
     /// Turns manifold repair on or off.
     pub const fn with_repair(mut self, repair: bool) -> Self {
         self.repair = repair;
+        self
+    }
+
+    /// Sets the exact mode's prediction.
+    pub const fn with_prediction(mut self, prediction: ExactPrediction) -> Self {
+        self.prediction = prediction;
         self
     }
 }
@@ -176,7 +190,8 @@ impl Encoder {
     /// `check_fans`: `p.table` was built without the closed-fan walk, check on the way.
     fn encode_exact(&self, p: Prepared, check_fans: bool) -> Result<Encoded, Error> {
         let bits = self.opts.quant_bits;
-        let payloads = encode_exact(&p.mesh, p.table, bits, check_fans)?;
+        let prediction = self.opts.prediction;
+        let payloads = encode_exact(&p.mesh, p.table, bits, check_fans, prediction)?;
         let bbox = p.mesh.bounding_box();
         let (min, max) = if bbox.is_empty() {
             ([0.0; 3], [0.0; 3])
@@ -191,6 +206,14 @@ impl Encoder {
         .with_version(self.opts.version)
         .with(tag::COMPONENT_COUNT, payloads.components as u64)
         .with(tag::QUANT_BITS, bits as u64);
+        if prediction != ExactPrediction::Degree {
+            // A reader before format 1.5 refuses the field by tag instead of misreading the
+            // geometry.
+            if header.version < VERSION_1_5 {
+                header = header.with_version(VERSION_1_5);
+            }
+            header = header.with(tag::EXACT_PREDICTION, prediction.code());
+        }
         header.set_bbox(min, max);
         let container = Container::new(header)
             .with_section(SectionKind::CONNECTIVITY, payloads.connectivity.clone())

@@ -36,9 +36,9 @@ pub fn fuzz_decode(data: &[u8]) {
     let _ = crate::SnapVetoes::from_field(data, 1 << 16);
 }
 
-/// The exact mode's payload decoders behind the container's CRCs: byte 0 picks the
-/// quantization bits, byte 1 where the input splits into the connectivity and geometry
-/// payloads.
+/// The exact mode's payload decoders behind the container's CRCs, both geometry orders:
+/// byte 0 picks the quantization bits, byte 1 where the input splits into the connectivity
+/// and geometry payloads.
 pub fn fuzz_exact_payloads(data: &[u8]) {
     if data.len() < 3 {
         return;
@@ -60,8 +60,15 @@ pub fn fuzz_exact_payloads(data: &[u8]) {
         triangles: 0,
         clers_histogram: [0; 5],
     };
-    if let Ok(mesh) = crate::decode_exact_payloads(&p) {
-        check_valid(&mesh);
+    // Both geometry orders read the same bytes: the traversal order's payload has no
+    // strategy bit, so each input reaches both decoders.
+    for prediction in [
+        crate::ExactPrediction::Degree,
+        crate::ExactPrediction::Traversal,
+    ] {
+        if let Ok(mesh) = crate::decode_exact_payloads(&p, prediction) {
+            check_valid(&mesh);
+        }
     }
 }
 

@@ -44,7 +44,7 @@ pub use decoder::{
 pub use encoder::{
     encode, prepare_mesh, EncodeOptions, EncodeReport, Encoded, Encoder, PreparedMesh,
 };
-pub use exact::ExactPayloads;
+pub use exact::{ExactPayloads, ExactPrediction};
 #[doc(hidden)]
 pub use fuzz::{
     fuzz_decode, fuzz_exact_payloads, fuzz_swing_payloads, fuzz_swing_payloads_extended,
@@ -104,17 +104,25 @@ impl Error {
 }
 
 #[doc(hidden)]
-pub fn encode_exact_payloads(mesh: &whet_mesh::Mesh, bits: u32) -> Result<ExactPayloads, Error> {
+pub fn encode_exact_payloads(
+    mesh: &whet_mesh::Mesh,
+    bits: u32,
+    prediction: ExactPrediction,
+) -> Result<ExactPayloads, Error> {
     let table = whet_mesh::CornerTable::new(mesh).map_err(Error::InvalidInput)?;
-    exact::encode_exact(mesh, table, bits, false)
+    exact::encode_exact(mesh, table, bits, false, prediction)
 }
 
 #[doc(hidden)]
-pub fn decode_exact_payloads(p: &ExactPayloads) -> Result<whet_mesh::Mesh, Error> {
+pub fn decode_exact_payloads(
+    p: &ExactPayloads,
+    prediction: ExactPrediction,
+) -> Result<whet_mesh::Mesh, Error> {
     exact::decode_exact(
         &p.connectivity,
         &p.geometry,
         &p.quantizer,
         &whet_edgebreaker::ConnectivityLimits::DEFAULT,
+        prediction,
     )
 }

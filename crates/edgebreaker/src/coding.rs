@@ -104,6 +104,11 @@ pub struct Connectivity {
     /// by the traversal at corner `3 i` as symbol `N - 1 - i`, so the traversal's steps
     /// are known without traversing.
     decoder_steps: Option<Vec<std::ops::Range<u32>>>,
+    /// Set on the encoder's table relabelled in traversal order (triangle `i` the `i`-th
+    /// visited): per triangle, the position in it (0..3) of the corner the traversal entered
+    /// it by (the start corner for a start triangle), so the steps are known without
+    /// traversing again.
+    visit_tips: Option<Vec<u8>>,
 }
 
 impl Connectivity {
@@ -118,6 +123,37 @@ impl Connectivity {
         // longer have the decoded shape (one triangle per symbol plus one start triangle per
         // component, a step range per component within the labels), traverse instead; the
         // fast path then cannot index out of range.
+        if let Some(tips) = &self.visit_tips {
+            let nt = tips.len();
+            // The shape a relabelled table has (see `decoder_steps` for why it is checked).
+            if self.table.triangle_count() == nt
+                && labels.len() + self.starts.len() == nt
+                && self.starts.iter().all(|s| s.index() < 3 * nt)
+            {
+                let mut next_start = 0usize;
+                let mut symbol = 0usize;
+                for (i, &rot) in tips.iter().enumerate() {
+                    match self.starts.get(next_start) {
+                        Some(&corner) if corner.index() / 3 == i => {
+                            next_start += 1;
+                            visit(Step::Start { corner });
+                            continue;
+                        }
+                        _ => {}
+                    }
+                    let Some(&label) = labels.get(symbol) else {
+                        break;
+                    };
+                    visit(Step::Triangle {
+                        tip: CornerId(3 * i as u32 + u32::from(rot % 3)),
+                        label,
+                        symbol: symbol as u32,
+                    });
+                    symbol += 1;
+                }
+                return Ok(());
+            }
+        }
         let steps = match &self.decoder_steps {
             Some(steps)
                 if steps.len() == self.starts.len()
@@ -202,6 +238,9 @@ pub struct EncodedConnectivity {
     /// Corner vertices and opposites of the table relabelled in traversal order, built
     /// during the traversal (taken by the first [`EncodedConnectivity::traversal_ordered`]).
     ordered: Option<Relabelled>,
+    /// Per triangle in traversal order, the position of the corner it was entered by
+    /// (taken with `ordered`: see `Connectivity::visit_tips`).
+    visit_tips: Option<Vec<u8>>,
 }
 
 impl EncodedConnectivity {
@@ -229,6 +268,7 @@ impl EncodedConnectivity {
             Some(r) => r,
             None => self.relabel()?,
         };
+        let visit_tips = self.visit_tips.take();
         let conn = &self.connectivity;
         let order = &conn.summary.vertex_order;
         // A renumbering of the checked input table: consistent by construction, so only the
@@ -251,6 +291,7 @@ impl EncodedConnectivity {
                 is_dummy,
                 summary,
                 decoder_steps: None,
+                visit_tips,
             },
             old,
         ))
@@ -395,10 +436,12 @@ pub fn encode_connectivity_with_table(
     let mut ov = vec![0u32; 3 * nt];
     let mut oo = vec![u32::MAX; 3 * nt];
     let mut new_starts = Vec::new();
+    let mut tips: Vec<u8> = Vec::with_capacity(nt);
     let summary = traverse(&table, None, |step| {
         let f = match step {
             Step::Start { corner } => {
                 new_starts.push(3 * face_order.len() as u32 + corner.0 % 3);
+                tips.push((corner.0 % 3) as u8);
                 for c in [corner, table.next(corner), table.prev(corner)] {
                     vertex_rank[table.vertex(c).index()] = next_vertex;
                     next_vertex += 1;
@@ -410,6 +453,7 @@ pub fn encode_connectivity_with_table(
                     vertex_rank[table.vertex(tip).index()] = next_vertex;
                     next_vertex += 1;
                 }
+                tips.push((tip.0 % 3) as u8);
                 tip.0 / 3
             }
         } as usize;
@@ -473,9 +517,11 @@ pub fn encode_connectivity_with_table(
             is_dummy,
             summary,
             decoder_steps: None,
+            visit_tips: None,
         },
         face_order,
         ordered: Some((ov, oo, new_starts)),
+        visit_tips: Some(tips),
     })
 }
 
@@ -651,6 +697,7 @@ pub fn decode_connectivity(
             summary,
             // The ranges partition 0..n (component_steps checks it).
             decoder_steps: Some(steps),
+            visit_tips: None,
         },
         consumed,
     ))

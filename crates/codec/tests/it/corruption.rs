@@ -109,3 +109,46 @@ fn decoding_is_refused_past_the_byte_limit() {
         other => panic!("{other:?}"),
     }
 }
+
+/// The traversal prediction's streams say so in header field 40 and are format 1.5; the
+/// default's carry no such field and keep their version. A value this whet does not know is
+/// refused by name, with valid CRCs (a newer writer's stream), and a 1.4 reader, which does
+/// not know the required field, refuses it by tag rather than misreading the geometry.
+#[test]
+fn the_exact_prediction_field_is_written_read_and_refused_when_unknown() {
+    use whet_codec::ExactPrediction;
+    use whet_format::{parse, tag, Limits};
+    let m = punch(&icosphere(3), |i| i % 17 == 3);
+    let traversal = EncodeOptions::DEFAULT.with_prediction(ExactPrediction::Traversal);
+    let t = encode(&m, &traversal).unwrap().bytes;
+    let d = encode(&m, &EncodeOptions::DEFAULT).unwrap().bytes;
+    let (ct, cd) = (
+        parse(&t, &Limits::DEFAULT).unwrap(),
+        parse(&d, &Limits::DEFAULT).unwrap(),
+    );
+    assert_eq!(ct.header.get_u64(tag::EXACT_PREDICTION), Some(1));
+    assert_eq!(ct.header.version, whet_codec::Version::new(1, 5));
+    assert_eq!(cd.header.get_u64(tag::EXACT_PREDICTION), None);
+    assert_eq!(cd.header.version, whet_codec::Version::new(1, 0));
+    // Both decode to the same mesh up to the order of the positions' rounding: the same
+    // triangles and the same grid.
+    let (mt, md) = (
+        decode(&t, &DecodeOptions::DEFAULT).unwrap(),
+        decode(&d, &DecodeOptions::DEFAULT).unwrap(),
+    );
+    assert_eq!(mt, md);
+    // An unknown value, with valid CRCs.
+    let mut c = ct.clone();
+    c.header.set(tag::EXACT_PREDICTION, 2u64);
+    let e = decode(&c.to_bytes().unwrap(), &DecodeOptions::DEFAULT).unwrap_err();
+    assert!(e.is_input_error(), "{e}");
+    assert!(e.to_string().contains("exact prediction 2"), "{e}");
+    // Without the field the traversal payload is read as the degree order's: refused or a
+    // different mesh, never the same one (the field is what keeps old readers out).
+    let mut c = ct;
+    c.header.remove(tag::EXACT_PREDICTION);
+    match decode(&c.to_bytes().unwrap(), &DecodeOptions::DEFAULT) {
+        Ok(other) => assert_ne!(other, mt),
+        Err(e) => assert!(e.is_input_error(), "{e}"),
+    }
+}

@@ -2,7 +2,9 @@
 //! positions within half a quantization step.
 
 use proptest::prelude::*;
-use whet_codec::{decode, encode, DecodeOptions, Decoder, EncodeOptions, StreamingDecoder};
+use whet_codec::{
+    decode, encode, DecodeOptions, Decoder, EncodeOptions, ExactPrediction, StreamingDecoder,
+};
 use whet_mesh::{DVec3, Mesh};
 use whet_testkit::meshes::*;
 
@@ -11,9 +13,19 @@ fn canonical(t: [u32; 3]) -> [u32; 3] {
     [t[r], t[(r + 1) % 3], t[(r + 2) % 3]]
 }
 
-/// Checks a decoded mesh against its source through the report's vertex order.
+/// Checks a decoded mesh against its source through the report's vertex order, for both
+/// exact-mode predictions; returns the default (degree order) stream.
 pub fn check_round_trip(mesh: &Mesh, bits: u32) -> Vec<u8> {
-    let enc = encode(mesh, &EncodeOptions::DEFAULT.with_quant_bits(bits)).unwrap();
+    check_round_trip_with(mesh, bits, ExactPrediction::Traversal);
+    check_round_trip_with(mesh, bits, ExactPrediction::Degree)
+}
+
+/// [`check_round_trip`] for one prediction.
+pub fn check_round_trip_with(mesh: &Mesh, bits: u32, prediction: ExactPrediction) -> Vec<u8> {
+    let opts = EncodeOptions::DEFAULT
+        .with_quant_bits(bits)
+        .with_prediction(prediction);
+    let enc = encode(mesh, &opts).unwrap();
     let dec = decode(&enc.bytes, &DecodeOptions::DEFAULT).unwrap();
     let order = &enc.report.vertex_order;
     assert_eq!(dec.positions.len(), order.len());

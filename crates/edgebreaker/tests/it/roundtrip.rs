@@ -60,6 +60,21 @@ fn round_trip(mesh: &Mesh) -> (f64, [usize; 5]) {
     let (again, old_again) = enc.traversal_ordered().expect("relabels again");
     assert_eq!(first.table, again.table);
     assert_eq!(first.starts, again.starts);
+    // The first carries the corners the traversal entered each triangle by, the second
+    // (rebuilt) traverses: both report the traversal's steps on the relabelled table.
+    let mut traversed_relabelled = Vec::new();
+    whet_edgebreaker::traverse(&first.table, Some(&first.starts), |s| {
+        traversed_relabelled.push(s)
+    })
+    .unwrap();
+    for conn in [&first, &again] {
+        let mut stepped = Vec::new();
+        conn.for_each_step(|s| stepped.push(s)).unwrap();
+        assert_eq!(
+            stepped, traversed_relabelled,
+            "recorded steps differ from the traversal"
+        );
+    }
     assert_eq!(first.is_dummy, again.is_dummy);
     assert_eq!(old_first, old_again);
     let mut relabelled: Vec<[u32; 3]> = first
