@@ -726,15 +726,21 @@ pub(crate) fn code_positions_traversal<I: ResidualIo>(
 ) -> Result<Vec<bool>, TraversalError> {
     let table = &conn.table;
     let nv = table.vertex_count();
-    let max_level = ((1u64 << bits.clamp(1, 30)) - 1) as i32;
+    let max_level = ((1u64 << bits.clamp(1, 30)) - 1) as i64;
     let mut models = PositionModels::new();
     let cv = table.corner_vertices();
     let opp = table.opposites();
     let nc = cv.len();
-    // Known, and dummies (never coded).
-    let mut known = vec![false; nv];
-    let dummy = |v: usize| conn.is_dummy.get(v).copied().unwrap_or(false);
-    let grid = |p: [i64; 3]| p.map(|c| c.clamp(0, max_level as i64) as i32);
+    // One byte per vertex: unknown, known, or a dummy (never coded).
+    let mut state: Vec<u8> = (0..nv)
+        .map(|v| {
+            if conn.is_dummy.get(v).copied().unwrap_or(false) {
+                DUMMY
+            } else {
+                UNKNOWN
+            }
+        })
+        .collect();
     let mut stop = false;
     conn.for_each_step(|step| {
         if stop {
@@ -752,7 +758,7 @@ pub(crate) fn code_positions_traversal<I: ResidualIo>(
                 let mut first: Option<[i32; 3]> = None;
                 let mut second: Option<[i32; 3]> = None;
                 for vi in vs {
-                    if known[vi] || dummy(vi) {
+                    if state[vi] != UNKNOWN {
                         continue;
                     }
                     let mut value = q[vi];
@@ -772,7 +778,7 @@ pub(crate) fn code_positions_traversal<I: ResidualIo>(
                         }
                     }
                     q[vi] = value;
-                    known[vi] = true;
+                    state[vi] = KNOWN;
                 }
             }
             whet_edgebreaker::Step::Triangle {
@@ -786,31 +792,37 @@ pub(crate) fn code_positions_traversal<I: ResidualIo>(
                     return;
                 }
                 let v = cv[t] as usize;
-                if known[v] || dummy(v) {
+                if state[v] != UNKNOWN {
                     return;
                 }
                 let base = t - t % 3;
                 let a = cv[base + (t + 1) % 3] as usize;
                 let b = cv[base + (t + 2) % 3] as usize;
                 let o = opp[t] as usize;
-                let w = if o < nc { Some(cv[o] as usize) } else { None };
-                let (class, prediction) = match (known[a], known[b], w) {
-                    (true, true, Some(w)) if known[w] => {
-                        let (qa, qb, qw) = (q[a], q[b], q[w]);
-                        (
-                            1,
-                            grid([0, 1, 2].map(|k| qa[k] as i64 + qb[k] as i64 - qw[k] as i64)),
-                        )
-                    }
-                    (true, true, _) => (0, gate_midpoint(q[a], q[b])),
-                    (true, false, _) => (0, q[a]),
-                    (false, true, _) => (0, q[b]),
-                    (false, false, _) => (0, [0; 3]),
+                let w = if o < nc { cv[o] as usize } else { v };
+                let (a_known, b_known) = (state[a] == KNOWN, state[b] == KNOWN);
+                let (class, prediction) = if a_known && b_known && state[w] == KNOWN {
+                    // Per axis, clamped into the grid, written out (an array map here was
+                    // an out-of-line call per vertex).
+                    let (qa, qb, qw) = (q[a], q[b], q[w]);
+                    // (`max`/`min`: `clamp` stayed an out-of-line call with its bounds assert.)
+                    let x = (qa[0] as i64 + qb[0] as i64 - qw[0] as i64).max(0).min(max_level);
+                    let y = (qa[1] as i64 + qb[1] as i64 - qw[1] as i64).max(0).min(max_level);
+                    let z = (qa[2] as i64 + qb[2] as i64 - qw[2] as i64).max(0).min(max_level);
+                    (1, [x as i32, y as i32, z as i32])
+                } else if a_known && b_known {
+                    (0, gate_midpoint(q[a], q[b]))
+                } else if a_known {
+                    (0, q[a])
+                } else if b_known {
+                    (0, q[b])
+                } else {
+                    (0, [0; 3])
                 };
                 let mut value = q[v];
                 io.residual(&mut models, Some(class), prediction, &mut value);
                 q[v] = value;
-                known[v] = true;
+                state[v] = KNOWN;
                 if io.exhausted() {
                     stop = true;
                 }
@@ -818,7 +830,7 @@ pub(crate) fn code_positions_traversal<I: ResidualIo>(
             _ => {}
         }
     })?;
-    Ok(known)
+    Ok(state.iter().map(|&s| s == KNOWN).collect())
 }
 
 /// Prediction without a parallelogram: the midpoint of the first triangle around the vertex
