@@ -806,9 +806,15 @@ pub(crate) fn code_positions_traversal<I: ResidualIo>(
                     // an out-of-line call per vertex).
                     let (qa, qb, qw) = (q[a], q[b], q[w]);
                     // (`max`/`min`: `clamp` stayed an out-of-line call with its bounds assert.)
-                    let x = (qa[0] as i64 + qb[0] as i64 - qw[0] as i64).max(0).min(max_level);
-                    let y = (qa[1] as i64 + qb[1] as i64 - qw[1] as i64).max(0).min(max_level);
-                    let z = (qa[2] as i64 + qb[2] as i64 - qw[2] as i64).max(0).min(max_level);
+                    let x = (qa[0] as i64 + qb[0] as i64 - qw[0] as i64)
+                        .max(0)
+                        .min(max_level);
+                    let y = (qa[1] as i64 + qb[1] as i64 - qw[1] as i64)
+                        .max(0)
+                        .min(max_level);
+                    let z = (qa[2] as i64 + qb[2] as i64 - qw[2] as i64)
+                        .max(0)
+                        .min(max_level);
                     (1, [x as i32, y as i32, z as i32])
                 } else if a_known && b_known {
                     (0, gate_midpoint(q[a], q[b]))

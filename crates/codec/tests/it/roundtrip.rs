@@ -274,23 +274,26 @@ fn read_and_streaming_decoders_agree_for_any_chunking() {
         &union(torus(9, 5), &punch(&icosphere(2), |i| i % 13 == 0), 4.0),
         9,
     );
-    let enc = encode(&m, &EncodeOptions::DEFAULT).unwrap();
-    let whole = decode(&enc.bytes, &DecodeOptions::DEFAULT).unwrap();
-    let from_read = Decoder::new(&enc.bytes[..], DecodeOptions::DEFAULT)
-        .decode()
-        .unwrap();
-    assert_eq!(from_read, whole);
-    for chunk in [1usize, 2, 3, 7, 64, 1000] {
-        let mut s = StreamingDecoder::new(DecodeOptions::DEFAULT);
-        for piece in enc.bytes.chunks(chunk) {
-            let mut rest = piece;
-            while !rest.is_empty() {
-                let (used, _) = s.update(rest).unwrap();
-                rest = &rest[used..];
+    for prediction in [ExactPrediction::Degree, ExactPrediction::Traversal] {
+        let opts = EncodeOptions::DEFAULT.with_prediction(prediction);
+        let enc = encode(&m, &opts).unwrap();
+        let whole = decode(&enc.bytes, &DecodeOptions::DEFAULT).unwrap();
+        let from_read = Decoder::new(&enc.bytes[..], DecodeOptions::DEFAULT)
+            .decode()
+            .unwrap();
+        assert_eq!(from_read, whole);
+        for chunk in [1usize, 2, 3, 7, 64, 1000] {
+            let mut s = StreamingDecoder::new(DecodeOptions::DEFAULT);
+            for piece in enc.bytes.chunks(chunk) {
+                let mut rest = piece;
+                while !rest.is_empty() {
+                    let (used, _) = s.update(rest).unwrap();
+                    rest = &rest[used..];
+                }
             }
+            assert!(s.is_done());
+            assert_eq!(s.finish().unwrap(), whole, "{prediction:?} chunk {chunk}");
         }
-        assert!(s.is_done());
-        assert_eq!(s.finish().unwrap(), whole, "chunk {chunk}");
     }
 }
 
