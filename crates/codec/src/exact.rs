@@ -631,31 +631,7 @@ pub(crate) fn code_positions<I: ResidualIo>(
                 st.anchor[vi] = c.0;
             }
         }
-        let mut first: Option<[i32; 3]> = None;
-        let mut second: Option<[i32; 3]> = None;
-        for &vi in &vs {
-            if st.state[vi] & STATE_MASK != UNKNOWN {
-                continue;
-            }
-            let mut value = q[vi];
-            match (first, second) {
-                (None, _) => {
-                    io.raw(bits, &mut value);
-                    first = Some(value);
-                }
-                (Some(f), None) => {
-                    io.residual(&mut models, None, f, &mut value);
-                    second = Some(value);
-                }
-                (Some(f), Some(s)) => {
-                    // i64: a corrupt stream can decode values near the i32 limits.
-                    let mid = [0, 1, 2].map(|k| ((f[k] as i64 + s[k] as i64).div_euclid(2)) as i32);
-                    io.residual(&mut models, None, mid, &mut value);
-                }
-            }
-            q[vi] = value;
-            st.state[vi] = KNOWN;
-        }
+        code_start_triangle(io, &mut models, bits, q, &mut st.state, vs);
         for &vi in &vs {
             if st.state[vi] == KNOWN {
                 st.walk(vi, q, None);
@@ -712,6 +688,45 @@ pub(crate) fn code_positions<I: ResidualIo>(
     Ok(known_vec(&st))
 }
 
+/// Codes a component's start triangle `vs` (its vertices in creation order), for both
+/// orders: the first unknown vertex raw, the second as a residual from the first, the third
+/// from their midpoint; vertices already known or dummies (by their `state` byte) are
+/// skipped. Marks the coded ones known.
+fn code_start_triangle<I: ResidualIo>(
+    io: &mut I,
+    models: &mut PositionModels,
+    bits: u32,
+    q: &mut [[i32; 3]],
+    state: &mut [u8],
+    vs: [usize; 3],
+) {
+    let mut first: Option<[i32; 3]> = None;
+    let mut second: Option<[i32; 3]> = None;
+    for vi in vs {
+        if state[vi] & STATE_MASK != UNKNOWN {
+            continue;
+        }
+        let mut value = q[vi];
+        match (first, second) {
+            (None, _) => {
+                io.raw(bits, &mut value);
+                first = Some(value);
+            }
+            (Some(f), None) => {
+                io.residual(models, None, f, &mut value);
+                second = Some(value);
+            }
+            (Some(f), Some(s)) => {
+                // i64: a corrupt stream can decode values near the i32 limits.
+                let mid = [0, 1, 2].map(|k| ((f[k] as i64 + s[k] as i64).div_euclid(2)) as i32);
+                io.residual(models, None, mid, &mut value);
+            }
+        }
+        q[vi] = value;
+        state[vi] = KNOWN;
+    }
+}
+
 /// Codes each real vertex's grid coordinates through `io` in traversal order (the order the
 /// connectivity decoder creates vertices): per component the start triangle's vertices as
 /// [`code_positions`] codes them, then each C triangle's tip predicted by the one
@@ -755,31 +770,7 @@ pub(crate) fn code_positions_traversal<I: ResidualIo>(
                 }
                 let base = c - c % 3;
                 let vs = [c, base + (c + 1) % 3, base + (c + 2) % 3].map(|x| cv[x] as usize);
-                let mut first: Option<[i32; 3]> = None;
-                let mut second: Option<[i32; 3]> = None;
-                for vi in vs {
-                    if state[vi] != UNKNOWN {
-                        continue;
-                    }
-                    let mut value = q[vi];
-                    match (first, second) {
-                        (None, _) => {
-                            io.raw(bits, &mut value);
-                            first = Some(value);
-                        }
-                        (Some(f), None) => {
-                            io.residual(&mut models, None, f, &mut value);
-                            second = Some(value);
-                        }
-                        (Some(f), Some(s)) => {
-                            let mid = [0, 1, 2]
-                                .map(|k| ((f[k] as i64 + s[k] as i64).div_euclid(2)) as i32);
-                            io.residual(&mut models, None, mid, &mut value);
-                        }
-                    }
-                    q[vi] = value;
-                    state[vi] = KNOWN;
-                }
+                code_start_triangle(io, &mut models, bits, q, &mut state, vs);
             }
             whet_edgebreaker::Step::Triangle {
                 tip,
