@@ -36,10 +36,16 @@ type RateCheck = fn(f64) -> Option<String>;
 /// sweep whose arguments are wrong is refused before it starts (exit 2), while a row that
 /// fails on one mesh (a rate too high for it, say) stays a row with its error.
 fn check_rates(plan: &Plan) -> CliResult {
-    let lists: [(&str, &str, &[f64], RateCheck); 3] = [
+    let lists: [(&str, &str, &[f64], RateCheck); 4] = [
         ("swing", "--rates", &plan.rates, swing_rate_problem),
         (
             "exact",
+            "--exact-bits",
+            &plan.exact_bits,
+            exact_rate_problem,
+        ),
+        (
+            "exact-traversal",
             "--exact-bits",
             &plan.exact_bits,
             exact_rate_problem,
@@ -73,18 +79,27 @@ pub fn check_samples(samples: usize) -> CliResult {
     Ok(())
 }
 
-/// The exact mode as an rd codec; the rate is the quantization bits.
-struct ExactCodec;
+/// The exact mode as an rd codec; the rate is the quantization bits. Mode `exact` codes
+/// with the default prediction, `exact-traversal` with the traversal prediction (the faster
+/// decoder; compare their decode-time columns).
+struct ExactCodec {
+    prediction: whet_codec::ExactPrediction,
+}
 
 impl Codec for ExactCodec {
     fn name(&self) -> String {
-        "exact".into()
+        match self.prediction {
+            whet_codec::ExactPrediction::Traversal => "exact-traversal".into(),
+            _ => "exact".into(),
+        }
     }
     fn encode(&self, mesh: &Mesh, rate: f64) -> Result<Vec<u8>, String> {
         if let Some(problem) = exact_rate_problem(rate) {
             return Err(problem);
         }
-        let opts = whet_codec::EncodeOptions::DEFAULT.with_quant_bits(rate as u32);
+        let opts = whet_codec::EncodeOptions::DEFAULT
+            .with_quant_bits(rate as u32)
+            .with_prediction(self.prediction);
         whet_codec::encode(mesh, &opts)
             .map(|e| e.bytes)
             .map_err(|e| e.to_string())
@@ -168,7 +183,7 @@ pub struct RdArgs {
     /// Control vertex counts of the subdiv mode's curve, comma separated.
     #[arg(long, value_delimiter = ',', default_value = "100,200,400,800")]
     subdiv_control: Vec<f64>,
-    /// Codec modes to sweep (swing, exact, subdiv).
+    /// Codec modes to sweep (swing, exact, exact-traversal, subdiv).
     #[arg(long, value_delimiter = ',', default_value = "swing,exact")]
     modes: Vec<String>,
     /// Post-processing stages to measure after decoding.
@@ -329,7 +344,12 @@ fn stage_by_name(name: &str) -> Result<Stage, Failure> {
 
 /// Runs a sweep and writes its files; returns the points and the markdown report (`rd.md`).
 pub fn run_plan(meshes: Vec<(String, Mesh)>, plan: &Plan) -> CliResult<(Vec<Point>, String)> {
-    let exact = ExactCodec;
+    let exact = ExactCodec {
+        prediction: whet_codec::ExactPrediction::Degree,
+    };
+    let exact_traversal = ExactCodec {
+        prediction: whet_codec::ExactPrediction::Traversal,
+    };
     let subdiv = SubdivCodec;
     let sharpens = plan.stages.iter().any(|s| s == "sharpened" || s == "bent");
     let swing = SwingCodec {
@@ -344,8 +364,13 @@ pub fn run_plan(meshes: Vec<(String, Mesh)>, plan: &Plan) -> CliResult<(Vec<Poin
     for m in &plan.modes {
         match m.as_str() {
             "swing" => codecs.push(CodecSweep::new(&swing, plan.rates.clone())),
-            "exact" => {
-                let mut c = CodecSweep::new(&exact, plan.exact_bits.clone());
+            "exact" | "exact-traversal" => {
+                let codec = if m == "exact" {
+                    &exact
+                } else {
+                    &exact_traversal
+                };
+                let mut c = CodecSweep::new(codec, plan.exact_bits.clone());
                 if let Some(s) = &plan.exact_stages {
                     c = c.with_stages(s.clone());
                 }
@@ -354,7 +379,7 @@ pub fn run_plan(meshes: Vec<(String, Mesh)>, plan: &Plan) -> CliResult<(Vec<Poin
             "subdiv" => codecs.push(CodecSweep::new(&subdiv, plan.subdiv_control.clone())),
             other => {
                 return Err(Failure::input(anyhow::anyhow!(
-                    "unknown mode {other:?} (available: swing, exact, subdiv)"
+                    "unknown mode {other:?} (available: swing, exact, exact-traversal, subdiv)"
                 )))
             }
         }

@@ -130,6 +130,35 @@ fn demo_runs_the_sweep_on_its_own_mesh() {
 }
 
 #[test]
+fn rd_sweeps_both_exact_predictions() {
+    // The traversal prediction decodes to the same mesh (same errors), in more bytes.
+    let dir = scratch_dir("cli-rd-traversal");
+    let out = dir.join("rd");
+    let o = whet(&[
+        "rd",
+        s(&shared_fixture("bunny.off")),
+        "--modes",
+        "exact,exact-traversal",
+        "--exact-bits",
+        "11",
+        "--samples",
+        "20000",
+        "--out",
+        s(&out),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("rd.json")).unwrap()).unwrap();
+    let pts = json["points"].as_array().unwrap();
+    assert_eq!(pts.len(), 2);
+    assert_eq!(pts[0]["mode"], "exact");
+    assert_eq!(pts[1]["mode"], "exact-traversal");
+    assert!(pts[0]["rms_pct"].is_number(), "{}", pts[0]);
+    assert_eq!(pts[0]["rms_pct"], pts[1]["rms_pct"]);
+    assert!(pts[1]["bytes"].as_u64() > pts[0]["bytes"].as_u64());
+}
+
+#[test]
 fn rd_reports_unknown_modes_and_stages() {
     let o = whet(&["rd", s(&shared_fixture("cube.off")), "--modes", "nonsense"]);
     assert_eq!(o.status.code(), Some(2));
