@@ -22,8 +22,9 @@ pub struct EncodeOptions {
     /// Cut non-manifold input with `Mesh::make_manifold` instead of refusing it.
     pub repair: bool,
     /// Exact mode: the order and predictor of the positions (the degree order by default;
-    /// the traversal order decodes about twice as fast for a few percent more bytes and
-    /// writes format 1.5).
+    /// the traversal order decodes about 1.8 times as fast for 3-15 % more bytes on most
+    /// meshes, up to about 50 % on blocky CAD parts, and writes format 1.5). Exact mode
+    /// only: other modes ignore it.
     pub prediction: ExactPrediction,
 }
 

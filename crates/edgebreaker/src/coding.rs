@@ -115,20 +115,29 @@ impl Connectivity {
     /// Calls `visit` with every step of the traversal of `table` from `starts`, in order:
     /// what [`crate::traverse`]`(&self.table, Some(&self.starts), visit)` does, without
     /// walking the table when it was decoded (the decoder's own construction order gives
-    /// the steps; a decoded connectivity whose table was replaced by another of the same
-    /// size gets the decoded table's steps).
+    /// the steps) or when it is the encoder's table relabelled in traversal order (the steps
+    /// were recorded while traversing). A connectivity whose table was replaced by another
+    /// of the same size gets the recorded steps of the one it replaced.
     pub fn for_each_step(&self, mut visit: impl FnMut(Step)) -> Result<(), TraversalError> {
         let labels = &self.summary.labels;
-        // The fields are public: a caller may have edited them since decoding. When they no
-        // longer have the decoded shape (one triangle per symbol plus one start triangle per
-        // component, a step range per component within the labels), traverse instead; the
-        // fast path then cannot index out of range.
+        // The fields are public: a caller may have edited them since decoding or relabelling.
+        // When they no longer have the recorded shape, traverse instead; the fast paths then
+        // cannot index out of range.
         if let Some(tips) = &self.visit_tips {
             let nt = tips.len();
-            // The shape a relabelled table has (see `decoder_steps` for why it is checked).
+            // A relabelled table: one triangle per symbol plus one start triangle per
+            // component, the starts in increasing triangle order (components follow each
+            // other), each start corner the one recorded for its triangle.
             if self.table.triangle_count() == nt
                 && labels.len() + self.starts.len() == nt
-                && self.starts.iter().all(|s| s.index() < 3 * nt)
+                && self
+                    .starts
+                    .windows(2)
+                    .all(|w| w[0].index() / 3 < w[1].index() / 3)
+                && self
+                    .starts
+                    .iter()
+                    .all(|s| tips.get(s.index() / 3) == Some(&((s.index() % 3) as u8)))
             {
                 let mut next_start = 0usize;
                 let mut symbol = 0usize;

@@ -200,7 +200,7 @@ pub mod tag {
     pub const FILTER_TANGENTIAL: u64 = 38;
     /// u64 (format 1.5): the order and predictor of an exact-mode stream's positions: 0
     /// the prediction-degree order with several parallelograms (absent: 0), 1 traversal
-    /// order with one parallelogram per vertex (faster to decode, a few percent larger).
+    /// order with one parallelogram per vertex (faster to decode, larger).
     /// Required: a reader that does not know it would misread the geometry.
     pub const EXACT_PREDICTION: u64 = 40;
 

@@ -4,32 +4,47 @@ use whet_codec::{decode, encode, DecodeOptions, EncodeOptions, Error};
 use whet_testkit::meshes::*;
 
 fn sample_stream() -> Vec<u8> {
+    sample_stream_with(whet_codec::ExactPrediction::Degree)
+}
+
+fn sample_stream_with(prediction: whet_codec::ExactPrediction) -> Vec<u8> {
     let m = shuffle(
         &union(torus(6, 5), &punch(&icosphere(2), |i| i % 9 == 0), 4.0),
         1,
     );
-    encode(&m, &EncodeOptions::DEFAULT.with_quant_bits(11))
-        .unwrap()
-        .bytes
+    let opts = EncodeOptions::DEFAULT
+        .with_quant_bits(11)
+        .with_prediction(prediction);
+    encode(&m, &opts).unwrap().bytes
+}
+
+/// Streams of both exact predictions.
+fn sample_streams() -> [Vec<u8>; 2] {
+    [
+        sample_stream(),
+        sample_stream_with(whet_codec::ExactPrediction::Traversal),
+    ]
 }
 
 #[test]
 fn every_truncation_is_an_error() {
-    let bytes = sample_stream();
-    for cut in 0..bytes.len() {
-        let e = decode(&bytes[..cut], &DecodeOptions::DEFAULT).unwrap_err();
-        assert!(e.is_input_error(), "cut {cut}: {e}");
+    for bytes in sample_streams() {
+        for cut in 0..bytes.len() {
+            let e = decode(&bytes[..cut], &DecodeOptions::DEFAULT).unwrap_err();
+            assert!(e.is_input_error(), "cut {cut}: {e}");
+        }
     }
 }
 
 #[test]
 fn every_bit_flip_is_an_error() {
-    let bytes = sample_stream();
-    for i in 0..bytes.len() * 8 {
-        let mut b = bytes.clone();
-        b[i / 8] ^= 1 << (i % 8);
-        let r = decode(&b, &DecodeOptions::DEFAULT);
-        assert!(r.is_err(), "flip of bit {i} decoded silently");
+    for bytes in sample_streams() {
+        for i in 0..bytes.len() * 8 {
+            let mut b = bytes.clone();
+            b[i / 8] ^= 1 << (i % 8);
+            let r = decode(&b, &DecodeOptions::DEFAULT);
+            assert!(r.is_err(), "flip of bit {i} decoded silently");
+        }
     }
 }
 
@@ -130,8 +145,9 @@ fn the_exact_prediction_field_is_written_read_and_refused_when_unknown() {
     assert_eq!(ct.header.version, whet_codec::Version::new(1, 5));
     assert_eq!(cd.header.get_u64(tag::EXACT_PREDICTION), None);
     assert_eq!(cd.header.version, whet_codec::Version::new(1, 0));
-    // Both decode to the same mesh up to the order of the positions' rounding: the same
-    // triangles and the same grid.
+    // Both decode to the same mesh: the same connectivity, hence the same vertex order
+    // and triangles, and the same grid positions (the prediction changes the residuals,
+    // not the coded values).
     let (mt, md) = (
         decode(&t, &DecodeOptions::DEFAULT).unwrap(),
         decode(&d, &DecodeOptions::DEFAULT).unwrap(),

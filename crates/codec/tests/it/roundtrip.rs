@@ -71,9 +71,12 @@ fn one_triangle_and_empty() {
     let one = Mesh::new(vec![DVec3::ZERO, DVec3::X, DVec3::Y], vec![[0, 1, 2]]);
     check_round_trip(&one, 10);
     let empty = Mesh::default();
-    let enc = encode(&empty, &EncodeOptions::DEFAULT).unwrap();
-    let dec = decode(&enc.bytes, &DecodeOptions::DEFAULT).unwrap();
-    assert!(dec.positions.is_empty() && dec.triangles.is_empty());
+    for prediction in [ExactPrediction::Degree, ExactPrediction::Traversal] {
+        let opts = EncodeOptions::DEFAULT.with_prediction(prediction);
+        let enc = encode(&empty, &opts).unwrap();
+        let dec = decode(&enc.bytes, &DecodeOptions::DEFAULT).unwrap();
+        assert!(dec.positions.is_empty() && dec.triangles.is_empty());
+    }
 }
 
 #[test]
