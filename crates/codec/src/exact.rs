@@ -12,7 +12,9 @@
 //! x bit length of the previous axis's residual of the same vertex (0..=5), which captures that
 //! a vertex badly predicted on one axis is usually badly predicted on the others.
 
-use crate::parallelogram::{average, gate_midpoint, masked_sum, mean, MAX_CANDIDATES};
+use crate::parallelogram::{
+    average, gate_midpoint, masked_sum, mean, partial_gate, MAX_CANDIDATES,
+};
 use whet_bits::{BitModel, RangeDecoder, ResidualModel, SignedIntModel};
 use whet_edgebreaker::{Connectivity, TraversalError};
 
@@ -597,20 +599,12 @@ pub(crate) fn code_positions<I: ResidualIo>(
 ) -> Result<Vec<bool>, TraversalError> {
     let table = &conn.table;
     let nv = table.vertex_count();
-    let max_level = ((1u64 << bits.clamp(1, 30)) - 1) as i32;
+    let max_level = max_grid_level(bits);
     let mut models = PositionModels::new();
     let mut st = DegreeOrder {
         cv: table.corner_vertices(),
         opp: table.opposites(),
-        state: (0..nv)
-            .map(|v| {
-                if conn.is_dummy.get(v).copied().unwrap_or(false) {
-                    DUMMY
-                } else {
-                    UNKNOWN
-                }
-            })
-            .collect(),
+        state: initial_states(conn, nv),
         anchor: vec![u32::MAX; nv],
         buckets: Default::default(),
     };
@@ -688,6 +682,24 @@ pub(crate) fn code_positions<I: ResidualIo>(
     Ok(known_vec(&st))
 }
 
+/// The largest grid coordinate at `bits` bits per axis (clamped to 1..=30).
+fn max_grid_level(bits: u32) -> i32 {
+    ((1u64 << bits.clamp(1, 30)) - 1) as i32
+}
+
+/// Each vertex's state before any is coded: a hole's dummy, or unknown.
+fn initial_states(conn: &Connectivity, nv: usize) -> Vec<u8> {
+    (0..nv)
+        .map(|v| {
+            if conn.is_dummy.get(v).copied().unwrap_or(false) {
+                DUMMY
+            } else {
+                UNKNOWN
+            }
+        })
+        .collect()
+}
+
 /// Codes a component's start triangle `vs` (its vertices in creation order), for both
 /// orders: the first unknown vertex raw, the second as a residual from the first, the third
 /// from their midpoint; vertices already known or dummies (by their `state` byte) are
@@ -741,21 +753,13 @@ pub(crate) fn code_positions_traversal<I: ResidualIo>(
 ) -> Result<Vec<bool>, TraversalError> {
     let table = &conn.table;
     let nv = table.vertex_count();
-    let max_level = ((1u64 << bits.clamp(1, 30)) - 1) as i64;
+    let max_level = i64::from(max_grid_level(bits));
     let mut models = PositionModels::new();
     let cv = table.corner_vertices();
     let opp = table.opposites();
     let nc = cv.len();
     // One byte per vertex: unknown, known, or a dummy (never coded).
-    let mut state: Vec<u8> = (0..nv)
-        .map(|v| {
-            if conn.is_dummy.get(v).copied().unwrap_or(false) {
-                DUMMY
-            } else {
-                UNKNOWN
-            }
-        })
-        .collect();
+    let mut state = initial_states(conn, nv);
     let mut stop = false;
     conn.for_each_step(|step| {
         if stop {
@@ -807,14 +811,11 @@ pub(crate) fn code_positions_traversal<I: ResidualIo>(
                         .max(0)
                         .min(max_level);
                     (1, [x as i32, y as i32, z as i32])
-                } else if a_known && b_known {
-                    (0, gate_midpoint(q[a], q[b]))
-                } else if a_known {
-                    (0, q[a])
-                } else if b_known {
-                    (0, q[b])
                 } else {
-                    (0, [0; 3])
+                    (
+                        0,
+                        partial_gate(a_known.then(|| q[a]), b_known.then(|| q[b])),
+                    )
                 };
                 let mut value = q[v];
                 io.residual(&mut models, Some(class), prediction, &mut value);
@@ -996,51 +997,20 @@ fn encode_exact_with(
         }
     }
     drop(new_id);
-    // Per mesh, keep the cheaper of the two prediction strategies: averaging every
-    // parallelogram suits smooth surfaces, choosing subsets suits creased CAD parts. Both
-    // are coded in one walk until a prefix settles the choice (EARLY_DECISION_VERTICES);
-    // coded to the end, subsets win only when strictly smaller.
-    let max_level = ((1u64 << bits.clamp(1, 30)) - 1) as i32;
-    if prediction == ExactPrediction::Traversal {
-        // One coder, no strategy to choose: the payload is the residuals alone.
-        let mut sink = whet_bits::RangeEncoder::new();
-        let mut io = ResidualWriter {
-            sink: &mut sink,
-            constrained: false,
-            budget: usize::MAX,
-        };
-        code_positions_traversal(&conn, bits, &mut q, &mut io)
-            .map_err(whet_edgebreaker::Error::from)?;
-        return Ok((
-            ExactPayloads {
-                connectivity: enc.bytes,
-                geometry: sink.finish(),
-                quantizer,
-                vertex_order,
-                components: conn.starts.len(),
-                triangles: mesh.triangles.len(),
-                clers_histogram,
-            },
-            None,
-        ));
-    }
-    let mut all = whet_bits::RangeEncoder::new();
-    let mut subsets = whet_bits::RangeEncoder::new();
-    all.encode_direct(0, 1);
-    subsets.encode_direct(1, 1);
-    let mut io = DualWriter::new(&mut all, &mut subsets, max_level);
-    if !early {
-        io.coded = usize::MAX;
-    }
-    code_positions(&conn, bits, &mut q, &mut io).map_err(whet_edgebreaker::Error::from)?;
-    let decided = io.decided;
-    let (all, subsets) = (all.finish(), subsets.finish());
-    let geometry = match decided {
-        // The other coder stopped when the prefix settled it.
-        Some(true) => subsets,
-        Some(false) => all,
-        None if subsets.len() < all.len() => subsets,
-        None => all,
+    let (geometry, decided) = match prediction {
+        ExactPrediction::Degree => degree_geometry(&conn, bits, &mut q, early)?,
+        ExactPrediction::Traversal => {
+            // One coder, no strategy to choose: the payload is the residuals alone.
+            let mut sink = whet_bits::RangeEncoder::new();
+            let mut io = ResidualWriter {
+                sink: &mut sink,
+                constrained: false,
+                budget: usize::MAX,
+            };
+            code_positions_traversal(&conn, bits, &mut q, &mut io)
+                .map_err(whet_edgebreaker::Error::from)?;
+            (sink.finish(), None)
+        }
     };
     Ok((
         ExactPayloads {
@@ -1054,6 +1024,39 @@ fn encode_exact_with(
         },
         decided,
     ))
+}
+
+/// The degree order's geometry payload and whether the strategy was settled early
+/// (`Some(true)`: subsets). Per mesh, keep the cheaper of the two prediction strategies:
+/// averaging every parallelogram suits smooth surfaces, choosing subsets suits creased CAD
+/// parts. Both are coded in one walk until a prefix settles the choice
+/// (EARLY_DECISION_VERTICES); coded to the end, subsets win only when strictly smaller.
+fn degree_geometry(
+    conn: &Connectivity,
+    bits: u32,
+    q: &mut [[i32; 3]],
+    early: bool,
+) -> Result<(Vec<u8>, Option<bool>), crate::Error> {
+    let max_level = max_grid_level(bits);
+    let mut all = whet_bits::RangeEncoder::new();
+    let mut subsets = whet_bits::RangeEncoder::new();
+    all.encode_direct(0, 1);
+    subsets.encode_direct(1, 1);
+    let mut io = DualWriter::new(&mut all, &mut subsets, max_level);
+    if !early {
+        io.coded = usize::MAX;
+    }
+    code_positions(conn, bits, q, &mut io).map_err(whet_edgebreaker::Error::from)?;
+    let decided = io.decided;
+    let (all, subsets) = (all.finish(), subsets.finish());
+    let geometry = match decided {
+        // The other coder stopped when the prefix settled it.
+        Some(true) => subsets,
+        Some(false) => all,
+        None if subsets.len() < all.len() => subsets,
+        None => all,
+    };
+    Ok((geometry, decided))
 }
 
 /// Decodes the two payloads of an exact-mode stream.

@@ -121,11 +121,17 @@ pub fn gate_fallback(
 ) -> [i32; 3] {
     let a = table.vertex(table.next(tip)).index();
     let b = table.vertex(table.prev(tip)).index();
-    match (known[a], known[b]) {
-        (true, true) => gate_midpoint(q[a], q[b]),
-        (true, false) => q[a],
-        (false, true) => q[b],
-        (false, false) => [0; 3],
+    partial_gate(known[a].then(|| q[a]), known[b].then(|| q[b]))
+}
+
+/// The prediction from a gate's known vertices (`None`: unknown): their midpoint, the one
+/// known, or the origin.
+#[inline]
+pub(crate) fn partial_gate(a: Option<[i32; 3]>, b: Option<[i32; 3]>) -> [i32; 3] {
+    match (a, b) {
+        (Some(a), Some(b)) => gate_midpoint(a, b),
+        (Some(x), None) | (None, Some(x)) => x,
+        (None, None) => [0; 3],
     }
 }
 
