@@ -1113,7 +1113,7 @@ pub(crate) fn decode_exact(
     }
     Ok(whet_mesh::Mesh::new(
         positions,
-        conn.output_triangles_ranked(&rank),
+        conn.into_output_triangles(&rank),
     ))
 }
 

@@ -57,8 +57,9 @@ fn checked_vertex(x: u32) -> Result<u32, Error> {
 
 /// The state of a reverse decode.
 pub(crate) struct ReverseDecoder {
-    /// Vertex of each corner.
-    pub v: Vec<u32>,
+    /// Vertices of each triangle's corners (corner `3 t + j` is `v[t][j]`): the decoded
+    /// mesh's triangle list, handed on without a copy.
+    pub v: Vec<[u32; 3]>,
     /// Opposite of each corner.
     pub o: Vec<u32>,
     leftmost: Vec<u32>,
@@ -88,7 +89,7 @@ impl ReverseDecoder {
         let mut splits = splits.to_vec();
         splits.sort_unstable_by(|a, b| b.source.cmp(&a.source).then(a.right.cmp(&b.right)));
         ReverseDecoder {
-            v: Vec::with_capacity(3 * capacity_faces),
+            v: Vec::with_capacity(capacity_faces),
             o: Vec::with_capacity(3 * capacity_faces),
             leftmost: Vec::with_capacity(capacity_faces / 2 + 3),
             valence: Vec::with_capacity(capacity_faces / 2 + 3),
@@ -105,10 +106,15 @@ impl ReverseDecoder {
     /// The open edge the next symbol is applied at (`None` when nothing is open and the
     /// next symbol is a forced E), looked up once for both the symbol's context and
     /// [`ReverseDecoder::apply`].
-    #[inline]
+    #[inline(always)]
     pub fn gate(&self) -> Option<Gate> {
         let &a = self.active.last()?;
-        let x = self.v.get(next(a) as usize).copied().unwrap_or(NONE);
+        let x = self
+            .v
+            .as_flattened()
+            .get(next(a) as usize)
+            .copied()
+            .unwrap_or(NONE);
         let val = self
             .valence
             .get(x as usize)
@@ -144,7 +150,7 @@ impl ReverseDecoder {
 
     #[inline]
     fn vertex_of(&self, c: u32) -> Result<u32, Error> {
-        match self.v.get(c as usize) {
+        match self.v.as_flattened().get(c as usize) {
             Some(&x) if x != NONE => Ok(x),
             _ => Err(Error::Corrupt("a corner has no vertex")),
         }
@@ -165,7 +171,7 @@ impl ReverseDecoder {
         if self.step >= self.symbols {
             return Err(Error::Corrupt("more symbols than announced"));
         }
-        let k = self.v.len() as u32;
+        let k = (3 * self.v.len()) as u32;
         if k > u32::MAX - 8 {
             return Err(Error::Corrupt("too many faces"));
         }
@@ -219,7 +225,7 @@ impl ReverseDecoder {
         self.glue_new(b, k + 2)?;
         let nb = self.vertex_of(next(b))?;
         let w = self.vertex_of(prev(a))?;
-        self.v.extend_from_slice(&[x, nb, w]);
+        self.v.push([x, nb, w]);
         self.o.extend_from_slice(&[NONE, a, b]);
         self.leftmost[w as usize] = k + 2;
         if let Some(top) = self.active.last_mut() {
@@ -245,14 +251,14 @@ impl ReverseDecoder {
         let vr = self.vertex_of(prev(a))?;
         let w = self.new_vertex(facing);
         if right {
-            self.v.extend_from_slice(&[vr, x, w]);
+            self.v.push([vr, x, w]);
             self.o.extend_from_slice(&[NONE, NONE, a]);
             self.leftmost[vr as usize] = k;
             self.gain(vr, 1);
             self.gain(x, 1);
             self.gain(w, 2);
         } else {
-            self.v.extend_from_slice(&[x, w, vr]);
+            self.v.push([x, w, vr]);
             self.o.extend_from_slice(&[NONE, a, NONE]);
             self.leftmost[vr as usize] = k + 2;
             self.gain(x, 1);
@@ -269,7 +275,7 @@ impl ReverseDecoder {
     #[inline(always)]
     fn apply_e(&mut self, k: u32) -> Result<(), Error> {
         let ids = [k, k + 1, k + 2].map(|c| self.new_vertex(c));
-        self.v.extend_from_slice(&ids);
+        self.v.push(ids);
         self.o.extend_from_slice(&[NONE; 3]);
         for id in ids {
             self.gain(id, 2);
@@ -284,7 +290,7 @@ impl ReverseDecoder {
     #[inline(never)]
     fn apply_s(&mut self, k: u32) -> Result<(), Error> {
         let i = self.step;
-        self.v.extend_from_slice(&[NONE; 3]);
+        self.v.push([NONE; 3]);
         self.o.extend_from_slice(&[NONE; 3]);
         let b = self
             .active
@@ -302,20 +308,21 @@ impl ReverseDecoder {
             .ok_or(Error::Corrupt("S with one edge open"))?;
         self.glue(a, k + 2)?;
         self.glue(b, k + 1)?;
+        // a and b are corners of earlier triangles: reading them before filling triangle k
+        // reads what the corner-by-corner fill read.
         let p = self.vertex_of(prev(a))?;
-        self.v[k as usize] = p;
-        self.v[(k + 1) as usize] = self.vertex_of(next(a))?;
+        let after_a = self.vertex_of(next(a))?;
         let w = self.vertex_of(prev(b))?;
-        self.v[(k + 2) as usize] = w;
+        self.v[k as usize / 3] = [p, after_a, w];
         self.leftmost[w as usize] = k + 2;
         let n = self.vertex_of(next(b))?;
         if n != p {
             self.leftmost[p as usize] = self.leftmost_of(n)?;
             // Merge n into p around n's fan, clockwise from next(b).
             let mut x = next(b);
-            let mut guard = self.v.len();
+            let mut guard = 3 * self.v.len();
             loop {
-                self.v[x as usize] = p;
+                self.v.as_flattened_mut()[x as usize] = p;
                 let on = self.o[next(x) as usize];
                 if on == NONE {
                     break;
@@ -334,7 +341,7 @@ impl ReverseDecoder {
             *top = k;
         }
         // The vertices at k + 1 and k + 2 gained an edge each.
-        let (v1, v2) = (self.v[(k + 1) as usize], self.v[(k + 2) as usize]);
+        let (v1, v2) = (self.v[k as usize / 3][1], self.v[k as usize / 3][2]);
         self.gain(v1, 1);
         self.gain(v2, 1);
         Ok(())
@@ -393,8 +400,8 @@ impl ReverseDecoder {
         let mut starts = Vec::with_capacity(components);
         let active = std::mem::take(&mut self.active);
         for &a in active.iter().rev() {
-            let k = self.v.len() as u32;
-            self.v.extend_from_slice(&[NONE; 3]);
+            let k = (3 * self.v.len()) as u32;
+            self.v.push([NONE; 3]);
             self.o.extend_from_slice(&[NONE; 3]);
             let n = self.vertex_of(next(a))?;
             let b = next(self.leftmost_of(n)?);
@@ -404,9 +411,7 @@ impl ReverseDecoder {
             self.glue(k, a)?;
             self.glue(k + 1, b)?;
             self.glue(k + 2, c)?;
-            self.v[k as usize] = x;
-            self.v[(k + 1) as usize] = p;
-            self.v[(k + 2) as usize] = n;
+            self.v[k as usize / 3] = [x, p, n];
             // Corner k faces the first symbol's triangle: it is n(s) of the encoder's start
             // corner s, so s itself is k + 2.
             starts.push(k + 2);

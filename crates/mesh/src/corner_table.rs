@@ -32,8 +32,11 @@ const NONE: u32 = u32::MAX;
 /// Corner table of an oriented manifold triangle mesh.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct CornerTable {
-    /// Vertex of each corner.
-    corner_vertex: Vec<u32>,
+    /// The vertices of each triangle's corners: corner `3 t + j` is `triangles[t][j]`. Kept
+    /// as triangles so that a decoder can hand the array on as its mesh's triangles without
+    /// a copy ([`CornerTable::into_triangles`]); read flat, per corner, through
+    /// [`CornerTable::corner_vertices`].
+    triangles: Vec<[u32; 3]>,
     /// Opposite of each corner, `NONE` at a boundary.
     opposite: Vec<u32>,
     /// For each vertex a corner at it from which [`CornerTable::swing`] visits the whole fan
@@ -98,7 +101,7 @@ impl CornerTable {
         }
         check_vertex_count(vertex_count)?;
         let nc = 3 * nt;
-        let mut corner_vertex = Vec::with_capacity(nc);
+        let mut triangles_out: Vec<[u32; 3]> = Vec::with_capacity(nt);
         // One pass over the triangles checks them, counts each vertex's corners and the edges
         // bucketed at it (by lower vertex, see below), and notes each vertex's first corner
         // (its fan's start unless it is on a boundary).
@@ -127,7 +130,7 @@ impl CornerTable {
                     vertex,
                 });
             }
-            corner_vertex.extend_from_slice(tri);
+            triangles_out.push(*tri);
             for (j, &v) in tri.iter().enumerate() {
                 valence[v as usize] += 1;
                 let slot = &mut vertex_corner[v as usize];
@@ -157,7 +160,8 @@ impl CornerTable {
         // One bit per corner: its edge runs from the lower vertex up. Read back when pairing
         // (twins must differ), it saves a random access to the corner vertices per edge.
         let mut upward = vec![0u64; nc.div_ceil(64)];
-        for (t, tri) in corner_vertex.chunks_exact(3).enumerate() {
+        let corner_vertex = triangles_out.as_flattened();
+        for (t, tri) in triangles_out.iter().enumerate() {
             for (j, (a, b)) in edges(tri).into_iter().enumerate() {
                 let c = 3 * t + j;
                 let lo = a.min(b) as usize;
@@ -222,7 +226,7 @@ impl CornerTable {
         drop(bucket);
         drop(offsets);
         let table = CornerTable {
-            corner_vertex,
+            triangles: triangles_out,
             opposite,
             vertex_corner,
         };
@@ -239,17 +243,13 @@ impl CornerTable {
     /// for consistent arrays the two give the same table. Inconsistent arrays give a table
     /// whose walks are wrong but bounded, never an out-of-bounds access.
     pub fn from_relabelled(
-        corner_vertex: Vec<u32>,
+        triangles: Vec<[u32; 3]>,
         opposite: Vec<u32>,
         vertex_count: usize,
     ) -> Result<CornerTable, MeshError> {
-        let nc = check_corner_arrays(&corner_vertex, &opposite, vertex_count)?;
+        let nc = check_corner_arrays(&triangles, &opposite, vertex_count)?;
         let mut vertex_corner = vec![NONE; vertex_count];
-        for (t, (tv, to)) in corner_vertex
-            .chunks_exact(3)
-            .zip(opposite.chunks_exact(3))
-            .enumerate()
-        {
+        for (t, (tv, to)) in triangles.iter().zip(opposite.chunks_exact(3)).enumerate() {
             for j in 0..3 {
                 let v = tv[j];
                 let Some(slot) = vertex_corner.get_mut(v as usize) else {
@@ -272,7 +272,7 @@ impl CornerTable {
             }
         }
         Ok(CornerTable {
-            corner_vertex,
+            triangles,
             opposite,
             vertex_corner,
         })
@@ -285,33 +285,33 @@ impl CornerTable {
     /// around every vertex: the costliest check, which a decoder whose construction cannot
     /// split fans may skip; every table walk stays bounded either way).
     pub fn from_raw(
-        corner_vertex: Vec<u32>,
+        triangles: Vec<[u32; 3]>,
         opposite: Vec<u32>,
         vertex_count: usize,
         check_fans: bool,
     ) -> Result<CornerTable, MeshError> {
-        Self::from_raw_checked::<false>(corner_vertex, opposite, vertex_count, check_fans)
+        Self::from_raw_checked::<false>(triangles, opposite, vertex_count, check_fans)
     }
 
     /// [`CornerTable::from_raw`] for a table that must be closed: an opposite left at the
     /// boundary marker is [`MeshError::OpenEdge`]. Found in the pass that checks the pairs,
     /// so a decoder need not scan its arrays for the marker first.
     pub fn from_raw_closed(
-        corner_vertex: Vec<u32>,
+        triangles: Vec<[u32; 3]>,
         opposite: Vec<u32>,
         vertex_count: usize,
         check_fans: bool,
     ) -> Result<CornerTable, MeshError> {
-        Self::from_raw_checked::<true>(corner_vertex, opposite, vertex_count, check_fans)
+        Self::from_raw_checked::<true>(triangles, opposite, vertex_count, check_fans)
     }
 
     fn from_raw_checked<const CLOSED: bool>(
-        corner_vertex: Vec<u32>,
+        triangles: Vec<[u32; 3]>,
         opposite: Vec<u32>,
         vertex_count: usize,
         check_fans: bool,
     ) -> Result<CornerTable, MeshError> {
-        let nc = check_corner_arrays(&corner_vertex, &opposite, vertex_count)?;
+        let nc = check_corner_arrays(&triangles, &opposite, vertex_count)?;
         // One pass over the triangles: vertex indices, repeated vertices, and each corner's
         // opposite (mutual, facing the same edge reversed); without the fan check the start
         // corners are picked on the way.
@@ -320,12 +320,7 @@ impl CornerTable {
         } else {
             vec![NONE; vertex_count]
         };
-        for (t, (tv, to)) in corner_vertex
-            .chunks_exact(3)
-            .zip(opposite.chunks_exact(3))
-            .enumerate()
-        {
-            let tv: [u32; 3] = [tv[0], tv[1], tv[2]];
+        for (t, (&tv, to)) in triangles.iter().zip(opposite.chunks_exact(3)).enumerate() {
             if let Some(&v) = tv.iter().find(|&&v| v as usize >= vertex_count) {
                 return Err(MeshError::IndexOutOfRange {
                     triangle: t as u32,
@@ -355,19 +350,19 @@ impl CornerTable {
                 let oi = o as usize;
                 let c = 3 * t + j;
                 let (x, y) = (tv[(j + 1) % 3], tv[(j + 2) % 3]);
-                // The corners before and after oi in its triangle from one 32-bit modulo
+                // The vertices before and after oi in its triangle from one 32-bit division
                 // and two table offsets (three 64-bit modulos were most of this loop).
-                const BEFORE: [u32; 3] = [2, 0, 1];
-                const AFTER: [u32; 3] = [1, 2, 0];
-                let k = (o % 3) as usize;
-                let base = o - k as u32;
-                let before = (base + BEFORE[k]) as usize;
-                let after = (base + AFTER[k]) as usize;
+                const BEFORE: [usize; 3] = [2, 0, 1];
+                const AFTER: [usize; 3] = [1, 2, 0];
+                let (ot, k) = ((o / 3) as usize, (o % 3) as usize);
                 // A pair is checked in full from its first corner; from the second, that
                 // it is mutual is enough (the first then checked this very pair).
                 let consistent = oi < nc
                     && opposite[oi] == c as u32
-                    && (oi < c || (corner_vertex[before] == x && corner_vertex[after] == y));
+                    && (oi < c || {
+                        let to = triangles[ot];
+                        to[BEFORE[k]] == x && to[AFTER[k]] == y
+                    });
                 if !consistent {
                     return Err(MeshError::NonManifoldEdge {
                         a: x.min(y),
@@ -387,33 +382,33 @@ impl CornerTable {
         }
         if !check_fans {
             return Ok(CornerTable {
-                corner_vertex,
+                triangles,
                 opposite,
                 vertex_corner,
             });
         }
-        CornerTable::from_parts(corner_vertex, opposite, vertex_count, true)
+        CornerTable::from_parts(triangles, opposite, vertex_count, true)
     }
 
     /// Finishes a table whose opposites are paired: picks each vertex's start corner (the
     /// clockwise-most at a boundary) and checks that swinging from it visits all the
     /// vertex's corners.
     fn from_parts(
-        corner_vertex: Vec<u32>,
+        triangles: Vec<[u32; 3]>,
         opposite: Vec<u32>,
         vertex_count: usize,
         walk_fans: bool,
     ) -> Result<CornerTable, MeshError> {
-        let nc = corner_vertex.len();
+        let nc = 3 * triangles.len();
         let mut table = CornerTable {
-            corner_vertex,
+            triangles,
             opposite,
             vertex_corner: vec![NONE; vertex_count],
         };
         let mut valence = vec![0u32; vertex_count];
         let mut open_fans = vec![0u8; vertex_count];
         for c in 0..nc {
-            let v = table.corner_vertex[c] as usize;
+            let v = table.corner_vertices()[c] as usize;
             valence[v] += 1;
             // c starts an open fan when the edge behind it, (v(prev c), v(c)), is a boundary.
             if table.opposite[prev_raw(c)] == NONE {
@@ -458,7 +453,7 @@ impl CornerTable {
     /// second fan, open or closed, or a start corner that is not an open fan's clockwise
     /// end leaves corners unmet.
     fn fans_cover_all_corners(&self) -> bool {
-        let nc = self.corner_vertex.len() as u64;
+        let nc = self.corner_count() as u64;
         let mut met = 0u64;
         for &start in &self.vertex_corner {
             if start == NONE {
@@ -506,7 +501,7 @@ impl CornerTable {
     fn fan_counts(&self) -> (Vec<u32>, Vec<u8>) {
         let mut valence = vec![0u32; self.vertex_corner.len()];
         let mut open_fans = vec![0u8; self.vertex_corner.len()];
-        for (c, &v) in self.corner_vertex.iter().enumerate() {
+        for (c, &v) in self.corner_vertices().iter().enumerate() {
             let v = v as usize;
             valence[v] += 1;
             if self.opposite[prev_raw(c)] == NONE {
@@ -539,8 +534,8 @@ impl CornerTable {
 
     // Error path only: the number of separate fans around `v` (a linear scan).
     fn count_fans(&self, v: VertexId) -> u32 {
-        let corners: Vec<u32> = (0..self.corner_vertex.len() as u32)
-            .filter(|&c| self.corner_vertex[c as usize] == v.0)
+        let corners: Vec<u32> = (0..self.corner_count() as u32)
+            .filter(|&c| self.corner_vertices()[c as usize] == v.0)
             .collect();
         let mut seen = vec![false; corners.len()];
         let mut fans = 0;
@@ -577,13 +572,13 @@ impl CornerTable {
     /// Number of corners (three per triangle).
     #[inline]
     pub fn corner_count(&self) -> usize {
-        self.corner_vertex.len()
+        3 * self.triangles.len()
     }
 
     /// Number of triangles.
     #[inline]
     pub fn triangle_count(&self) -> usize {
-        self.corner_vertex.len() / 3
+        self.triangles.len()
     }
 
     /// Number of vertices (including unused ones).
@@ -595,7 +590,19 @@ impl CornerTable {
     /// The vertex of every corner, indexed by corner (for hot loops that walk fans).
     #[inline]
     pub fn corner_vertices(&self) -> &[u32] {
-        &self.corner_vertex
+        self.triangles.as_flattened()
+    }
+
+    /// The vertices of each triangle, indexed by triangle.
+    #[inline]
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles
+    }
+
+    /// The table's triangles, as a mesh's triangle list, without copying them (a decoder's
+    /// output).
+    pub fn into_triangles(self) -> Vec<[u32; 3]> {
+        self.triangles
     }
 
     /// The opposite of every corner, indexed by corner; `u32::MAX` at a boundary.
@@ -613,8 +620,8 @@ impl CornerTable {
         // Triangle by triangle, in corner order (the same sum): corner j of a triangle faces
         // the edge from vertex j + 1 to j + 2, read without a modulo per corner.
         for (t, (tri, o3)) in self
-            .corner_vertex
-            .chunks_exact(3)
+            .triangles
+            .iter()
             .zip(self.opposite.chunks_exact(3))
             .enumerate()
         {
@@ -640,13 +647,13 @@ impl CornerTable {
 
     /// All corners in order.
     pub fn corners(&self) -> impl Iterator<Item = CornerId> + '_ {
-        (0..self.corner_vertex.len() as u32).map(CornerId)
+        (0..self.corner_count() as u32).map(CornerId)
     }
 
     /// Vertex at corner `c`.
     #[inline]
     pub fn vertex(&self, c: CornerId) -> VertexId {
-        VertexId(self.corner_vertex[c.index()])
+        VertexId(self.corner_vertices()[c.index()])
     }
 
     /// Next corner of the same triangle (counter-clockwise).
@@ -756,12 +763,12 @@ fn next_raw(c: usize) -> usize {
 /// triangles, one opposite per corner, corner and vertex indices below the `NONE` marker.
 /// Returns the corner count.
 fn check_corner_arrays(
-    corner_vertex: &[u32],
+    triangles: &[[u32; 3]],
     opposite: &[u32],
     vertex_count: usize,
 ) -> Result<usize, MeshError> {
-    let nc = corner_vertex.len();
-    if nc % 3 != 0 || opposite.len() != nc || nc >= NONE as usize {
+    let nc = triangles.len().saturating_mul(3);
+    if opposite.len() != nc || nc >= NONE as usize {
         return Err(MeshError::TooLarge {
             what: "corner arrays of unequal length",
             count: nc,
@@ -806,7 +813,7 @@ mod tests {
     #[test]
     fn a_closed_build_accepts_a_closed_table_and_names_an_unglued_corner() {
         let t = CornerTable::new(&tetrahedron()).unwrap();
-        let (v, o) = (t.corner_vertices().to_vec(), t.opposites().to_vec());
+        let (v, o) = (t.triangles().to_vec(), t.opposites().to_vec());
         assert_eq!(
             CornerTable::from_raw_closed(v.clone(), o.clone(), 4, false),
             CornerTable::from_raw(v.clone(), o.clone(), 4, false)
@@ -825,7 +832,7 @@ mod tests {
         // A corner without a vertex is out of range, as before (in the first triangle, whose
         // own check comes before any pair's).
         let mut lost = v;
-        lost[1] = NONE;
+        lost[0][1] = NONE;
         assert!(matches!(
             CornerTable::from_raw_closed(lost, o, 4, false),
             Err(MeshError::IndexOutOfRange { .. })
@@ -1078,7 +1085,7 @@ mod tests {
             let deferred = CornerTable::from_triangles_deferring_fans(&tris, nv);
             proptest::prop_assert_eq!(deferred.as_ref(), Ok(&t));
             let raw = CornerTable::from_raw(
-                t.corner_vertices().to_vec(),
+                t.triangles().to_vec(),
                 t.opposites().to_vec(),
                 nv,
                 true,
@@ -1086,7 +1093,7 @@ mod tests {
             proptest::prop_assert_eq!(raw, Ok(t.clone()));
             // A grid is open: the closed build names one of its boundary edges.
             let closed = CornerTable::from_raw_closed(
-                t.corner_vertices().to_vec(),
+                t.triangles().to_vec(),
                 t.opposites().to_vec(),
                 nv,
                 false,
@@ -1104,7 +1111,7 @@ mod tests {
             proptest::prop_assert!(open, "({}, {}) is not a boundary edge", a, b);
             // Arrays of a checked table: the sequential constructor picks the same starts.
             let relabelled = CornerTable::from_relabelled(
-                t.corner_vertices().to_vec(),
+                t.triangles().to_vec(),
                 t.opposites().to_vec(),
                 nv,
             );
@@ -1155,12 +1162,12 @@ mod tests {
     #[test]
     fn from_relabelled_refuses_what_would_index_out_of_bounds() {
         let t = CornerTable::from_triangles(&[[0, 1, 2], [0, 2, 3]], 4).unwrap();
-        let (cv, opp) = (t.corner_vertices().to_vec(), t.opposites().to_vec());
+        let (cv, opp) = (t.triangles().to_vec(), t.opposites().to_vec());
         assert!(CornerTable::from_relabelled(cv.clone(), opp.clone(), 3).is_err());
         let mut bad = opp.clone();
         bad[0] = 6;
         assert!(CornerTable::from_relabelled(cv.clone(), bad, 4).is_err());
-        assert!(CornerTable::from_relabelled(cv[..5].to_vec(), opp[..5].to_vec(), 4).is_err());
+        assert!(CornerTable::from_relabelled(cv[..1].to_vec(), opp[..5].to_vec(), 4).is_err());
         assert!(CornerTable::from_relabelled(cv, opp[..3].to_vec(), 4).is_err());
     }
 }

@@ -253,7 +253,7 @@ pub(crate) fn welded_table(input_table: &CornerTable, welded: &Welded) -> Option
         return None;
     }
     let nt = welded.mesh.triangles.len();
-    let corner_vertex: Vec<u32> = welded.mesh.triangles.iter().flatten().copied().collect();
+    let triangles = welded.mesh.triangles.clone();
     let input_opposite = input_table.opposites();
     let mut opposite = vec![NONE; 3 * nt];
     // Corners whose opposite triangle was removed, by their edge (from, to).
@@ -268,8 +268,8 @@ pub(crate) fn welded_table(input_table: &CornerTable, welded: &Welded) -> Option
             if ot != NONE {
                 opposite[3 * k + j] = 3 * ot + o % 3;
             } else {
-                let a = corner_vertex[3 * k + (j + 1) % 3];
-                let b = corner_vertex[3 * k + (j + 2) % 3];
+                let a = triangles[k][(j + 1) % 3];
+                let b = triangles[k][(j + 2) % 3];
                 loose.push((u64::from(a) << 32 | u64::from(b), (3 * k + j) as u32));
             }
         }
@@ -283,7 +283,7 @@ pub(crate) fn welded_table(input_table: &CornerTable, welded: &Welded) -> Option
         let i = loose.binary_search_by_key(&twin, |e| e.0).ok()?;
         opposite[c as usize] = loose[i].1;
     }
-    CornerTable::from_relabelled(corner_vertex, opposite, welded.mesh.positions.len()).ok()
+    CornerTable::from_relabelled(triangles, opposite, welded.mesh.positions.len()).ok()
 }
 
 /// An input and its welding, for the smooth threshold of a run on the welded mesh.
