@@ -1094,27 +1094,28 @@ pub(crate) fn decode_exact(
         return Err(crate::Error::Truncated("geometry"));
     }
     let max = quantizer.max_level();
-    // Output vertices in traversal order (dummies skipped), their ranks, then the triangles.
-    let mut rank = vec![u32::MAX; conn.table.vertex_count()];
-    let mut positions = Vec::with_capacity(conn.summary.vertex_order.len());
-    for v in &conn.summary.vertex_order {
-        let i = v.index();
-        if conn.is_dummy[i] {
-            continue;
-        }
-        let g = q[i];
-        if !known[i] || g.iter().any(|&c| c < 0 || c > max) {
+    // decode_connectivity numbers the vertices in traversal order, the real ones first: the
+    // output is ids 0..real in order, and the triangles that touch no dummy.
+    let real = conn
+        .is_dummy
+        .iter()
+        .position(|&d| d)
+        .unwrap_or(conn.is_dummy.len());
+    let mut positions = Vec::with_capacity(real);
+    for (&g, &k) in q[..real].iter().zip(&known[..real]) {
+        if !k || g.iter().any(|&c| c < 0 || c > max) {
             return Err(crate::Error::Corrupt(
                 "a decoded position falls outside the quantization grid".into(),
             ));
         }
-        rank[i] = positions.len() as u32;
         positions.push(quantizer.dequantize(g));
     }
-    Ok(whet_mesh::Mesh::new(
-        positions,
-        conn.into_output_triangles(&rank),
-    ))
+    drop(q);
+    let mut triangles = conn.table.into_triangles();
+    if real < known.len() {
+        triangles.retain(|t| t.iter().all(|&x| (x as usize) < real));
+    }
+    Ok(whet_mesh::Mesh::new(positions, triangles))
 }
 
 #[cfg(test)]

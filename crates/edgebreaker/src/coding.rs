@@ -557,7 +557,9 @@ pub fn label_bits(labels: &[Clers], splits: &[SplitEvent]) -> Result<f64, Error>
 }
 
 /// Decodes a payload written by [`encode_connectivity`]. Returns the connectivity and the
-/// number of bytes consumed.
+/// number of bytes consumed. Its vertices are numbered in traversal order, the real ones
+/// first (`0..r`) and the holes' dummies after them, so `summary.vertex_order` lists the
+/// real vertices as `0, 1, .., r - 1` with the dummies' ids at their places in the order.
 pub fn decode_connectivity(
     bytes: &[u8],
     limits: &ConnectivityLimits,
@@ -652,67 +654,93 @@ pub fn decode_connectivity(
     let starts = rev.finish(k as usize)?;
     let steps = rev.component_steps()?;
     let vertex_ids = rev.vertex_ids();
-    let v = std::mem::take(&mut rev.v);
+    let mut v = std::mem::take(&mut rev.v);
     let o = std::mem::take(&mut rev.o);
     drop(rev);
+    // The traversal's vertex order without traversing again: per component, the start
+    // triangle's vertices, then the tip of each C in encoding order; decoder step i made
+    // triangle i, whose corner 3 i is its tip. In the reverse decoder's ids first.
+    let corner_vertex = v.as_flattened();
+    let vertex_at = |c: u32| {
+        corner_vertex
+            .get(c as usize)
+            .copied()
+            .ok_or(Error::Corrupt("a start corner is out of range"))
+    };
+    let mut order: Vec<u32> = Vec::with_capacity(vertex_ids);
+    for (&s, range) in starts.iter().zip(&steps) {
+        let base = s - s % 3;
+        for c in [s, base + (s + 1) % 3, base + (s + 2) % 3] {
+            order.push(vertex_at(c)?);
+        }
+        for i in range.clone().rev() {
+            if decoded[i as usize] == Clers::C {
+                order.push(vertex_at(3 * i)?);
+            }
+        }
+    }
+    // Renumber the vertices in that order, the real ones first and the holes' dummies
+    // after them, so that a geometry decoder's output order is the ids' own (no rank
+    // arrays, positions written in sequence, the triangle list kept as it is when there
+    // are no holes). Every vertex must come exactly once: what the traversal guarantees,
+    // and what a corrupt stream may break.
+    let real = order
+        .len()
+        .checked_sub(dummy_positions.len())
+        .ok_or(Error::Corrupt("dummy vertex position out of range"))?;
+    const NONE: u32 = u32::MAX;
+    let mut new_id = vec![NONE; vertex_ids];
+    let (mut next_real, mut next_dummy) = (0u32, real as u32);
+    let mut dummies = dummy_positions.iter().peekable();
+    for (pos, x) in order.iter_mut().enumerate() {
+        let slot = new_id
+            .get_mut(*x as usize)
+            .ok_or(Error::Corrupt("a corner has no vertex"))?;
+        if *slot != NONE {
+            return Err(Error::Corrupt(
+                "the decoded vertex order is not a permutation",
+            ));
+        }
+        // The dummy positions increase (their deltas are checked positive).
+        if dummies.next_if(|&&p| p == pos as u64).is_some() {
+            *slot = next_dummy;
+            next_dummy += 1;
+        } else {
+            *slot = next_real;
+            next_real += 1;
+        }
+        *x = *slot;
+    }
+    if dummies.next().is_some() {
+        return Err(Error::Corrupt("dummy vertex position out of range"));
+    }
+    for x in v.as_flattened_mut() {
+        *x = match new_id.get(*x as usize) {
+            None => return Err(Error::Corrupt("a corner has no vertex")),
+            Some(&NONE) => return Err(Error::Corrupt("the decoded vertex order misses vertices")),
+            Some(&id) => id,
+        };
+    }
+    drop(new_id);
+    let vertex_count = order.len();
     // The reverse decoder builds fans by construction; walks over the table stay bounded
     // even if a corrupt stream produced a split fan, so the fan check is skipped. The table
-    // must be closed (the holes open later): a corner left unglued or without a vertex is
-    // found here, in the pass that checks the pairs.
-    let table = CornerTable::from_raw_closed(v, o, vertex_ids, false).map_err(|e| match e {
+    // must be closed (the holes open later): a corner left unglued is found here, in the
+    // pass that checks the pairs.
+    let table = CornerTable::from_raw_closed(v, o, vertex_count, false).map_err(|e| match e {
         MeshError::OpenEdge { .. } => Error::Corrupt("the decoded mesh is not closed"),
         MeshError::IndexOutOfRange { .. } => Error::Corrupt("a corner has no vertex"),
         _ => Error::Corrupt("the decoded mesh is not a manifold"),
     })?;
     let starts: Vec<CornerId> = starts.into_iter().map(CornerId).collect();
-    // The traversal's vertex order without traversing again: per component, the start
-    // triangle's vertices, then the tip of each C in encoding order; decoder step i made
-    // triangle i, whose corner 3 i is its tip.
-    let mut vertex_order = Vec::with_capacity(vertex_ids);
-    for (s, range) in starts.iter().zip(&steps) {
-        for c in [*s, table.next(*s), table.prev(*s)] {
-            vertex_order.push(table.vertex(c));
-        }
-        for i in range.clone().rev() {
-            if decoded[i as usize] == Clers::C {
-                vertex_order.push(table.vertex(CornerId(3 * i)));
-            }
-        }
-    }
-    // Every vertex of the table exactly once (what the traversal guarantees; a corrupt
-    // stream may break it).
-    let mut seen = vec![false; vertex_ids];
-    for x in &vertex_order {
-        let slot = &mut seen[x.index()];
-        if *slot || table.vertex_corner(*x).is_none() {
-            return Err(Error::Corrupt(
-                "the decoded vertex order is not a permutation",
-            ));
-        }
-        *slot = true;
-    }
-    let used = (0..vertex_ids as u32)
-        .filter(|&x| table.vertex_corner(VertexId(x)).is_some())
-        .count();
-    if used != vertex_order.len() {
-        return Err(Error::Corrupt("the decoded vertex order misses vertices"));
-    }
-    drop(seen);
     decoded.reverse();
     let summary = TraversalSummary {
         labels: decoded,
         splits,
         starts: starts.clone(),
-        vertex_order,
+        vertex_order: order.into_iter().map(VertexId).collect(),
     };
-    let mut is_dummy = vec![false; vertex_ids];
-    for &p in &dummy_positions {
-        let v = summary
-            .vertex_order
-            .get(p as usize)
-            .ok_or(Error::Corrupt("dummy vertex position out of range"))?;
-        is_dummy[v.index()] = true;
-    }
+    let is_dummy = (0..vertex_count).map(|i| i >= real).collect();
     Ok((
         Connectivity {
             table,

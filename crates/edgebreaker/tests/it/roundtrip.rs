@@ -20,6 +20,24 @@ fn round_trip(mesh: &Mesh) -> (f64, [usize; 5]) {
     assert_eq!(used, enc.bytes.len(), "whole payload consumed");
     assert_eq!(dec.summary.labels, enc.connectivity.summary.labels);
     assert_eq!(dec.summary.splits, enc.connectivity.summary.splits);
+    // The decoder numbers its vertices in traversal order, the real ones first: the real
+    // vertices of the order are 0, 1, 2, .., the dummies follow them in order.
+    let real = dec.is_dummy.iter().filter(|&&d| !d).count();
+    assert!(
+        dec.is_dummy[..real].iter().all(|&d| !d),
+        "a dummy among the first ids"
+    );
+    let (reals, dummies): (Vec<u32>, Vec<u32>) = dec
+        .summary
+        .vertex_order
+        .iter()
+        .map(|v| v.0)
+        .partition(|&v| (v as usize) < real);
+    assert_eq!(reals, (0..real as u32).collect::<Vec<_>>());
+    assert_eq!(
+        dummies,
+        (real as u32..dec.table.vertex_count() as u32).collect::<Vec<_>>()
+    );
     // The decoder's summary (vertex order from the reverse decoder) is what traversing
     // its table gives.
     let mut traversed = Vec::new();
