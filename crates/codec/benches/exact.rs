@@ -1,10 +1,13 @@
 //! Exact-mode encode and decode throughput on a ~1M-triangle mesh (issue target: decode at
 //! 20 M triangles/s, encode at 5 M triangles/s on one core), with the default prediction
-//! and with the traversal prediction (`*_traversal`).
+//! and with the traversal prediction (`*_traversal`); `*_reusing` decodes with one set of
+//! [`DecodeBuffers`] throughout, as a server decoding stream after stream would.
 #![allow(clippy::unwrap_used)] // benches may panic on their own setup
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
-use whet_codec::{decode, encode, DecodeOptions, EncodeOptions, ExactPrediction};
+use whet_codec::{
+    decode, decode_reusing, encode, DecodeBuffers, DecodeOptions, EncodeOptions, ExactPrediction,
+};
 use whet_testkit::meshes::{icosphere, shuffle};
 
 fn bench(c: &mut Criterion) {
@@ -36,6 +39,20 @@ fn bench(c: &mut Criterion) {
     g.bench_function("decode_1.3M_traversal", |b| {
         b.iter(|| black_box(decode(&enc_fast.bytes, &DecodeOptions::DEFAULT).unwrap()))
     });
+    // A decoder that decodes one stream after another keeps its buffers and gives each
+    // mesh back when done with it (`decode_reusing`): no fresh memory to fault in.
+    for (name, bytes) in [
+        ("decode_1.3M_reusing", &enc.bytes),
+        ("decode_1.3M_traversal_reusing", &enc_fast.bytes),
+    ] {
+        let mut buffers = DecodeBuffers::new();
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                let mesh = decode_reusing(bytes, &DecodeOptions::DEFAULT, &mut buffers).unwrap();
+                buffers.recycle(black_box(mesh));
+            })
+        });
+    }
     g.finish();
 }
 

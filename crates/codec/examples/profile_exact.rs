@@ -3,11 +3,14 @@
 //! e.g. `-- 0 20` to profile decoding alone). The icosphere's vertices and triangles are
 //! shuffled (the worst memory order an encoder meets); `PROFILE_PREDICTION=traversal` codes
 //! with the traversal prediction; `PROFILE_ORDER=natural` keeps the
-//! generator's order, and `PROFILE_MESH=<file>` profiles that mesh in its file's order.
+//! generator's order, and `PROFILE_MESH=<file>` profiles that mesh in its file's order;
+//! `PROFILE_REUSE=1` decodes with one [`DecodeBuffers`] throughout.
 #![allow(clippy::unwrap_used)]
 
 use std::time::Instant;
-use whet_codec::{decode, encode, DecodeOptions, EncodeOptions, ExactPrediction};
+use whet_codec::{
+    decode, decode_reusing, encode, DecodeBuffers, DecodeOptions, EncodeOptions, ExactPrediction,
+};
 
 fn main() {
     let arg = |i: usize, d: usize| {
@@ -53,13 +56,23 @@ fn main() {
         }
     }
     let e = e.unwrap();
+    // PROFILE_REUSE=1: one set of buffers for every decode, each mesh given back.
+    let reuse = std::env::var_os("PROFILE_REUSE").is_some();
+    let mut buffers = DecodeBuffers::new();
     for _ in 0..decodes {
         let t = Instant::now();
-        let m = decode(&e.bytes, &DecodeOptions::DEFAULT).unwrap();
+        let m = if reuse {
+            decode_reusing(&e.bytes, &DecodeOptions::DEFAULT, &mut buffers).unwrap()
+        } else {
+            decode(&e.bytes, &DecodeOptions::DEFAULT).unwrap()
+        };
         eprintln!(
             "decode: {:?} ({} triangles)",
             t.elapsed(),
             m.triangles.len()
         );
+        if reuse {
+            buffers.recycle(m);
+        }
     }
 }

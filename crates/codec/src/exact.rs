@@ -689,15 +689,20 @@ fn max_grid_level(bits: u32) -> i32 {
 
 /// Each vertex's state before any is coded: a hole's dummy, or unknown.
 fn initial_states(conn: &Connectivity, nv: usize) -> Vec<u8> {
-    (0..nv)
-        .map(|v| {
-            if conn.is_dummy.get(v).copied().unwrap_or(false) {
-                DUMMY
-            } else {
-                UNKNOWN
-            }
-        })
-        .collect()
+    initial_states_in(conn, nv, Vec::new())
+}
+
+/// [`initial_states`] in the memory of `buffer` (its contents ignored).
+fn initial_states_in(conn: &Connectivity, nv: usize, mut buffer: Vec<u8>) -> Vec<u8> {
+    buffer.clear();
+    buffer.extend((0..nv).map(|v| {
+        if conn.is_dummy.get(v).copied().unwrap_or(false) {
+            DUMMY
+        } else {
+            UNKNOWN
+        }
+    }));
+    buffer
 }
 
 /// Codes a component's start triangle `vs` (its vertices in creation order), for both
@@ -745,12 +750,16 @@ fn code_start_triangle<I: ResidualIo>(
 /// parallelogram across its gate (`v(n t) + v(p t) - v(o t)`), or by the gate's known
 /// vertices where a hole's dummy takes part. No walk and no queue: the traversal's steps come
 /// from the decoder's construction order, so decoding is one pass in memory order.
+///
+/// Returns the vertex states, in the memory of `states` (its contents ignored): a vertex
+/// was coded exactly when its state is `KNOWN`.
 pub(crate) fn code_positions_traversal<I: ResidualIo>(
     conn: &Connectivity,
     bits: u32,
     q: &mut [[i32; 3]],
     io: &mut I,
-) -> Result<Vec<bool>, TraversalError> {
+    states: Vec<u8>,
+) -> Result<Vec<u8>, TraversalError> {
     let table = &conn.table;
     let nv = table.vertex_count();
     let max_level = i64::from(max_grid_level(bits));
@@ -759,7 +768,7 @@ pub(crate) fn code_positions_traversal<I: ResidualIo>(
     let opp = table.opposites();
     let nc = cv.len();
     // One byte per vertex: unknown, known, or a dummy (never coded).
-    let mut state = initial_states(conn, nv);
+    let mut state = initial_states_in(conn, nv, states);
     let mut stop = false;
     conn.for_each_step(|step| {
         if stop {
@@ -828,7 +837,7 @@ pub(crate) fn code_positions_traversal<I: ResidualIo>(
             _ => {}
         }
     })?;
-    Ok(state.iter().map(|&s| s == KNOWN).collect())
+    Ok(state)
 }
 
 /// Prediction without a parallelogram: the midpoint of the first triangle around the vertex
@@ -1007,7 +1016,7 @@ fn encode_exact_with(
                 constrained: false,
                 budget: usize::MAX,
             };
-            code_positions_traversal(&conn, bits, &mut q, &mut io)
+            code_positions_traversal(&conn, bits, &mut q, &mut io, Vec::new())
                 .map_err(whet_edgebreaker::Error::from)?;
             (sink.finish(), None)
         }
@@ -1060,20 +1069,38 @@ fn degree_geometry(
 }
 
 /// Decodes the two payloads of an exact-mode stream.
+/// The arrays the exact decoder works in, kept between decodes (see
+/// [`crate::DecodeBuffers`]).
+#[derive(Debug, Default)]
+pub(crate) struct ExactBuffers {
+    pub connectivity: whet_edgebreaker::ConnectivityBuffers,
+    grid: Vec<[i32; 3]>,
+    states: Vec<u8>,
+    pub positions: Vec<whet_mesh::DVec3>,
+}
+
 pub(crate) fn decode_exact(
     connectivity: &[u8],
     geometry: &[u8],
     quantizer: &crate::Quantizer,
     limits: &whet_edgebreaker::ConnectivityLimits,
     prediction: ExactPrediction,
+    buffers: &mut ExactBuffers,
 ) -> Result<whet_mesh::Mesh, crate::Error> {
-    let (conn, used) = whet_edgebreaker::decode_connectivity(connectivity, limits)?;
+    let (conn, used) = whet_edgebreaker::decode_connectivity_reusing(
+        connectivity,
+        limits,
+        &mut buffers.connectivity,
+    )?;
     if used != connectivity.len() {
         return Err(crate::Error::Corrupt(
             "connectivity section has trailing bytes".into(),
         ));
     }
-    let mut q: Vec<[i32; 3]> = vec![[0; 3]; conn.table.vertex_count()];
+    let nv = conn.table.vertex_count();
+    let mut q = std::mem::take(&mut buffers.grid);
+    q.clear();
+    q.resize(nv, [0; 3]);
     let mut dec = RangeDecoder::new(geometry).map_err(|_| crate::Error::Truncated("geometry"))?;
     // The degree order's payload opens with its strategy bit; the traversal order has none.
     let constrained = prediction == ExactPrediction::Degree && dec.decode_direct(1) == 1;
@@ -1083,36 +1110,50 @@ pub(crate) fn decode_exact(
         max_level: quantizer.max_level(),
         invalid: false,
     };
-    let known = match prediction {
-        ExactPrediction::Degree => code_positions(&conn, quantizer.bits, &mut q, &mut io),
+    // Per vertex, whether it was decoded: the degree walk's flags, or the traversal's
+    // states (kept for the next decode).
+    let (known, states) = match prediction {
+        ExactPrediction::Degree => (
+            code_positions(&conn, quantizer.bits, &mut q, &mut io)
+                .map_err(whet_edgebreaker::Error::from)?,
+            None,
+        ),
         ExactPrediction::Traversal => {
-            code_positions_traversal(&conn, quantizer.bits, &mut q, &mut io)
+            let states = std::mem::take(&mut buffers.states);
+            let states = code_positions_traversal(&conn, quantizer.bits, &mut q, &mut io, states)
+                .map_err(whet_edgebreaker::Error::from)?;
+            (Vec::new(), Some(states))
         }
-    }
-    .map_err(whet_edgebreaker::Error::from)?;
+    };
     if dec.finish().is_err() {
         return Err(crate::Error::Truncated("geometry"));
     }
     let max = quantizer.max_level();
     // decode_connectivity numbers the vertices in traversal order, the real ones first: the
     // output is ids 0..real in order, and the triangles that touch no dummy.
-    let real = conn
-        .is_dummy
-        .iter()
-        .position(|&d| d)
-        .unwrap_or(conn.is_dummy.len());
-    let mut positions = Vec::with_capacity(real);
-    for (&g, &k) in q[..real].iter().zip(&known[..real]) {
-        if !k || g.iter().any(|&c| c < 0 || c > max) {
+    let real = conn.is_dummy.iter().position(|&d| d).unwrap_or(nv);
+    let mut positions = std::mem::take(&mut buffers.positions);
+    positions.clear();
+    positions.reserve(real);
+    for (i, &g) in q[..real].iter().enumerate() {
+        let decoded = match &states {
+            Some(s) => s[i] == KNOWN,
+            None => known[i],
+        };
+        if !decoded || g.iter().any(|&c| c < 0 || c > max) {
             return Err(crate::Error::Corrupt(
                 "a decoded position falls outside the quantization grid".into(),
             ));
         }
         positions.push(quantizer.dequantize(g));
     }
-    drop(q);
-    let mut triangles = conn.table.into_triangles();
-    if real < known.len() {
+    buffers.grid = q;
+    if let Some(s) = states {
+        buffers.states = s;
+    }
+    // The triangles leave with the mesh; the table's other arrays stay for the next decode.
+    let mut triangles = buffers.connectivity.recycle_all_but_triangles(conn);
+    if real < nv {
         triangles.retain(|t| t.iter().all(|&x| (x as usize) < real));
     }
     Ok(whet_mesh::Mesh::new(positions, triangles))

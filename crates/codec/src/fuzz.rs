@@ -66,10 +66,39 @@ pub fn fuzz_exact_payloads(data: &[u8]) {
         crate::ExactPrediction::Degree,
         crate::ExactPrediction::Traversal,
     ] {
-        if let Ok(mesh) = crate::decode_exact_payloads(&p, prediction) {
-            check_valid(&mesh);
+        let fresh = crate::decode_exact_payloads(&p, prediction);
+        if let Ok(mesh) = &fresh {
+            check_valid(mesh);
         }
+        // Buffers kept from every earlier input of this process (left in any state by the
+        // corrupt ones) decode the same.
+        let reused = REUSED.with(|b| {
+            let mut buffers = b.borrow_mut();
+            let r = crate::exact::decode_exact(
+                &p.connectivity,
+                &p.geometry,
+                &p.quantizer,
+                &whet_edgebreaker::ConnectivityLimits::DEFAULT,
+                prediction,
+                &mut buffers,
+            );
+            if let Ok(mesh) = &r {
+                buffers
+                    .connectivity
+                    .recycle_triangles(mesh.triangles.clone());
+            }
+            r
+        });
+        assert_eq!(
+            reused.map_err(|e| e.to_string()),
+            fresh.map_err(|e| e.to_string()),
+            "reused buffers decode otherwise"
+        );
     }
+}
+
+thread_local! {
+    static REUSED: std::cell::RefCell<crate::exact::ExactBuffers> = Default::default();
 }
 
 /// Bytes before the payloads in a [`fuzz_swing_payloads`] input.

@@ -38,8 +38,9 @@ pub mod surface_filter;
 pub mod swing;
 
 pub use decoder::{
-    decode, decode_container, peek_header, DecodeOptions, Decoder, StreamingDecoder,
-    DECODE_BYTES_PER_TRIANGLE, DECODE_BYTES_PER_VERTEX, DECODE_PEAK_LIMIT,
+    decode, decode_container, decode_container_reusing, decode_reusing, peek_header, DecodeBuffers,
+    DecodeOptions, Decoder, StreamingDecoder, DECODE_BYTES_PER_TRIANGLE, DECODE_BYTES_PER_VERTEX,
+    DECODE_PEAK_LIMIT,
 };
 pub use encoder::{
     encode, prepare_mesh, EncodeOptions, EncodeReport, Encoded, Encoder, PreparedMesh,
@@ -124,5 +125,6 @@ pub fn decode_exact_payloads(
         &p.quantizer,
         &whet_edgebreaker::ConnectivityLimits::DEFAULT,
         prediction,
+        &mut Default::default(),
     )
 }

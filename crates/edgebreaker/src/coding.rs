@@ -11,7 +11,7 @@
 //! | labels in decoding order (last first), the forced first E omitted | range coded, context = remaining valence (6) x previous decoded label (5) |
 
 use crate::holes::close_holes;
-use crate::reverse_decoder::{ReverseDecoder, VALENCE_CONTEXTS};
+use crate::reverse_decoder::{ReverseBuffers, ReverseDecoder, VALENCE_CONTEXTS};
 use crate::traversal::{traverse, Clers, SplitEvent, Step, TraversalError, TraversalSummary};
 use crate::Error;
 use whet_bits::{
@@ -564,6 +564,74 @@ pub fn decode_connectivity(
     bytes: &[u8],
     limits: &ConnectivityLimits,
 ) -> Result<(Connectivity, usize), Error> {
+    decode_connectivity_reusing(bytes, limits, &mut ConnectivityBuffers::default())
+}
+
+/// The arrays [`decode_connectivity_reusing`] builds a connectivity in, kept between decodes
+/// by a caller that decodes one stream after another: on a 1.3M-triangle mesh about 45 MB
+/// that would otherwise be fresh memory, faulted in page by page, at every decode. Holds
+/// the largest sizes decoded so far until dropped.
+#[derive(Debug, Default)]
+pub struct ConnectivityBuffers {
+    reverse: ReverseBuffers,
+    labels: Vec<Clers>,
+    order: Vec<u32>,
+    new_id: Vec<u32>,
+    vertex_corner: Vec<u32>,
+    is_dummy: Vec<bool>,
+}
+
+impl ConnectivityBuffers {
+    /// Takes back the arrays of a connectivity this decoded (any connectivity's are fine;
+    /// their contents are ignored).
+    pub fn recycle(&mut self, conn: Connectivity) {
+        let triangles = self.recycle_all_but_triangles(conn);
+        self.recycle_triangles(triangles);
+    }
+
+    /// [`ConnectivityBuffers::recycle`] but for the table's triangle list, which it returns
+    /// (what a decoder outputs).
+    pub fn recycle_all_but_triangles(&mut self, conn: Connectivity) -> Vec<[u32; 3]> {
+        let (triangles, opposite, vertex_corner) = conn.table.into_parts();
+        self.reverse.o = opposite;
+        self.vertex_corner = vertex_corner;
+        self.labels = conn.summary.labels;
+        self.order = conn.summary.vertex_order.into_iter().map(|v| v.0).collect();
+        self.is_dummy = conn.is_dummy;
+        triangles
+    }
+
+    /// Takes back a triangle list (a decoded mesh's, once its user is done with it): the
+    /// next decode builds its table, and so its output, in it.
+    pub fn recycle_triangles(&mut self, triangles: Vec<[u32; 3]>) {
+        if triangles.capacity() > self.reverse.v.capacity() {
+            self.reverse.v = triangles;
+        }
+    }
+
+    /// Takes the triangle list out (empty; with the capacity of the largest recycled).
+    pub fn take_triangles(&mut self) -> Vec<[u32; 3]> {
+        let mut t = std::mem::take(&mut self.reverse.v);
+        t.clear();
+        t
+    }
+}
+
+/// Clears `v` and fills it with `n` copies of `x`, in the memory it has.
+fn refill<T: Copy>(mut v: Vec<T>, n: usize, x: T) -> Vec<T> {
+    v.clear();
+    v.resize(n, x);
+    v
+}
+
+/// [`decode_connectivity`] in the arrays of `buffers` (and of connectivities recycled into
+/// it): the same results, without fresh memory once the buffers are as large as the stream
+/// needs.
+pub fn decode_connectivity_reusing(
+    bytes: &[u8],
+    limits: &ConnectivityLimits,
+    buffers: &mut ConnectivityBuffers,
+) -> Result<(Connectivity, usize), Error> {
     let mut pos = 0usize;
     let n = read_varint(bytes, &mut pos)?;
     let k = read_varint(bytes, &mut pos)?;
@@ -625,11 +693,18 @@ pub fn decode_connectivity(
     }
 
     let n32 = n as u32;
-    let mut rev = ReverseDecoder::new(n32, &splits, (triangles as usize).min(1 << 22));
+    let mut rev = ReverseDecoder::with_buffers(
+        n32,
+        &splits,
+        (triangles as usize).min(1 << 22),
+        std::mem::take(&mut buffers.reverse),
+    );
     let mut models = LabelModels::new();
     let mut prev = Clers::E;
     // Labels in decoding order (the reverse of the encoder's).
-    let mut decoded: Vec<Clers> = Vec::with_capacity((n as usize).min(1 << 22));
+    let mut decoded: Vec<Clers> = std::mem::take(&mut buffers.labels);
+    decoded.clear();
+    decoded.reserve((n as usize).min(1 << 22));
     for i in 0..n32 {
         let gate = rev.gate();
         let sym = match gate {
@@ -656,6 +731,8 @@ pub fn decode_connectivity(
     let vertex_ids = rev.vertex_ids();
     let mut v = std::mem::take(&mut rev.v);
     let o = std::mem::take(&mut rev.o);
+    buffers.reverse.leftmost = std::mem::take(&mut rev.leftmost);
+    buffers.reverse.valence = std::mem::take(&mut rev.valence);
     drop(rev);
     // The traversal's vertex order without traversing again: per component, the start
     // triangle's vertices, then the tip of each C in encoding order; decoder step i made
@@ -667,7 +744,9 @@ pub fn decode_connectivity(
             .copied()
             .ok_or(Error::Corrupt("a start corner is out of range"))
     };
-    let mut order: Vec<u32> = Vec::with_capacity(vertex_ids);
+    let mut order = std::mem::take(&mut buffers.order);
+    order.clear();
+    order.reserve(vertex_ids);
     for (&s, range) in starts.iter().zip(&steps) {
         let base = s - s % 3;
         for c in [s, base + (s + 1) % 3, base + (s + 2) % 3] {
@@ -689,7 +768,7 @@ pub fn decode_connectivity(
         .checked_sub(dummy_positions.len())
         .ok_or(Error::Corrupt("dummy vertex position out of range"))?;
     const NONE: u32 = u32::MAX;
-    let mut new_id = vec![NONE; vertex_ids];
+    let mut new_id = refill(std::mem::take(&mut buffers.new_id), vertex_ids, NONE);
     let (mut next_real, mut next_dummy) = (0u32, real as u32);
     let mut dummies = dummy_positions.iter().peekable();
     for (pos, x) in order.iter_mut().enumerate() {
@@ -721,13 +800,20 @@ pub fn decode_connectivity(
             Some(&id) => id,
         };
     }
-    drop(new_id);
+    buffers.new_id = new_id;
     let vertex_count = order.len();
     // The reverse decoder builds fans by construction; walks over the table stay bounded
     // even if a corrupt stream produced a split fan, so the fan check is skipped. The table
     // must be closed (the holes open later): a corner left unglued is found here, in the
     // pass that checks the pairs.
-    let table = CornerTable::from_raw_closed(v, o, vertex_count, false).map_err(|e| match e {
+    let table = CornerTable::from_raw_closed_reusing(
+        v,
+        o,
+        vertex_count,
+        false,
+        std::mem::take(&mut buffers.vertex_corner),
+    )
+    .map_err(|e| match e {
         MeshError::OpenEdge { .. } => Error::Corrupt("the decoded mesh is not closed"),
         MeshError::IndexOutOfRange { .. } => Error::Corrupt("a corner has no vertex"),
         _ => Error::Corrupt("the decoded mesh is not a manifold"),
@@ -740,7 +826,8 @@ pub fn decode_connectivity(
         starts: starts.clone(),
         vertex_order: order.into_iter().map(VertexId).collect(),
     };
-    let is_dummy = (0..vertex_count).map(|i| i >= real).collect();
+    let mut is_dummy = refill(std::mem::take(&mut buffers.is_dummy), vertex_count, false);
+    is_dummy[real..].fill(true);
     Ok((
         Connectivity {
             table,

@@ -24,8 +24,9 @@ mod reverse_decoder;
 mod traversal;
 
 pub use coding::{
-    decode_connectivity, encode_connectivity, encode_connectivity_with_table, label_bits,
-    Connectivity, ConnectivityLimits, EncodedConnectivity,
+    decode_connectivity, decode_connectivity_reusing, encode_connectivity,
+    encode_connectivity_with_table, label_bits, Connectivity, ConnectivityBuffers,
+    ConnectivityLimits, EncodedConnectivity,
 };
 pub use holes::close_holes;
 pub use traversal::{traverse, Clers, SplitEvent, Step, TraversalError, TraversalSummary};

@@ -56,14 +56,23 @@ fn checked_vertex(x: u32) -> Result<u32, Error> {
 }
 
 /// The state of a reverse decode.
+/// The large arrays of a [`ReverseDecoder`], kept between decodes.
+#[derive(Debug, Default)]
+pub(crate) struct ReverseBuffers {
+    pub v: Vec<[u32; 3]>,
+    pub o: Vec<u32>,
+    pub leftmost: Vec<u32>,
+    pub valence: Vec<u32>,
+}
+
 pub(crate) struct ReverseDecoder {
     /// Vertices of each triangle's corners (corner `3 t + j` is `v[t][j]`): the decoded
     /// mesh's triangle list, handed on without a copy.
     pub v: Vec<[u32; 3]>,
     /// Opposite of each corner.
     pub o: Vec<u32>,
-    leftmost: Vec<u32>,
-    valence: Vec<u32>,
+    pub leftmost: Vec<u32>,
+    pub valence: Vec<u32>,
     active: Vec<u32>,
     /// Per entry of `active`, the decoder step of the E that opened it (kept when an S
     /// puts a split corner in the place of the entry it pops): the entries left at the end
@@ -86,13 +95,38 @@ impl ReverseDecoder {
     /// the number of faces to reserve (symbols plus components), already checked by the
     /// caller against its limits.
     pub fn new(symbols: u32, splits: &[SplitEvent], capacity_faces: usize) -> Self {
+        Self::with_buffers(symbols, splits, capacity_faces, ReverseBuffers::default())
+    }
+
+    /// [`ReverseDecoder::new`] filling the arrays of `buffers` (their contents ignored): a
+    /// decoder that kept them from an earlier stream does not fault their memory in again.
+    pub fn with_buffers(
+        symbols: u32,
+        splits: &[SplitEvent],
+        capacity_faces: usize,
+        buffers: ReverseBuffers,
+    ) -> Self {
         let mut splits = splits.to_vec();
         splits.sort_unstable_by(|a, b| b.source.cmp(&a.source).then(a.right.cmp(&b.right)));
+        let ReverseBuffers {
+            mut v,
+            mut o,
+            mut leftmost,
+            mut valence,
+        } = buffers;
+        v.clear();
+        v.reserve(capacity_faces);
+        o.clear();
+        o.reserve(3 * capacity_faces);
+        leftmost.clear();
+        leftmost.reserve(capacity_faces / 2 + 3);
+        valence.clear();
+        valence.reserve(capacity_faces / 2 + 3);
         ReverseDecoder {
-            v: Vec::with_capacity(capacity_faces),
-            o: Vec::with_capacity(3 * capacity_faces),
-            leftmost: Vec::with_capacity(capacity_faces / 2 + 3),
-            valence: Vec::with_capacity(capacity_faces / 2 + 3),
+            v,
+            o,
+            leftmost,
+            valence,
             active: Vec::new(),
             origin: Vec::new(),
             split_active: Vec::new(),

@@ -290,7 +290,7 @@ impl CornerTable {
         vertex_count: usize,
         check_fans: bool,
     ) -> Result<CornerTable, MeshError> {
-        Self::from_raw_checked::<false>(triangles, opposite, vertex_count, check_fans)
+        Self::from_raw_checked::<false>(triangles, opposite, vertex_count, check_fans, Vec::new())
     }
 
     /// [`CornerTable::from_raw`] for a table that must be closed: an opposite left at the
@@ -302,7 +302,26 @@ impl CornerTable {
         vertex_count: usize,
         check_fans: bool,
     ) -> Result<CornerTable, MeshError> {
-        Self::from_raw_checked::<true>(triangles, opposite, vertex_count, check_fans)
+        Self::from_raw_closed_reusing(triangles, opposite, vertex_count, check_fans, Vec::new())
+    }
+
+    /// [`CornerTable::from_raw_closed`] that builds its per-vertex array in `buffer` (its
+    /// contents ignored), as a decoder that keeps the arrays of its last table does: memory
+    /// already mapped is not faulted in again. [`CornerTable::into_parts`] gives it back.
+    pub fn from_raw_closed_reusing(
+        triangles: Vec<[u32; 3]>,
+        opposite: Vec<u32>,
+        vertex_count: usize,
+        check_fans: bool,
+        buffer: Vec<u32>,
+    ) -> Result<CornerTable, MeshError> {
+        Self::from_raw_checked::<true>(triangles, opposite, vertex_count, check_fans, buffer)
+    }
+
+    /// The table's arrays: its triangles, the opposite of each corner, and each vertex's
+    /// start corner (for reuse by a decoder; see [`CornerTable::from_raw_closed_reusing`]).
+    pub fn into_parts(self) -> (Vec<[u32; 3]>, Vec<u32>, Vec<u32>) {
+        (self.triangles, self.opposite, self.vertex_corner)
     }
 
     fn from_raw_checked<const CLOSED: bool>(
@@ -310,16 +329,17 @@ impl CornerTable {
         opposite: Vec<u32>,
         vertex_count: usize,
         check_fans: bool,
+        mut buffer: Vec<u32>,
     ) -> Result<CornerTable, MeshError> {
         let nc = check_corner_arrays(&triangles, &opposite, vertex_count)?;
         // One pass over the triangles: vertex indices, repeated vertices, and each corner's
         // opposite (mutual, facing the same edge reversed); without the fan check the start
         // corners are picked on the way.
-        let mut vertex_corner = if check_fans {
-            Vec::new()
-        } else {
-            vec![NONE; vertex_count]
-        };
+        buffer.clear();
+        let mut vertex_corner = buffer;
+        if !check_fans {
+            vertex_corner.resize(vertex_count, NONE);
+        }
         for (t, (&tv, to)) in triangles.iter().zip(opposite.chunks_exact(3)).enumerate() {
             if let Some(&v) = tv.iter().find(|&&v| v as usize >= vertex_count) {
                 return Err(MeshError::IndexOutOfRange {

@@ -1,6 +1,8 @@
 //! Truncated, bit-flipped, random and version-bumped streams give clear errors.
 
-use whet_codec::{decode, encode, DecodeOptions, EncodeOptions, Error};
+use whet_codec::{
+    decode, decode_reusing, encode, DecodeBuffers, DecodeOptions, EncodeOptions, Error,
+};
 use whet_testkit::meshes::*;
 
 fn sample_stream() -> Vec<u8> {
@@ -39,12 +41,21 @@ fn every_truncation_is_an_error() {
 #[test]
 fn every_bit_flip_is_an_error() {
     for bytes in sample_streams() {
+        // Decoders that keep their buffers across the corrupt streams fail the same way.
+        let mut buffers = DecodeBuffers::new();
         for i in 0..bytes.len() * 8 {
             let mut b = bytes.clone();
             b[i / 8] ^= 1 << (i % 8);
             let r = decode(&b, &DecodeOptions::DEFAULT);
             assert!(r.is_err(), "flip of bit {i} decoded silently");
+            let reused = decode_reusing(&b, &DecodeOptions::DEFAULT, &mut buffers);
+            assert_eq!(
+                reused.map_err(|e| e.to_string()),
+                r.map_err(|e| e.to_string())
+            );
         }
+        let clean = decode_reusing(&bytes, &DecodeOptions::DEFAULT, &mut buffers).unwrap();
+        assert_eq!(clean, decode(&bytes, &DecodeOptions::DEFAULT).unwrap());
     }
 }
 

@@ -3,7 +3,8 @@
 
 use proptest::prelude::*;
 use whet_codec::{
-    decode, encode, DecodeOptions, Decoder, EncodeOptions, ExactPrediction, StreamingDecoder,
+    decode, decode_reusing, encode, DecodeBuffers, DecodeOptions, Decoder, EncodeOptions,
+    ExactPrediction, StreamingDecoder,
 };
 use whet_mesh::{DVec3, Mesh};
 use whet_testkit::meshes::*;
@@ -62,6 +63,52 @@ fn fixtures_round_trip() {
         let mesh = whet_io::read_path(&path, None).unwrap();
         for bits in [8, 14] {
             check_round_trip(&mesh, bits);
+        }
+    }
+}
+
+/// One set of buffers through streams of every size and kind, each mesh given back when
+/// checked (larger and smaller than the last, with holes and without, both predictions, a
+/// corrupt stream in between): every decode is `decode`'s.
+#[test]
+fn reused_buffers_decode_what_decode_decodes() {
+    let holes = union(
+        union(torus(10, 7), &punch(&icosphere(3), |i| i % 41 == 5), 6.0),
+        &grid(4, 3),
+        12.0,
+    );
+    let meshes = [
+        shuffle(&icosphere(4), 1),
+        Mesh::new(vec![DVec3::ZERO, DVec3::X, DVec3::Y], vec![[0, 1, 2]]),
+        shuffle(&holes, 2),
+        Mesh::default(),
+        shuffle(&icosphere(5), 3),
+        torus(6, 5),
+    ];
+    let mut buffers = DecodeBuffers::new();
+    for round in 0..2 {
+        for (i, mesh) in meshes.iter().enumerate() {
+            for prediction in [ExactPrediction::Traversal, ExactPrediction::Degree] {
+                let opts = EncodeOptions::DEFAULT
+                    .with_quant_bits(10 + i as u32)
+                    .with_prediction(prediction);
+                let bytes = encode(mesh, &opts).unwrap().bytes;
+                let want = decode(&bytes, &DecodeOptions::DEFAULT).unwrap();
+                let got = decode_reusing(&bytes, &DecodeOptions::DEFAULT, &mut buffers).unwrap();
+                assert_eq!(got, want, "round {round}, mesh {i}, {prediction:?}");
+                if round == 1 {
+                    buffers.recycle(got);
+                }
+                // A stream cut short fails the same way and leaves the buffers usable.
+                let cut = &bytes[..bytes.len() * 2 / 3];
+                let e = decode_reusing(cut, &DecodeOptions::DEFAULT, &mut buffers).unwrap_err();
+                assert_eq!(
+                    e.to_string(),
+                    decode(cut, &DecodeOptions::DEFAULT)
+                        .unwrap_err()
+                        .to_string()
+                );
+            }
         }
     }
 }
