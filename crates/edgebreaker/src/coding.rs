@@ -729,7 +729,7 @@ pub fn decode_connectivity_reusing(
     let starts = rev.finish(k as usize)?;
     let steps = rev.component_steps()?;
     let vertex_ids = rev.vertex_ids();
-    let mut v = std::mem::take(&mut rev.v);
+    let v = std::mem::take(&mut rev.v);
     let o = std::mem::take(&mut rev.o);
     buffers.reverse.leftmost = std::mem::take(&mut rev.leftmost);
     buffers.reverse.valence = std::mem::take(&mut rev.valence);
@@ -793,31 +793,27 @@ pub fn decode_connectivity_reusing(
     if dummies.next().is_some() {
         return Err(Error::Corrupt("dummy vertex position out of range"));
     }
-    for x in v.as_flattened_mut() {
-        *x = match new_id.get(*x as usize) {
-            None => return Err(Error::Corrupt("a corner has no vertex")),
-            Some(&NONE) => return Err(Error::Corrupt("the decoded vertex order misses vertices")),
-            Some(&id) => id,
-        };
-    }
-    buffers.new_id = new_id;
     let vertex_count = order.len();
     // The reverse decoder builds fans by construction; walks over the table stay bounded
     // even if a corrupt stream produced a split fan, so the fan check is skipped. The table
     // must be closed (the holes open later): a corner left unglued is found here, in the
-    // pass that checks the pairs.
-    let table = CornerTable::from_raw_closed_reusing(
+    // pass that checks the pairs, which also renumbers the triangles (a vertex outside the
+    // order, or a corner without a vertex, has no new number).
+    let table = CornerTable::from_raw_closed_renumbering(
         v,
         o,
+        &new_id,
         vertex_count,
-        false,
         std::mem::take(&mut buffers.vertex_corner),
     )
     .map_err(|e| match e {
         MeshError::OpenEdge { .. } => Error::Corrupt("the decoded mesh is not closed"),
-        MeshError::IndexOutOfRange { .. } => Error::Corrupt("a corner has no vertex"),
+        MeshError::IndexOutOfRange { .. } => {
+            Error::Corrupt("a corner's vertex is missing from the decoded vertex order")
+        }
         _ => Error::Corrupt("the decoded mesh is not a manifold"),
     })?;
+    buffers.new_id = new_id;
     let starts: Vec<CornerId> = starts.into_iter().map(CornerId).collect();
     decoded.reverse();
     let summary = TraversalSummary {

@@ -290,7 +290,14 @@ impl CornerTable {
         vertex_count: usize,
         check_fans: bool,
     ) -> Result<CornerTable, MeshError> {
-        Self::from_raw_checked::<false>(triangles, opposite, vertex_count, check_fans, Vec::new())
+        Self::from_raw_checked::<false>(
+            triangles,
+            opposite,
+            vertex_count,
+            check_fans,
+            Vec::new(),
+            None,
+        )
     }
 
     /// [`CornerTable::from_raw`] for a table that must be closed: an opposite left at the
@@ -315,7 +322,30 @@ impl CornerTable {
         check_fans: bool,
         buffer: Vec<u32>,
     ) -> Result<CornerTable, MeshError> {
-        Self::from_raw_checked::<true>(triangles, opposite, vertex_count, check_fans, buffer)
+        Self::from_raw_checked::<true>(triangles, opposite, vertex_count, check_fans, buffer, None)
+    }
+
+    /// [`CornerTable::from_raw_closed_reusing`] that also renumbers the vertices: vertex `v`
+    /// of `triangles` becomes `renumber[v]`, in the pass that checks the table (a decoder
+    /// that numbers its vertices in another order saves a pass over its triangles). The map
+    /// must be injective on the vertices used; a vertex without a number (`u32::MAX`, or
+    /// past the map) is [`MeshError::IndexOutOfRange`] against the map's length, and the new
+    /// numbers must lie below `vertex_count`.
+    pub fn from_raw_closed_renumbering(
+        triangles: Vec<[u32; 3]>,
+        opposite: Vec<u32>,
+        renumber: &[u32],
+        vertex_count: usize,
+        buffer: Vec<u32>,
+    ) -> Result<CornerTable, MeshError> {
+        Self::from_raw_checked::<true>(
+            triangles,
+            opposite,
+            vertex_count,
+            false,
+            buffer,
+            Some(renumber),
+        )
     }
 
     /// The table's arrays: its triangles, the opposite of each corner, and each vertex's
@@ -325,27 +355,32 @@ impl CornerTable {
     }
 
     fn from_raw_checked<const CLOSED: bool>(
-        triangles: Vec<[u32; 3]>,
+        mut triangles: Vec<[u32; 3]>,
         opposite: Vec<u32>,
         vertex_count: usize,
         check_fans: bool,
         mut buffer: Vec<u32>,
+        renumber: Option<&[u32]>,
     ) -> Result<CornerTable, MeshError> {
         let nc = check_corner_arrays(&triangles, &opposite, vertex_count)?;
         // One pass over the triangles: vertex indices, repeated vertices, and each corner's
         // opposite (mutual, facing the same edge reversed); without the fan check the start
-        // corners are picked on the way.
+        // corners are picked on the way. When renumbering, the checks compare the old
+        // numbers (a triangle is renumbered after its checks, and its later neighbours are
+        // still in the old ones; the map is injective, so the comparisons agree).
         buffer.clear();
         let mut vertex_corner = buffer;
         if !check_fans {
             vertex_corner.resize(vertex_count, NONE);
         }
-        for (t, (&tv, to)) in triangles.iter().zip(opposite.chunks_exact(3)).enumerate() {
-            if let Some(&v) = tv.iter().find(|&&v| v as usize >= vertex_count) {
+        let old_count = renumber.map_or(vertex_count, |m| m.len());
+        for (t, to) in opposite.chunks_exact(3).enumerate() {
+            let tv = triangles[t];
+            if let Some(&v) = tv.iter().find(|&&v| v as usize >= old_count) {
                 return Err(MeshError::IndexOutOfRange {
                     triangle: t as u32,
                     index: v,
-                    vertex_count: vertex_count as u32,
+                    vertex_count: old_count as u32,
                 });
             }
             let [a, b, c] = tv;
@@ -391,6 +426,21 @@ impl CornerTable {
                     });
                 }
             }
+            let tv = match renumber {
+                None => tv,
+                Some(map) => {
+                    let new = tv.map(|v| map[v as usize]);
+                    if let Some(j) = new.iter().position(|&v| v as usize >= vertex_count) {
+                        return Err(MeshError::IndexOutOfRange {
+                            triangle: t as u32,
+                            index: tv[j],
+                            vertex_count: old_count as u32,
+                        });
+                    }
+                    triangles[t] = new;
+                    new
+                }
+            };
             if !check_fans {
                 for j in 0..3 {
                     let slot = &mut vertex_corner[tv[j] as usize];
@@ -857,6 +907,31 @@ mod tests {
             CornerTable::from_raw_closed(lost, o, 4, false),
             Err(MeshError::IndexOutOfRange { .. })
         ));
+    }
+
+    #[test]
+    fn a_renumbering_build_is_the_build_of_the_renumbered_triangles() {
+        let t = CornerTable::new(&tetrahedron()).unwrap();
+        let (v, o) = (t.triangles().to_vec(), t.opposites().to_vec());
+        let map = [2, 0, 3, 1];
+        let renumbered: Vec<[u32; 3]> = v.iter().map(|t| t.map(|x| map[x as usize])).collect();
+        let want = CornerTable::from_raw_closed(renumbered, o.clone(), 4, false).unwrap();
+        let got =
+            CornerTable::from_raw_closed_renumbering(v.clone(), o.clone(), &map, 4, vec![7; 9]);
+        assert_eq!(got, Ok(want));
+        // A vertex without a number, a map too short, a number past the count: refused.
+        for (map, count) in [
+            (vec![2, 0, u32::MAX, 1], 4),
+            (vec![2, 0, 3], 4),
+            (vec![2, 0, 3, 1], 3),
+        ] {
+            let r =
+                CornerTable::from_raw_closed_renumbering(v.clone(), o.clone(), &map, count, vec![]);
+            assert!(
+                matches!(r, Err(MeshError::IndexOutOfRange { .. })),
+                "{map:?}: {r:?}"
+            );
+        }
     }
 
     #[test]
