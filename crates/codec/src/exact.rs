@@ -1098,8 +1098,9 @@ pub(crate) fn decode_exact(
         ));
     }
     let nv = conn.table.vertex_count();
+    // Kept from the last decode as it is: both orders read a vertex's coordinates only once
+    // it is known (decoded in this decode), so only new entries need a value.
     let mut q = std::mem::take(&mut buffers.grid);
-    q.clear();
     q.resize(nv, [0; 3]);
     let mut dec = RangeDecoder::new(geometry).map_err(|_| crate::Error::Truncated("geometry"))?;
     // The degree order's payload opens with its strategy bit; the traversal order has none.
@@ -1135,18 +1136,25 @@ pub(crate) fn decode_exact(
     let mut positions = std::mem::take(&mut buffers.positions);
     positions.clear();
     positions.reserve(real);
-    for (i, &g) in q[..real].iter().enumerate() {
-        let decoded = match &states {
-            Some(s) => s[i] == KNOWN,
-            None => known[i],
-        };
-        if !decoded || g.iter().any(|&c| c < 0 || c > max) {
-            return Err(crate::Error::Corrupt(
-                "a decoded position falls outside the quantization grid".into(),
-            ));
-        }
-        positions.push(quantizer.dequantize(g));
+    // Every real vertex decoded and inside the grid (one branch-free pass), then the
+    // positions in one sequential pass.
+    let outside = |g: &[i32; 3]| g.iter().fold(false, |o, &c| o | (c < 0) | (c > max));
+    let bad = match &states {
+        Some(s) => q[..real]
+            .iter()
+            .zip(&s[..real])
+            .fold(false, |b, (g, &st)| b | (st != KNOWN) | outside(g)),
+        None => q[..real]
+            .iter()
+            .zip(&known[..real])
+            .fold(false, |b, (g, &k)| b | !k | outside(g)),
+    };
+    if bad {
+        return Err(crate::Error::Corrupt(
+            "a decoded position falls outside the quantization grid".into(),
+        ));
     }
+    positions.extend(q[..real].iter().map(|&g| quantizer.dequantize(g)));
     buffers.grid = q;
     if let Some(s) = states {
         buffers.states = s;
