@@ -64,6 +64,12 @@ impl CdfModel {
     /// copies came out as scalar loops (about eight times the instructions).
     #[inline(never)]
     pub fn update(&mut self, s: usize) {
+        self.update_in_line(s)
+    }
+
+    /// [`CdfModel::update`] inlined, for the decoder's one hot call site.
+    #[inline(always)]
+    fn update_in_line(&mut self, s: usize) {
         let rate = RATE_MIN + (self.count / RATE_STEP) as u32;
         if (self.count as u32) < RATE_STEP as u32 * RATE_STEPS {
             self.count += 1;
@@ -158,7 +164,7 @@ impl RangeDecoder<'_> {
         // A corrupt stream may break `code < range`; wrapping keeps it garbage, not a panic.
         self.code = code.wrapping_sub(lo);
         self.range = range.max(1);
-        model.update(s);
+        model.update_in_line(s);
         self.normalize_pub();
         s
     }
