@@ -33,7 +33,10 @@ pub mod codec {
     pub use whet_codec::*;
 }
 
-pub use whet_codec::{encode, DecodeOptions, Decoder, EncodeOptions, Encoder, StreamingDecoder};
+pub use whet_codec::{
+    encode, DecodeBuffers, DecodeOptions, Decoder, EncodeBuffers, EncodeOptions, Encoder,
+    StreamingDecoder,
+};
 
 /// Why a stream could not be decoded (or a subdiv stream encoded).
 #[derive(Debug, thiserror::Error)]
@@ -100,6 +103,23 @@ pub fn decode_with_levels(
 /// Decodes a `.whet` stream of any mode (see [`decode_with_levels`]).
 pub fn decode(bytes: &[u8], opts: &DecodeOptions) -> Result<Mesh, Error> {
     decode_with_levels(bytes, opts, None)
+}
+
+/// [`decode`] in the memory of `buffers`, for a caller that decodes stream after stream
+/// (see [`DecodeBuffers`]: the exact mode then allocates nothing once the buffers are large
+/// enough, and a mesh given back with [`DecodeBuffers::recycle`] receives the next one).
+pub fn decode_reusing(
+    bytes: &[u8],
+    opts: &DecodeOptions,
+    buffers: &mut DecodeBuffers,
+) -> Result<Mesh, Error> {
+    let container = whet_format::parse(bytes, &opts.limits).map_err(whet_codec::Error::from)?;
+    if container.header.mode == whet_format::Mode::Subdiv {
+        return decode(bytes, opts);
+    }
+    Ok(whet_codec::decode_container_reusing(
+        &container, opts, buffers,
+    )?)
 }
 
 /// Encodes `mesh` in the subdiv mode: fits a control mesh with continuous edge sharpness and

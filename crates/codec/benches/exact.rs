@@ -1,12 +1,14 @@
 //! Exact-mode encode and decode throughput on a ~1M-triangle mesh (issue target: decode at
 //! 20 M triangles/s, encode at 5 M triangles/s on one core), with the default prediction
-//! and with the traversal prediction (`*_traversal`); `*_reusing` decodes with one set of
-//! [`DecodeBuffers`] throughout, as a server decoding stream after stream would.
+//! and with the traversal prediction (`*_traversal`); `*_reusing` encodes with one set of
+//! [`EncodeBuffers`] or decodes with one set of [`DecodeBuffers`] throughout, as a server
+//! coding mesh after mesh would.
 #![allow(clippy::unwrap_used)] // benches may panic on their own setup
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
 use whet_codec::{
-    decode, decode_reusing, encode, DecodeBuffers, DecodeOptions, EncodeOptions, ExactPrediction,
+    decode, decode_reusing, encode, DecodeBuffers, DecodeOptions, EncodeBuffers, EncodeOptions,
+    Encoder, ExactPrediction,
 };
 use whet_testkit::meshes::{icosphere, shuffle};
 
@@ -39,8 +41,20 @@ fn bench(c: &mut Criterion) {
     g.bench_function("decode_1.3M_traversal", |b| {
         b.iter(|| black_box(decode(&enc_fast.bytes, &DecodeOptions::DEFAULT).unwrap()))
     });
-    // A decoder that decodes one stream after another keeps its buffers and gives each
-    // mesh back when done with it (`decode_reusing`): no fresh memory to fault in.
+    // An encoder that encodes one mesh after another keeps its buffers
+    // (`Encoder::encode_reusing`), as a decoder that decodes one stream after another keeps
+    // its own and gives each mesh back when done with it (`decode_reusing`): no fresh
+    // memory to fault in.
+    for (name, o) in [
+        ("encode_1.3M_reusing", opts),
+        ("encode_1.3M_traversal_reusing", fast),
+    ] {
+        let encoder = Encoder::new(o);
+        let mut buffers = EncodeBuffers::new();
+        g.bench_function(name, |b| {
+            b.iter(|| black_box(encoder.encode_reusing(&mesh, &mut buffers).unwrap()))
+        });
+    }
     for (name, bytes) in [
         ("decode_1.3M_reusing", &enc.bytes),
         ("decode_1.3M_traversal_reusing", &enc_fast.bytes),

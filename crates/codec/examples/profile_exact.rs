@@ -4,12 +4,14 @@
 //! shuffled (the worst memory order an encoder meets); `PROFILE_PREDICTION=traversal` codes
 //! with the traversal prediction; `PROFILE_ORDER=natural` keeps the
 //! generator's order, and `PROFILE_MESH=<file>` profiles that mesh in its file's order;
-//! `PROFILE_REUSE=1` decodes with one [`DecodeBuffers`] throughout.
+//! `PROFILE_REUSE=1` encodes with one [`EncodeBuffers`] and decodes with one
+//! [`DecodeBuffers`] throughout.
 #![allow(clippy::unwrap_used)]
 
 use std::time::Instant;
 use whet_codec::{
-    decode, decode_reusing, encode, DecodeBuffers, DecodeOptions, EncodeOptions, ExactPrediction,
+    decode, decode_reusing, encode, DecodeBuffers, DecodeOptions, EncodeBuffers, EncodeOptions,
+    Encoder, ExactPrediction,
 };
 
 fn main() {
@@ -47,17 +49,23 @@ fn main() {
         Ok("traversal") => EncodeOptions::DEFAULT.with_prediction(ExactPrediction::Traversal),
         _ => EncodeOptions::DEFAULT,
     };
+    // PROFILE_REUSE=1: one set of buffers for every encode and every decode.
+    let reuse = std::env::var_os("PROFILE_REUSE").is_some();
+    let encoder = Encoder::new(opts);
+    let mut encode_buffers = EncodeBuffers::new();
     let mut e = None;
     for _ in 0..encodes.max(1) {
         let t = Instant::now();
-        e = Some(encode(&mesh, &opts).unwrap());
+        e = Some(if reuse {
+            encoder.encode_reusing(&mesh, &mut encode_buffers).unwrap()
+        } else {
+            encode(&mesh, &opts).unwrap()
+        });
         if encodes > 0 {
             eprintln!("encode: {:?}", t.elapsed());
         }
     }
     let e = e.unwrap();
-    // PROFILE_REUSE=1: one set of buffers for every decode, each mesh given back.
-    let reuse = std::env::var_os("PROFILE_REUSE").is_some();
     let mut buffers = DecodeBuffers::new();
     for _ in 0..decodes {
         let t = Instant::now();

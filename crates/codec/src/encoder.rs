@@ -4,7 +4,7 @@
 use crate::exact::{encode_exact, ExactPrediction};
 use crate::Error;
 use whet_format::{tag, Container, Header, Mode, SectionKind, Version};
-use whet_mesh::{morton_spread, ManifoldRepair, Mesh};
+use whet_mesh::{morton_spread, ManifoldRepair, Mesh, Scratch};
 
 /// The format version of header field `exact_prediction`.
 const VERSION_1_5: Version = Version::new(1, 5);
@@ -150,6 +150,18 @@ impl Encoder {
 
     /// Encodes `mesh`.
     pub fn encode(&self, mesh: &Mesh) -> Result<Encoded, Error> {
+        self.encode_reusing(mesh, &mut EncodeBuffers::new())
+    }
+
+    /// [`Encoder::encode`] in the memory of `buffers`: the same stream and report, and for
+    /// a caller that encodes mesh after mesh with one set of buffers, no fresh memory to
+    /// fault in once they are as large as the meshes need (see [`EncodeBuffers`]).
+    pub fn encode_reusing(
+        &self,
+        mesh: &Mesh,
+        buffers: &mut EncodeBuffers,
+    ) -> Result<Encoded, Error> {
+        let scratch = &mut buffers.scratch;
         let opts = &self.opts;
         if !(1..=30).contains(&opts.quant_bits) {
             return Err(Error::Parameter(format!(
@@ -168,11 +180,11 @@ impl Encoder {
             // accesses on an input in random memory order); the encoder walks them on its
             // traversal-ordered copy instead. Any failure takes the path that checks
             // everything up front (and repairs or reports exactly as it always did).
-            let fast =
-                prepare_with(mesh, opts.repair, false).and_then(|p| self.encode_exact(p, true));
+            let fast = prepare_with(mesh, opts.repair, false, scratch)
+                .and_then(|p| self.encode_exact(p, true, scratch));
             return match fast {
                 Ok(encoded) => Ok(encoded),
-                Err(_) => self.encode_exact(prepare(mesh, opts.repair)?, false),
+                Err(_) => self.encode_exact(prepare(mesh, opts.repair)?, false, scratch),
             };
         }
         let _prepared = prepare(mesh, opts.repair)?;
@@ -189,10 +201,15 @@ impl Encoder {
     }
 
     /// `check_fans`: `p.table` was built without the closed-fan walk, check on the way.
-    fn encode_exact(&self, p: Prepared, check_fans: bool) -> Result<Encoded, Error> {
+    fn encode_exact(
+        &self,
+        p: Prepared,
+        check_fans: bool,
+        scratch: &mut Scratch,
+    ) -> Result<Encoded, Error> {
         let bits = self.opts.quant_bits;
         let prediction = self.opts.prediction;
-        let payloads = encode_exact(&p.mesh, p.table, bits, check_fans, prediction)?;
+        let payloads = encode_exact(&p.mesh, p.table, bits, check_fans, prediction, scratch)?;
         let bbox = p.mesh.bounding_box();
         let (min, max) = if bbox.is_empty() {
             ([0.0; 3], [0.0; 3])
@@ -225,9 +242,15 @@ impl Encoder {
             .iter()
             .map(|&v| p.original[v as usize])
             .collect();
+        // The working copy and the encoder's orders go back for the next mesh.
+        scratch.give(p.mesh.positions);
+        scratch.give(p.mesh.triangles);
+        scratch.give(p.original);
+        let vertices = payloads.vertex_order.len();
+        scratch.give(payloads.vertex_order);
         let report = EncodeReport {
             bytes: bytes.len(),
-            vertices: payloads.vertex_order.len(),
+            vertices,
             triangles: payloads.triangles,
             connectivity_bits: payloads.connectivity.len() as u64 * 8,
             geometry_bits: payloads.geometry.len() as u64 * 8,
@@ -244,6 +267,24 @@ impl Encoder {
 /// Encodes `mesh` with `opts` (see [`Encoder`]).
 pub fn encode(mesh: &Mesh, opts: &EncodeOptions) -> Result<Encoded, Error> {
     Encoder::new(*opts).encode(mesh)
+}
+
+/// Memory an [`Encoder`] keeps between meshes ([`Encoder::encode_reusing`]): the exact
+/// mode's working copy of the input, its corner tables, the traversal's arrays and the
+/// quantized positions, given back at the end of each encode and taken again by the next.
+/// On a 1.3M-triangle mesh an encode touches some 180 MB; fresh, that memory is faulted in
+/// page by page (a seventh of the encode's time on the machines whet is measured on).
+/// Holds the largest sizes encoded so far until dropped.
+#[derive(Debug, Default)]
+pub struct EncodeBuffers {
+    scratch: Scratch,
+}
+
+impl EncodeBuffers {
+    /// Empty buffers.
+    pub fn new() -> Self {
+        Self::default()
+    }
 }
 
 /// An input mesh made ready for a codec mode by [`prepare_mesh`].
@@ -283,14 +324,19 @@ pub(crate) struct Prepared {
 }
 
 pub(crate) fn prepare(mesh: &Mesh, repair: bool) -> Result<Prepared, Error> {
-    prepare_with(mesh, repair, true)
+    prepare_with(mesh, repair, true, &mut Scratch::new())
 }
 
 /// [`prepare`]; without `walk_fans` the input's table is built with
 /// `CornerTable::from_triangles_deferring_fans` (a vertex pinching closed fans is not
 /// detected, nor repaired: the caller must check the fans later and fall back to
 /// [`prepare`]).
-fn prepare_with(mesh: &Mesh, repair: bool, walk_fans: bool) -> Result<Prepared, Error> {
+fn prepare_with(
+    mesh: &Mesh,
+    repair: bool,
+    walk_fans: bool,
+    scratch: &mut Scratch,
+) -> Result<Prepared, Error> {
     if let Some(v) = mesh.positions.iter().position(|p| !p.is_finite()) {
         return Err(Error::InvalidInput(
             whet_mesh::MeshError::NonFiniteCoordinate { vertex: v as u32 },
@@ -302,11 +348,17 @@ fn prepare_with(mesh: &Mesh, repair: bool, walk_fans: bool) -> Result<Prepared, 
     let reordered = if walk_fans {
         None
     } else {
-        spatial_order(mesh, REORDER_MIN_TRIANGLES)
+        spatial_order(mesh, REORDER_MIN_TRIANGLES, scratch)
     };
     let (mut work, reorder) = match reordered {
         Some((m, order)) => (m, Some(order)),
-        None => (mesh.clone(), None),
+        None => {
+            let mut positions = scratch.take_empty(mesh.positions.len());
+            positions.extend_from_slice(&mesh.positions);
+            let mut triangles = scratch.take_empty(mesh.triangles.len());
+            triangles.extend_from_slice(&mesh.triangles);
+            (Mesh::new(positions, triangles), None)
+        }
     };
     let input_vertices = work.positions.len();
     let mut rep = ManifoldRepair::default();
@@ -314,7 +366,11 @@ fn prepare_with(mesh: &Mesh, repair: bool, walk_fans: bool) -> Result<Prepared, 
     let built = if walk_fans {
         whet_mesh::CornerTable::new(&work)
     } else {
-        whet_mesh::CornerTable::from_triangles_deferring_fans(&work.triangles, work.positions.len())
+        whet_mesh::CornerTable::from_triangles_deferring_fans_in(
+            &work.triangles,
+            work.positions.len(),
+            scratch,
+        )
     };
     let mut table = match built {
         Ok(t) => Some(t),
@@ -332,8 +388,11 @@ fn prepare_with(mesh: &Mesh, repair: bool, walk_fans: bool) -> Result<Prepared, 
     // Repair appends copies; remember which input vertex each one copies by position (the
     // repair copies positions exactly, and the first input vertex at that position is the
     // one it split from or an identical one).
-    let mut original: Vec<u32> =
-        reorder.unwrap_or_else(|| (0..work.positions.len() as u32).collect());
+    let mut original: Vec<u32> = reorder.unwrap_or_else(|| {
+        let mut o = scratch.take_empty(work.positions.len());
+        o.extend(0..work.positions.len() as u32);
+        o
+    });
     if work.positions.len() > input_vertices {
         let mut by_bits: std::collections::HashMap<[u64; 3], u32> = Default::default();
         for (i, p) in mesh.positions.iter().enumerate() {
@@ -349,7 +408,7 @@ fn prepare_with(mesh: &Mesh, repair: bool, walk_fans: bool) -> Result<Prepared, 
         }
     }
     // Drop unused vertices.
-    let mut used = vec![false; work.positions.len()];
+    let mut used = scratch.take_filled(work.positions.len(), false);
     for t in &work.triangles {
         for &v in t {
             used[v as usize] = true;
@@ -379,6 +438,7 @@ fn prepare_with(mesh: &Mesh, repair: bool, walk_fans: bool) -> Result<Prepared, 
         original = orig;
         table = None;
     }
+    scratch.give(used);
     let table = match table {
         Some(t) => t,
         None => whet_mesh::CornerTable::new(&work).map_err(Error::InvalidInput)?,
@@ -432,8 +492,12 @@ fn scattered(tris: &[[u32; 3]], nv: usize) -> Option<bool> {
 
 /// Where each of `buckets` buckets starts in a counting sort of `keys` (each below
 /// `buckets`).
-fn bucket_starts(keys: impl Iterator<Item = usize>, buckets: usize) -> Vec<u32> {
-    let mut start = vec![0u32; buckets + 1];
+fn bucket_starts(
+    keys: impl Iterator<Item = usize>,
+    buckets: usize,
+    scratch: &mut Scratch,
+) -> Vec<u32> {
+    let mut start = scratch.take_filled(buckets + 1, 0u32);
     for k in keys {
         start[k + 1] += 1;
     }
@@ -448,7 +512,11 @@ fn bucket_starts(keys: impl Iterator<Item = usize>, buckets: usize) -> Vec<u32> 
 /// cell of their position (a counting sort over about one cell per four vertices), triangles
 /// by their lowest new vertex (each keeps its corners' rotation). `None`
 /// otherwise, or when an index is out of range (the caller reports it).
-fn spatial_order(mesh: &Mesh, min_triangles: usize) -> Option<(Mesh, Vec<u32>)> {
+fn spatial_order(
+    mesh: &Mesh,
+    min_triangles: usize,
+    scratch: &mut Scratch,
+) -> Option<(Mesh, Vec<u32>)> {
     let (nv, nt) = (mesh.positions.len(), mesh.triangles.len());
     if nt < min_triangles.max(WINDOW) || nv == 0 || !scattered(&mesh.triangles, nv)? {
         return None;
@@ -460,20 +528,18 @@ fn spatial_order(mesh: &Mesh, min_triangles: usize) -> Option<(Mesh, Vec<u32>)> 
     let extent = (bbox.max - bbox.min).max_element().max(f64::MIN_POSITIVE);
     let scale = ((1u32 << bits) as f64 - 1e-6) / extent;
     let top = (1u64 << bits) - 1;
-    let cell: Vec<u32> = mesh
-        .positions
-        .iter()
-        .map(|p| {
-            let q = ((*p - bbox.min) * scale)
-                .to_array()
-                .map(|x| (x as u64).min(top));
-            (morton_spread(q[0]) | morton_spread(q[1]) << 1 | morton_spread(q[2]) << 2) as u32
-        })
-        .collect();
-    let mut start = bucket_starts(cell.iter().map(|&c| c as usize), cells);
-    let mut new_id = vec![0u32; nv];
-    let mut original = vec![0u32; nv];
-    let mut positions = vec![whet_mesh::DVec3::ZERO; nv];
+    let mut cell: Vec<u32> = scratch.take_empty(nv);
+    cell.extend(mesh.positions.iter().map(|p| {
+        let q = ((*p - bbox.min) * scale)
+            .to_array()
+            .map(|x| (x as u64).min(top));
+        (morton_spread(q[0]) | morton_spread(q[1]) << 1 | morton_spread(q[2]) << 2) as u32
+    }));
+    let mut start = bucket_starts(cell.iter().map(|&c| c as usize), cells, scratch);
+    // Each written once below (a permutation).
+    let mut new_id = scratch.take_overwritten(nv, 0u32);
+    let mut original = scratch.take_overwritten(nv, 0u32);
+    let mut positions = scratch.take_overwritten(nv, whet_mesh::DVec3::ZERO);
     for (v, (&c, p)) in cell.iter().zip(&mesh.positions).enumerate() {
         let slot = &mut start[c as usize];
         new_id[v] = *slot;
@@ -487,26 +553,28 @@ fn spatial_order(mesh: &Mesh, min_triangles: usize) -> Option<(Mesh, Vec<u32>)> 
     let buckets = (nv >> shift) + 1;
     // An index out of range anywhere (the windows sample only some triangles) leaves the
     // mesh to the table's check, which names it.
-    let renamed: Vec<([u32; 3], u32)> = mesh
-        .triangles
-        .iter()
-        .map(|t| {
-            let r = [
-                *new_id.get(t[0] as usize)?,
-                *new_id.get(t[1] as usize)?,
-                *new_id.get(t[2] as usize)?,
-            ];
-            Some((r, r[0].min(r[1]).min(r[2]) >> shift))
-        })
-        .collect::<Option<_>>()?;
-    drop(new_id);
-    let mut first = bucket_starts(renamed.iter().map(|&(_, b)| b as usize), buckets);
-    let mut triangles = vec![[0u32; 3]; nt];
-    for (t, b) in renamed {
+    scratch.give(cell);
+    scratch.give(start);
+    let mut renamed: Vec<([u32; 3], u32)> = scratch.take_empty(nt);
+    for t in &mesh.triangles {
+        let r = [
+            *new_id.get(t[0] as usize)?,
+            *new_id.get(t[1] as usize)?,
+            *new_id.get(t[2] as usize)?,
+        ];
+        renamed.push((r, r[0].min(r[1]).min(r[2]) >> shift));
+    }
+    scratch.give(new_id);
+    let mut first = bucket_starts(renamed.iter().map(|&(_, b)| b as usize), buckets, scratch);
+    // Each written once below (a permutation).
+    let mut triangles = scratch.take_overwritten(nt, [0u32; 3]);
+    for &(t, b) in &renamed {
         let slot = &mut first[b as usize];
         triangles[*slot as usize] = t;
         *slot += 1;
     }
+    scratch.give(renamed);
+    scratch.give(first);
     Some((Mesh::new(positions, triangles), original))
 }
 
@@ -532,7 +600,7 @@ mod tests {
         let mut mesh = shuffle(&icosphere(5), 4);
         let nv = mesh.positions.len() as u32;
         mesh.triangles[300][2] = nv + 7;
-        assert!(spatial_order(&mesh, 0).is_none());
+        assert!(spatial_order(&mesh, 0, &mut whet_mesh::Scratch::new()).is_none());
         // Without repair the encoder names the index; with it (the default) it cuts the
         // triangle and reports that, as it always did.
         let strict = crate::EncodeOptions::DEFAULT.with_repair(false);
@@ -545,10 +613,11 @@ mod tests {
     fn the_spatial_order_is_a_renumbering() {
         let mesh = shuffle(&icosphere(5), 2);
         assert!(
-            spatial_order(&mesh, 1 << 30).is_none(),
+            spatial_order(&mesh, 1 << 30, &mut whet_mesh::Scratch::new()).is_none(),
             "under the size bound"
         );
-        let (m, original) = spatial_order(&mesh, 0).expect("a shuffled mesh is reordered");
+        let (m, original) = spatial_order(&mesh, 0, &mut whet_mesh::Scratch::new())
+            .expect("a shuffled mesh is reordered");
         let mut seen = vec![false; mesh.positions.len()];
         for (new, &old) in original.iter().enumerate() {
             assert!(!std::mem::replace(&mut seen[old as usize], true));

@@ -17,6 +17,7 @@ use crate::parallelogram::{
 };
 use whet_bits::{BitModel, RangeDecoder, ResidualModel, SignedIntModel};
 use whet_edgebreaker::{Connectivity, TraversalError};
+use whet_mesh::Scratch;
 
 const CLASSES: usize = 4;
 /// Candidate counts up to which [`ResidualWriter::select`] builds subset sums incrementally
@@ -934,8 +935,9 @@ pub(crate) fn encode_exact(
     bits: u32,
     check_fans: bool,
     prediction: ExactPrediction,
+    scratch: &mut Scratch,
 ) -> Result<ExactPayloads, crate::Error> {
-    encode_exact_with(mesh, table, bits, check_fans, true, prediction).map(|(p, _)| p)
+    encode_exact_with(mesh, table, bits, check_fans, true, prediction, scratch).map(|(p, _)| p)
 }
 
 /// [`encode_exact`], with or without the early choice of the geometry strategy; also says
@@ -947,6 +949,7 @@ fn encode_exact_with(
     check_fans: bool,
     early: bool,
     prediction: ExactPrediction,
+    scratch: &mut Scratch,
 ) -> Result<(ExactPayloads, Option<bool>), crate::Error> {
     let bbox = mesh.bounding_box();
     if !bbox.is_empty() && !bbox.size().max_element().is_finite() {
@@ -956,15 +959,16 @@ fn encode_exact_with(
         ));
     }
     let quantizer = crate::Quantizer::new(&bbox, bits);
-    let mut enc = whet_edgebreaker::encode_connectivity_with_table(
+    let mut enc = whet_edgebreaker::encode_connectivity_with_table_in(
         table,
         &mesh.triangles,
         mesh.positions.len(),
+        scratch,
     )?;
     let clers_histogram = enc.histogram();
     // The geometry passes walk a copy of the table relabelled in traversal order: the same
     // corners, so the same coding order, but walked roughly in memory order.
-    let (conn, old_id) = enc.traversal_ordered()?;
+    let (conn, old_id) = enc.traversal_ordered_in(scratch)?;
     if check_fans {
         // The input's table was built without walking its closed fans: walk them here, in
         // memory order. (The relabelled table is the same mesh, closed.)
@@ -980,7 +984,7 @@ fn encode_exact_with(
         .collect();
     // Quantize in input order and scatter to the traversal order: on an input in random
     // order, scattered stores overlap where gathered loads would wait one by one.
-    let mut new_id = vec![u32::MAX; mesh.positions.len()];
+    let mut new_id = scratch.take_filled(mesh.positions.len(), u32::MAX);
     for (new, &old) in old_id.iter().enumerate() {
         if let Some(slot) = new_id.get_mut(old as usize) {
             if *slot != u32::MAX {
@@ -999,13 +1003,14 @@ fn encode_exact_with(
             *slot = new as u32;
         }
     }
-    let mut q: Vec<[i32; 3]> = vec![[0; 3]; conn.table.vertex_count()];
+    let mut q: Vec<[i32; 3]> = scratch.take_filled(conn.table.vertex_count(), [0; 3]);
     for (p, &new) in mesh.positions.iter().zip(&new_id) {
         if let Some(qi) = q.get_mut(new as usize) {
             *qi = quantizer.quantize(*p);
         }
     }
-    drop(new_id);
+    scratch.give(new_id);
+    scratch.give(old_id);
     let (geometry, decided) = match prediction {
         ExactPrediction::Degree => degree_geometry(&conn, bits, &mut q, early)?,
         ExactPrediction::Traversal => {
@@ -1016,18 +1021,25 @@ fn encode_exact_with(
                 constrained: false,
                 budget: usize::MAX,
             };
-            code_positions_traversal(&conn, bits, &mut q, &mut io, Vec::new())
+            let states = scratch.take_empty(conn.table.vertex_count());
+            let states = code_positions_traversal(&conn, bits, &mut q, &mut io, states)
                 .map_err(whet_edgebreaker::Error::from)?;
+            scratch.give(states);
             (sink.finish(), None)
         }
     };
+    scratch.give(q);
+    let components = conn.starts.len();
+    conn.recycle(scratch);
+    let connectivity = std::mem::take(&mut enc.bytes);
+    enc.recycle(scratch);
     Ok((
         ExactPayloads {
-            connectivity: enc.bytes,
+            connectivity,
             geometry,
             quantizer,
             vertex_order,
-            components: conn.starts.len(),
+            components,
             triangles: mesh.triangles.len(),
             clers_histogram,
         },
@@ -1180,6 +1192,7 @@ mod tests {
             false,
             early,
             super::ExactPrediction::Degree,
+            &mut whet_mesh::Scratch::new(),
         )
         .unwrap();
         (p.geometry, decided)

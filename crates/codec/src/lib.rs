@@ -43,7 +43,8 @@ pub use decoder::{
     DECODE_PEAK_LIMIT,
 };
 pub use encoder::{
-    encode, prepare_mesh, EncodeOptions, EncodeReport, Encoded, Encoder, PreparedMesh,
+    encode, prepare_mesh, EncodeBuffers, EncodeOptions, EncodeReport, Encoded, Encoder,
+    PreparedMesh,
 };
 pub use exact::{ExactPayloads, ExactPrediction};
 #[doc(hidden)]
@@ -111,7 +112,14 @@ pub fn encode_exact_payloads(
     prediction: ExactPrediction,
 ) -> Result<ExactPayloads, Error> {
     let table = whet_mesh::CornerTable::new(mesh).map_err(Error::InvalidInput)?;
-    exact::encode_exact(mesh, table, bits, false, prediction)
+    exact::encode_exact(
+        mesh,
+        table,
+        bits,
+        false,
+        prediction,
+        &mut whet_mesh::Scratch::new(),
+    )
 }
 
 #[doc(hidden)]

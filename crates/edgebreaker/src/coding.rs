@@ -12,12 +12,14 @@
 
 use crate::holes::close_holes;
 use crate::reverse_decoder::{ReverseBuffers, ReverseDecoder, VALENCE_CONTEXTS};
-use crate::traversal::{traverse, Clers, SplitEvent, Step, TraversalError, TraversalSummary};
+use crate::traversal::{
+    traverse, traverse_in, Clers, SplitEvent, Step, TraversalError, TraversalSummary,
+};
 use crate::Error;
 use whet_bits::{
     BitModel, BitSink, CostCounter, RangeDecoder, RangeEncoder, SymbolModel, UnsignedIntModel,
 };
-use whet_mesh::{CornerId, CornerTable, MeshError, VertexId};
+use whet_mesh::{CornerId, CornerTable, MeshError, Scratch, VertexId};
 
 /// The label models: one adaptive 5-symbol model per (valence, previous label) context.
 struct LabelModels {
@@ -225,6 +227,21 @@ impl Connectivity {
         triangles
     }
 
+    /// Gives the connectivity's arrays (its table's included) to `scratch` for a later
+    /// encode.
+    pub fn recycle(self, scratch: &mut Scratch) {
+        self.table.recycle(scratch);
+        scratch.give(self.starts);
+        scratch.give(self.is_dummy);
+        scratch.give(self.summary.labels);
+        scratch.give(self.summary.starts);
+        scratch.give(self.summary.vertex_order);
+        scratch.give(self.summary.splits);
+        if let Some(t) = self.visit_tips {
+            scratch.give(t);
+        }
+    }
+
     /// Output index of each table vertex (`u32::MAX` for dummies and unused ids).
     pub fn output_rank(&self) -> Vec<u32> {
         let mut rank = vec![u32::MAX; self.table.vertex_count()];
@@ -268,6 +285,22 @@ pub struct EncodedConnectivity {
 }
 
 impl EncodedConnectivity {
+    /// Gives the encoder's arrays (the connectivity's, the traversal order's, the payload
+    /// bytes') to `scratch` for a later encode.
+    pub fn recycle(self, scratch: &mut Scratch) {
+        self.connectivity.recycle(scratch);
+        scratch.give(self.bytes);
+        scratch.give(self.face_order);
+        if let Some((v, o, starts)) = self.ordered {
+            scratch.give(v);
+            scratch.give(o);
+            scratch.give(starts);
+        }
+        if let Some(t) = self.visit_tips {
+            scratch.give(t);
+        }
+    }
+
     /// Counts of C, L, E, R, S.
     pub fn histogram(&self) -> [usize; 5] {
         let mut h = [0usize; 5];
@@ -288,6 +321,14 @@ impl EncodedConnectivity {
     /// The first call takes the relabelled arrays the encoder built while traversing (the
     /// triangles' lines are in cache then); later calls rebuild them.
     pub fn traversal_ordered(&mut self) -> Result<(Connectivity, Vec<u32>), Error> {
+        self.traversal_ordered_in(&mut Scratch::new())
+    }
+
+    /// [`EncodedConnectivity::traversal_ordered`] with the new arrays taken from `scratch`.
+    pub fn traversal_ordered_in(
+        &mut self,
+        scratch: &mut Scratch,
+    ) -> Result<(Connectivity, Vec<u32>), Error> {
         let (v, o, starts) = match self.ordered.take() {
             Some(r) => r,
             None => self.relabel()?,
@@ -297,17 +338,23 @@ impl EncodedConnectivity {
         let order = &conn.summary.vertex_order;
         // A renumbering of the checked input table: consistent by construction, so only the
         // indices are checked (from_raw's pairing checks were 5 % of an exact encode).
-        let new_table = CornerTable::from_relabelled(v, o, order.len())
+        let new_table = CornerTable::from_relabelled_in(v, o, order.len(), scratch)
             .map_err(|_| Error::Corrupt("relabelled table is inconsistent"))?;
         let starts: Vec<CornerId> = starts.into_iter().map(CornerId).collect();
-        let is_dummy = order.iter().map(|v| conn.is_dummy[v.index()]).collect();
+        let mut is_dummy: Vec<bool> = scratch.take_empty(order.len());
+        is_dummy.extend(order.iter().map(|v| conn.is_dummy[v.index()]));
+        let mut labels: Vec<Clers> = scratch.take_empty(conn.summary.labels.len());
+        labels.extend_from_slice(&conn.summary.labels);
+        let mut vertex_order: Vec<VertexId> = scratch.take_empty(order.len());
+        vertex_order.extend((0..order.len() as u32).map(VertexId));
         let summary = TraversalSummary {
-            labels: conn.summary.labels.clone(),
+            labels,
             splits: conn.summary.splits.clone(),
             starts: starts.clone(),
-            vertex_order: (0..order.len() as u32).map(VertexId).collect(),
+            vertex_order,
         };
-        let old = order.iter().map(|v| v.0).collect();
+        let mut old: Vec<u32> = scratch.take_empty(order.len());
+        old.extend(order.iter().map(|v| v.0));
         Ok((
             Connectivity {
                 table: new_table,
@@ -436,6 +483,18 @@ pub fn encode_connectivity_with_table(
     triangles: &[[u32; 3]],
     vertex_count: usize,
 ) -> Result<EncodedConnectivity, Error> {
+    encode_connectivity_with_table_in(open, triangles, vertex_count, &mut Scratch::new())
+}
+
+/// [`encode_connectivity_with_table`] with its arrays taken from `scratch` (the result's
+/// included: [`EncodedConnectivity::recycle`] gives them back), for a caller that encodes
+/// mesh after mesh.
+pub fn encode_connectivity_with_table_in(
+    open: CornerTable,
+    triangles: &[[u32; 3]],
+    vertex_count: usize,
+    scratch: &mut Scratch,
+) -> Result<EncodedConnectivity, Error> {
     let has_boundary = open.corners().any(|c| open.is_boundary_corner(c));
     let (table, dummies) = if has_boundary {
         let (closed, dummies) = close_holes(triangles, &open, vertex_count)?;
@@ -449,56 +508,63 @@ pub fn encode_connectivity_with_table(
     };
     let total_vertices = vertex_count + dummies;
     let nt = table.triangle_count();
-    let mut face_order = Vec::with_capacity(nt);
+    let mut face_order = scratch.take_empty(nt);
     // The table relabelled in traversal order (see `EncodedConnectivity::traversal_ordered`),
     // built as each triangle is visited: its corners are in cache then, and so are most of
     // its neighbours' ranks.
     let (cv, opp) = (table.corner_vertices(), table.opposites());
-    let mut vertex_rank = vec![u32::MAX; table.vertex_count()];
-    let mut face_rank = vec![u32::MAX; nt];
+    let mut vertex_rank = scratch.take_filled(table.vertex_count(), u32::MAX);
+    let mut face_rank = scratch.take_filled(nt, u32::MAX);
     let mut next_vertex = 0u32;
-    let mut ov = vec![[0u32; 3]; nt];
-    let mut oo = vec![u32::MAX; 3 * nt];
+    // Every triangle is written as it is visited (a traversal that misses one fails).
+    let mut ov = scratch.take_overwritten(nt, [0u32; 3]);
+    let mut oo = scratch.take_filled(3 * nt, u32::MAX);
     let mut new_starts = Vec::new();
-    let mut tips: Vec<u8> = Vec::with_capacity(nt);
-    let summary = traverse(&table, None, |step| {
-        let f = match step {
-            Step::Start { corner } => {
-                new_starts.push(3 * face_order.len() as u32 + corner.0 % 3);
-                tips.push((corner.0 % 3) as u8);
-                for c in [corner, table.next(corner), table.prev(corner)] {
-                    vertex_rank[table.vertex(c).index()] = next_vertex;
-                    next_vertex += 1;
+    let mut tips: Vec<u8> = scratch.take_empty(nt);
+    let summary = traverse_in(
+        &table,
+        None,
+        |step| {
+            let f = match step {
+                Step::Start { corner } => {
+                    new_starts.push(3 * face_order.len() as u32 + corner.0 % 3);
+                    tips.push((corner.0 % 3) as u8);
+                    for c in [corner, table.next(corner), table.prev(corner)] {
+                        vertex_rank[table.vertex(c).index()] = next_vertex;
+                        next_vertex += 1;
+                    }
+                    corner.0 / 3
                 }
-                corner.0 / 3
-            }
-            Step::Triangle { tip, label, .. } => {
-                if label == Clers::C {
-                    vertex_rank[table.vertex(tip).index()] = next_vertex;
-                    next_vertex += 1;
+                Step::Triangle { tip, label, .. } => {
+                    if label == Clers::C {
+                        vertex_rank[table.vertex(tip).index()] = next_vertex;
+                        next_vertex += 1;
+                    }
+                    tips.push((tip.0 % 3) as u8);
+                    tip.0 / 3
                 }
-                tips.push((tip.0 % 3) as u8);
-                tip.0 / 3
-            }
-        } as usize;
-        let i = face_order.len();
-        face_order.push(f as u32);
-        face_rank[f] = i as u32;
-        for j in 0..3 {
-            let c = 3 * f + j;
-            ov[i][j] = vertex_rank[cv[c] as usize];
-            let o = opp[c];
-            if o != u32::MAX {
-                let g = face_rank[o as usize / 3];
-                if g != u32::MAX {
-                    let no = 3 * g + o % 3;
-                    oo[3 * i + j] = no;
-                    oo[no as usize] = (3 * i + j) as u32;
+            } as usize;
+            let i = face_order.len();
+            face_order.push(f as u32);
+            face_rank[f] = i as u32;
+            for j in 0..3 {
+                let c = 3 * f + j;
+                ov[i][j] = vertex_rank[cv[c] as usize];
+                let o = opp[c];
+                if o != u32::MAX {
+                    let g = face_rank[o as usize / 3];
+                    if g != u32::MAX {
+                        let no = 3 * g + o % 3;
+                        oo[3 * i + j] = no;
+                        oo[no as usize] = (3 * i + j) as u32;
+                    }
                 }
             }
-        }
-    })?;
-    drop((vertex_rank, face_rank));
+        },
+        scratch,
+    )?;
+    scratch.give(vertex_rank);
+    scratch.give(face_rank);
     if face_order.len() != nt {
         return Err(Error::Corrupt("the traversal did not visit every triangle"));
     }

@@ -25,11 +25,13 @@ mod traversal;
 
 pub use coding::{
     decode_connectivity, decode_connectivity_reusing, encode_connectivity,
-    encode_connectivity_with_table, label_bits, Connectivity, ConnectivityBuffers,
-    ConnectivityLimits, EncodedConnectivity,
+    encode_connectivity_with_table, encode_connectivity_with_table_in, label_bits, Connectivity,
+    ConnectivityBuffers, ConnectivityLimits, EncodedConnectivity,
 };
 pub use holes::close_holes;
-pub use traversal::{traverse, Clers, SplitEvent, Step, TraversalError, TraversalSummary};
+pub use traversal::{
+    traverse, traverse_in, Clers, SplitEvent, Step, TraversalError, TraversalSummary,
+};
 
 /// Why connectivity could not be coded or decoded.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]

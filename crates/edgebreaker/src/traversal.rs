@@ -27,7 +27,7 @@
 //! The traversal needs a closed manifold (every corner has an opposite): close holes first
 //! (see [`crate::close_holes`]). Corner tables with boundaries are refused.
 
-use whet_mesh::{CornerId, CornerTable, VertexId};
+use whet_mesh::{CornerId, CornerTable, Scratch, VertexId};
 
 /// The five Edgebreaker labels.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -142,16 +142,28 @@ const S_MARK: u32 = 2;
 pub fn traverse(
     table: &CornerTable,
     starts: Option<&[CornerId]>,
+    visit: impl FnMut(Step),
+) -> Result<TraversalSummary, TraversalError> {
+    traverse_in(table, starts, visit, &mut Scratch::new())
+}
+
+/// [`traverse`] with its arrays (the summary's included) taken from `scratch`; its own
+/// marks are given back.
+pub fn traverse_in(
+    table: &CornerTable,
+    starts: Option<&[CornerId]>,
     mut visit: impl FnMut(Step),
+    scratch: &mut Scratch,
 ) -> Result<TraversalSummary, TraversalError> {
     let nt = table.triangle_count();
     if let Some(c) = table.corners().find(|&c| table.opposite(c).is_none()) {
         return Err(TraversalError::Boundary(c.0));
     }
-    let mut tri_mark = vec![UNVISITED; nt];
-    let mut vertex_seen = vec![false; table.vertex_count()];
+    let mut tri_mark = scratch.take_filled(nt, UNVISITED);
+    let mut vertex_seen = scratch.take_filled(table.vertex_count(), false);
     let mut summary = TraversalSummary {
-        labels: Vec::with_capacity(nt),
+        labels: scratch.take_empty(nt),
+        vertex_order: scratch.take_empty(table.vertex_count()),
         ..Default::default()
     };
     let mut stack: Vec<CornerId> = Vec::new();
@@ -271,6 +283,8 @@ pub fn traverse(
         }
     }
     std::hint::black_box(touched);
+    scratch.give(tri_mark);
+    scratch.give(vertex_seen);
     if visited_count != nt {
         return Err(TraversalError::Unreached(nt - visited_count));
     }

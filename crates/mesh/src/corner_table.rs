@@ -25,6 +25,7 @@
 
 use crate::ids::{CornerId, VertexId};
 use crate::mesh::Mesh;
+use crate::scratch::Scratch;
 use crate::topology::MeshError;
 
 const NONE: u32 = u32::MAX;
@@ -56,7 +57,7 @@ impl CornerTable {
         triangles: &[[u32; 3]],
         vertex_count: usize,
     ) -> Result<CornerTable, MeshError> {
-        CornerTable::build(triangles, vertex_count, true)
+        CornerTable::build(triangles, vertex_count, true, &mut Scratch::new())
     }
 
     /// [`CornerTable::from_triangles`] without the walk around closed fans: it checks
@@ -70,7 +71,25 @@ impl CornerTable {
         triangles: &[[u32; 3]],
         vertex_count: usize,
     ) -> Result<CornerTable, MeshError> {
-        CornerTable::build(triangles, vertex_count, false)
+        CornerTable::build(triangles, vertex_count, false, &mut Scratch::new())
+    }
+
+    /// [`CornerTable::from_triangles_deferring_fans`] in the memory of `scratch` (its
+    /// working arrays taken from it and given back, the table's own taken from it): the
+    /// same table. [`CornerTable::recycle`] gives the table's arrays back.
+    pub fn from_triangles_deferring_fans_in(
+        triangles: &[[u32; 3]],
+        vertex_count: usize,
+        scratch: &mut Scratch,
+    ) -> Result<CornerTable, MeshError> {
+        CornerTable::build(triangles, vertex_count, false, scratch)
+    }
+
+    /// Gives the table's arrays to `scratch` for a later build.
+    pub fn recycle(self, scratch: &mut Scratch) {
+        scratch.give(self.triangles);
+        scratch.give(self.opposite);
+        scratch.give(self.vertex_corner);
     }
 
     /// Checks that every used vertex has a single fan (the check
@@ -91,6 +110,7 @@ impl CornerTable {
         triangles: &[[u32; 3]],
         vertex_count: usize,
         walk_fans: bool,
+        scratch: &mut Scratch,
     ) -> Result<CornerTable, MeshError> {
         let nt = triangles.len();
         if nt > (u32::MAX as usize - 3) / 3 {
@@ -101,14 +121,14 @@ impl CornerTable {
         }
         check_vertex_count(vertex_count)?;
         let nc = 3 * nt;
-        let mut triangles_out: Vec<[u32; 3]> = Vec::with_capacity(nt);
+        let mut triangles_out: Vec<[u32; 3]> = scratch.take_empty(nt);
         // One pass over the triangles checks them, counts each vertex's corners and the edges
         // bucketed at it (by lower vertex, see below), and notes each vertex's first corner
         // (its fan's start unless it is on a boundary).
         let edges = |tri: &[u32]| [(tri[1], tri[2]), (tri[2], tri[0]), (tri[0], tri[1])];
-        let mut offsets = vec![0u32; vertex_count + 1];
-        let mut valence = vec![0u32; vertex_count];
-        let mut vertex_corner = vec![NONE; vertex_count];
+        let mut offsets = scratch.take_filled(vertex_count + 1, 0u32);
+        let mut valence = scratch.take_filled(vertex_count, 0u32);
+        let mut vertex_corner = scratch.take_filled(vertex_count, NONE);
         for (t, tri) in triangles.iter().enumerate() {
             for &v in tri {
                 if v as usize >= vertex_count {
@@ -153,13 +173,14 @@ impl CornerTable {
         for v in 0..vertex_count {
             offsets[v + 1] += offsets[v];
         }
-        let mut fill = offsets.clone();
+        let mut fill: Vec<u32> = scratch.take_empty(vertex_count + 1);
+        fill.extend_from_slice(&offsets);
         // Entries pack (higher vertex, corner) into one u64, so the small sorts compare one
-        // word (the same order as the pair).
-        let mut bucket = vec![0u64; nc];
+        // word (the same order as the pair). Every entry is written before it is read.
+        let mut bucket = scratch.take_overwritten(nc, 0u64);
         // One bit per corner: its edge runs from the lower vertex up. Read back when pairing
         // (twins must differ), it saves a random access to the corner vertices per edge.
-        let mut upward = vec![0u64; nc.div_ceil(64)];
+        let mut upward = scratch.take_filled(nc.div_ceil(64), 0u64);
         let corner_vertex = triangles_out.as_flattened();
         for (t, tri) in triangles_out.iter().enumerate() {
             for (j, (a, b)) in edges(tri).into_iter().enumerate() {
@@ -170,12 +191,12 @@ impl CornerTable {
                 upward[c / 64] |= ((a < b) as u64) << (c % 64);
             }
         }
-        drop(fill);
+        scratch.give(fill);
         let is_upward = |c: usize| upward[c / 64] >> (c % 64) & 1 == 1;
-        let mut opposite = vec![NONE; nc];
+        let mut opposite = scratch.take_filled(nc, NONE);
         // Corners that start an open fan, per vertex: the corner after each boundary corner
         // (the edge behind it is the boundary). The fan walk then starts there.
-        let mut open_fans = vec![0u8; vertex_count];
+        let mut open_fans = scratch.take_filled(vertex_count, 0u8);
         for v in 0..vertex_count {
             let s = &mut bucket[offsets[v] as usize..offsets[v + 1] as usize];
             if s.len() > 1 {
@@ -223,14 +244,18 @@ impl CornerTable {
                 i = j;
             }
         }
-        drop(bucket);
-        drop(offsets);
+        scratch.give(bucket);
+        scratch.give(offsets);
+        scratch.give(upward);
         let table = CornerTable {
             triangles: triangles_out,
             opposite,
             vertex_corner,
         };
-        table.check_vertex_fans(&valence, &open_fans, walk_fans)?;
+        let checked = table.check_vertex_fans(&valence, &open_fans, walk_fans);
+        scratch.give(valence);
+        scratch.give(open_fans);
+        checked?;
         Ok(table)
     }
 
@@ -247,8 +272,18 @@ impl CornerTable {
         opposite: Vec<u32>,
         vertex_count: usize,
     ) -> Result<CornerTable, MeshError> {
+        Self::from_relabelled_in(triangles, opposite, vertex_count, &mut Scratch::new())
+    }
+
+    /// [`CornerTable::from_relabelled`] with its per-vertex array taken from `scratch`.
+    pub fn from_relabelled_in(
+        triangles: Vec<[u32; 3]>,
+        opposite: Vec<u32>,
+        vertex_count: usize,
+        scratch: &mut Scratch,
+    ) -> Result<CornerTable, MeshError> {
         let nc = check_corner_arrays(&triangles, &opposite, vertex_count)?;
-        let mut vertex_corner = vec![NONE; vertex_count];
+        let mut vertex_corner = scratch.take_filled(vertex_count, NONE);
         for (t, (tv, to)) in triangles.iter().zip(opposite.chunks_exact(3)).enumerate() {
             for j in 0..3 {
                 let v = tv[j];

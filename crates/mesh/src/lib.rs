@@ -26,12 +26,14 @@ mod corner_table;
 mod ids;
 mod make_manifold;
 mod mesh;
+mod scratch;
 mod topology;
 
 pub use corner_table::{CornerTable, VertexCorners};
 pub use ids::{CornerId, FaceId, VertexId};
 pub use make_manifold::ManifoldRepair;
 pub use mesh::{angle_between, edge_key, morton_spread, Aabb, EdgeLengthStats, Mesh};
+pub use scratch::Scratch;
 pub use topology::{MeshError, TopologyReport};
 
 pub use glam::DVec3;

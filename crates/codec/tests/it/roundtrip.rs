@@ -3,8 +3,8 @@
 
 use proptest::prelude::*;
 use whet_codec::{
-    decode, decode_reusing, encode, DecodeBuffers, DecodeOptions, Decoder, EncodeOptions,
-    ExactPrediction, StreamingDecoder,
+    decode, decode_reusing, encode, DecodeBuffers, DecodeOptions, Decoder, EncodeBuffers,
+    EncodeOptions, Encoder, ExactPrediction, StreamingDecoder,
 };
 use whet_mesh::{DVec3, Mesh};
 use whet_testkit::meshes::*;
@@ -108,6 +108,74 @@ fn reused_buffers_decode_what_decode_decodes() {
                         .unwrap_err()
                         .to_string()
                 );
+            }
+        }
+    }
+}
+
+/// One set of encoder buffers through meshes of every size and kind (a shuffled one large
+/// enough to be renumbered spatially, holes, a mesh that takes the repairing path, the
+/// empty mesh), both predictions, twice: every stream and report is `encode`'s.
+#[test]
+fn reused_encoder_buffers_encode_what_encode_encodes() {
+    let holes = union(
+        union(torus(10, 7), &punch(&icosphere(3), |i| i % 41 == 5), 6.0),
+        &grid(4, 3),
+        12.0,
+    );
+    // Two tetrahedra sharing one vertex: the fast path refuses, the repairing one cuts.
+    let pinched = Mesh::new(
+        vec![
+            DVec3::ZERO,
+            DVec3::X,
+            DVec3::Y,
+            DVec3::Z,
+            DVec3::new(-1.0, 0.0, 0.0),
+            DVec3::new(0.0, -1.0, 0.0),
+            DVec3::new(0.0, 0.0, -1.0),
+        ],
+        vec![
+            [0, 2, 1],
+            [0, 1, 3],
+            [1, 2, 3],
+            [2, 0, 3],
+            [0, 4, 5],
+            [0, 6, 4],
+            [4, 6, 5],
+            [5, 6, 0],
+        ],
+    );
+    let large = shuffle(&icosphere(7), 5);
+    let meshes = [
+        shuffle(&icosphere(4), 1),
+        large,
+        shuffle(&holes, 2),
+        pinched,
+        Mesh::default(),
+        torus(6, 5),
+    ];
+    for prediction in [ExactPrediction::Traversal, ExactPrediction::Degree] {
+        let mut buffers = EncodeBuffers::new();
+        for round in 0..2 {
+            for (i, mesh) in meshes.iter().enumerate() {
+                if i == 1 && prediction == ExactPrediction::Degree {
+                    continue; // the large mesh once per round is enough
+                }
+                let opts = EncodeOptions::DEFAULT
+                    .with_quant_bits(9 + i as u32)
+                    .with_prediction(prediction);
+                let want = encode(mesh, &opts).unwrap();
+                let got = Encoder::new(opts)
+                    .encode_reusing(mesh, &mut buffers)
+                    .unwrap();
+                assert_eq!(
+                    got.bytes, want.bytes,
+                    "round {round}, mesh {i}, {prediction:?}"
+                );
+                assert_eq!(got.report, want.report, "round {round}, mesh {i}");
+                if i == 3 {
+                    assert_eq!(want.report.repair.added_vertices, 1, "the pinch is cut");
+                }
             }
         }
     }
