@@ -162,5 +162,26 @@ mod thread_safety {
         both::<crate::io::Error>();
         both::<crate::codec::Error>();
         both::<crate::codec::EncodeReport>();
+        // Buffers belong to one worker at a time: they move between threads.
+        fn send<T: Send>() {}
+        send::<crate::DecodeBuffers>();
+        send::<crate::EncodeBuffers>();
+    }
+
+    /// The facade's reusing decoder gives `decode`'s mesh, stream after stream, with the
+    /// meshes given back.
+    #[test]
+    fn decode_reusing_decodes_what_decode_decodes() {
+        let mut buffers = crate::DecodeBuffers::new();
+        for n in [3, 2, 4] {
+            let mesh = whet_testkit::meshes::icosphere(n);
+            let bytes = crate::encode(&mesh, &crate::EncodeOptions::DEFAULT)
+                .unwrap()
+                .bytes;
+            let opts = crate::DecodeOptions::DEFAULT;
+            let got = crate::decode_reusing(&bytes, &opts, &mut buffers).unwrap();
+            assert_eq!(got, crate::decode(&bytes, &opts).unwrap());
+            buffers.recycle(got);
+        }
     }
 }
