@@ -209,8 +209,10 @@ impl Encoder {
     ) -> Result<Encoded, Error> {
         let bits = self.opts.quant_bits;
         let prediction = self.opts.prediction;
-        let payloads = encode_exact(&p.mesh, p.table, bits, check_fans, prediction, scratch)?;
-        let bbox = p.mesh.bounding_box();
+        let bbox = p.bbox;
+        let payloads = encode_exact(
+            &p.mesh, &bbox, p.table, bits, check_fans, prediction, scratch,
+        )?;
         let (min, max) = if bbox.is_empty() {
             ([0.0; 3], [0.0; 3])
         } else {
@@ -315,6 +317,8 @@ pub fn prepare_mesh(mesh: &Mesh, repair: bool) -> Result<PreparedMesh, Error> {
 /// A mesh ready for a mode: finite, oriented manifold, no unused vertices.
 pub(crate) struct Prepared {
     pub mesh: Mesh,
+    /// `mesh`'s bounding box.
+    pub bbox: whet_mesh::Aabb,
     /// Corner table of `mesh` (built once, reused by the connectivity coder).
     pub table: whet_mesh::CornerTable,
     /// Input vertex of each prepared vertex.
@@ -345,10 +349,13 @@ fn prepare_with(
     // The fast path works on a copy in spatial order when the input's memory order is poor:
     // building the table and traversing it then read memory in order (the reordering costs
     // less than the misses it saves on a mesh in random order; docs/codec.md, "Speed").
+    // The box of the input's positions: the prepared mesh's too unless vertices are dropped
+    // below (a permutation or repair copies keep it).
+    let mut bbox = mesh.bounding_box();
     let reordered = if walk_fans {
         None
     } else {
-        spatial_order(mesh, REORDER_MIN_TRIANGLES, scratch)
+        spatial_order(mesh, &bbox, REORDER_MIN_TRIANGLES, scratch)
     };
     let (mut work, reorder) = match reordered {
         Some((m, order)) => (m, Some(order)),
@@ -437,6 +444,7 @@ fn prepare_with(
         work.positions = positions;
         original = orig;
         table = None;
+        bbox = work.bounding_box();
     }
     scratch.give(used);
     let table = match table {
@@ -445,6 +453,7 @@ fn prepare_with(
     };
     Ok(Prepared {
         table,
+        bbox,
         mesh: work,
         original,
         repair: rep,
@@ -514,6 +523,7 @@ fn bucket_starts(
 /// otherwise, or when an index is out of range (the caller reports it).
 fn spatial_order(
     mesh: &Mesh,
+    bbox: &whet_mesh::Aabb,
     min_triangles: usize,
     scratch: &mut Scratch,
 ) -> Option<(Mesh, Vec<u32>)> {
@@ -524,7 +534,6 @@ fn spatial_order(
     // At most 2^24 cells (64 MB of counts), from about 24M vertices on.
     let bits = ((((nv / 4).max(1) as f64).log2() / 3.0).round() as u32).clamp(1, 8);
     let cells = 1usize << (3 * bits);
-    let bbox = mesh.bounding_box();
     let extent = (bbox.max - bbox.min).max_element().max(f64::MIN_POSITIVE);
     let scale = ((1u32 << bits) as f64 - 1e-6) / extent;
     let top = (1u64 << bits) - 1;
@@ -600,7 +609,13 @@ mod tests {
         let mut mesh = shuffle(&icosphere(5), 4);
         let nv = mesh.positions.len() as u32;
         mesh.triangles[300][2] = nv + 7;
-        assert!(spatial_order(&mesh, 0, &mut whet_mesh::Scratch::new()).is_none());
+        assert!(spatial_order(
+            &mesh,
+            &mesh.bounding_box(),
+            0,
+            &mut whet_mesh::Scratch::new()
+        )
+        .is_none());
         // Without repair the encoder names the index; with it (the default) it cuts the
         // triangle and reports that, as it always did.
         let strict = crate::EncodeOptions::DEFAULT.with_repair(false);
@@ -613,11 +628,22 @@ mod tests {
     fn the_spatial_order_is_a_renumbering() {
         let mesh = shuffle(&icosphere(5), 2);
         assert!(
-            spatial_order(&mesh, 1 << 30, &mut whet_mesh::Scratch::new()).is_none(),
+            spatial_order(
+                &mesh,
+                &mesh.bounding_box(),
+                1 << 30,
+                &mut whet_mesh::Scratch::new()
+            )
+            .is_none(),
             "under the size bound"
         );
-        let (m, original) = spatial_order(&mesh, 0, &mut whet_mesh::Scratch::new())
-            .expect("a shuffled mesh is reordered");
+        let (m, original) = spatial_order(
+            &mesh,
+            &mesh.bounding_box(),
+            0,
+            &mut whet_mesh::Scratch::new(),
+        )
+        .expect("a shuffled mesh is reordered");
         let mut seen = vec![false; mesh.positions.len()];
         for (new, &old) in original.iter().enumerate() {
             assert!(!std::mem::replace(&mut seen[old as usize], true));

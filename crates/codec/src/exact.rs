@@ -929,21 +929,29 @@ pub struct ExactPayloads {
 }
 
 /// Encodes an oriented manifold (holes, handles, components allowed) in the exact mode.
+/// `bbox` is `mesh`'s bounding box (the caller's, computed once: a pass over the positions
+/// costs a few milliseconds on a large mesh).
 pub(crate) fn encode_exact(
     mesh: &whet_mesh::Mesh,
+    bbox: &whet_mesh::Aabb,
     table: whet_mesh::CornerTable,
     bits: u32,
     check_fans: bool,
     prediction: ExactPrediction,
     scratch: &mut Scratch,
 ) -> Result<ExactPayloads, crate::Error> {
-    encode_exact_with(mesh, table, bits, check_fans, true, prediction, scratch).map(|(p, _)| p)
+    encode_exact_with(
+        mesh, bbox, table, bits, check_fans, true, prediction, scratch,
+    )
+    .map(|(p, _)| p)
 }
 
 /// [`encode_exact`], with or without the early choice of the geometry strategy; also says
 /// whether the choice was made early (`Some(true)`: subsets).
+#[allow(clippy::too_many_arguments)] // the stages' inputs, passed through once
 fn encode_exact_with(
     mesh: &whet_mesh::Mesh,
+    bbox: &whet_mesh::Aabb,
     table: whet_mesh::CornerTable,
     bits: u32,
     check_fans: bool,
@@ -951,14 +959,13 @@ fn encode_exact_with(
     prediction: ExactPrediction,
     scratch: &mut Scratch,
 ) -> Result<(ExactPayloads, Option<bool>), crate::Error> {
-    let bbox = mesh.bounding_box();
     if !bbox.is_empty() && !bbox.size().max_element().is_finite() {
         // The grid's step would be infinite: every position would land on one corner.
         return Err(crate::Error::InvalidInput(
             whet_mesh::MeshError::ExtentOverflow,
         ));
     }
-    let quantizer = crate::Quantizer::new(&bbox, bits);
+    let quantizer = crate::Quantizer::new(bbox, bits);
     let mut enc = whet_edgebreaker::encode_connectivity_with_table_in(
         table,
         &mesh.triangles,
@@ -1187,6 +1194,7 @@ mod tests {
         let table = whet_mesh::CornerTable::new(mesh).unwrap();
         let (p, decided) = encode_exact_with(
             mesh,
+            &mesh.bounding_box(),
             table,
             bits,
             false,

@@ -114,6 +114,7 @@ pub fn encode_exact_payloads(
     let table = whet_mesh::CornerTable::new(mesh).map_err(Error::InvalidInput)?;
     exact::encode_exact(
         mesh,
+        &mesh.bounding_box(),
         table,
         bits,
         false,
