@@ -30,7 +30,9 @@ fn main() {
         (None, Ok("natural")) => whet_testkit::meshes::icosphere(8),
         _ => whet_testkit::meshes::shuffle(&whet_testkit::meshes::icosphere(8), 1),
     };
-    if encodes > 0 {
+    // The stage timings first (they build tables and traverse the input outside the encoder;
+    // PROFILE_NO_STAGES=1 leaves them out of a profile of the encoder).
+    if encodes > 0 && std::env::var_os("PROFILE_NO_STAGES").is_none() {
         let t = Instant::now();
         let table = whet_mesh::CornerTable::new(&mesh).unwrap();
         eprintln!("corner table: {:?}", t.elapsed());
