@@ -72,11 +72,7 @@ fn fixtures_round_trip() {
 /// corrupt stream in between): every decode is `decode`'s.
 #[test]
 fn reused_buffers_decode_what_decode_decodes() {
-    let holes = union(
-        union(torus(10, 7), &punch(&icosphere(3), |i| i % 41 == 5), 6.0),
-        &grid(4, 3),
-        12.0,
-    );
+    let holes = holes_handles_components_mesh();
     let meshes = [
         shuffle(&icosphere(4), 1),
         Mesh::new(vec![DVec3::ZERO, DVec3::X, DVec3::Y], vec![[0, 1, 2]]),
@@ -118,11 +114,7 @@ fn reused_buffers_decode_what_decode_decodes() {
 /// empty mesh), both predictions, twice: every stream and report is `encode`'s.
 #[test]
 fn reused_encoder_buffers_encode_what_encode_encodes() {
-    let holes = union(
-        union(torus(10, 7), &punch(&icosphere(3), |i| i % 41 == 5), 6.0),
-        &grid(4, 3),
-        12.0,
-    );
+    let holes = holes_handles_components_mesh();
     // Two tetrahedra sharing one vertex: the fast path refuses, the repairing one cuts.
     let pinched = Mesh::new(
         vec![
@@ -194,13 +186,18 @@ fn one_triangle_and_empty() {
     }
 }
 
-#[test]
-fn holes_handles_components() {
-    let m = union(
+/// A torus (a handle), a punched sphere (holes) and a grid (a boundary), three components.
+fn holes_handles_components_mesh() -> Mesh {
+    union(
         union(torus(10, 7), &punch(&icosphere(3), |i| i % 41 == 5), 6.0),
         &grid(4, 3),
         12.0,
-    );
+    )
+}
+
+#[test]
+fn holes_handles_components() {
+    let m = holes_handles_components_mesh();
     for seed in 0..3 {
         check_round_trip(&shuffle(&m, seed), 12);
     }
