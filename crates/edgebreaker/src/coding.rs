@@ -446,9 +446,32 @@ fn code_labels<S: BitSink>(
     sink: &mut S,
     labels: &[Clers],
     splits: &[SplitEvent],
+    scratch: &mut Scratch,
 ) -> Result<(), Error> {
     let n = labels.len() as u32;
-    let mut dec = ReverseDecoder::new(n, splits, labels.len() + 1);
+    // The decoder's own contexts come from replaying its reverse decoder: its arrays (the
+    // size of a decoded table) are taken from the scratch pool and given back.
+    let faces = labels.len() + 1;
+    let buffers = ReverseBuffers {
+        v: scratch.take_empty(faces),
+        o: scratch.take_empty(3 * faces),
+        leftmost: scratch.take_empty(faces / 2 + 3),
+        valence: scratch.take_empty(faces / 2 + 3),
+    };
+    let mut dec = ReverseDecoder::with_buffers(n, splits, faces, buffers);
+    let coded = code_labels_with(sink, labels, &mut dec);
+    scratch.give(std::mem::take(&mut dec.v));
+    scratch.give(std::mem::take(&mut dec.o));
+    scratch.give(std::mem::take(&mut dec.leftmost));
+    scratch.give(std::mem::take(&mut dec.valence));
+    coded
+}
+
+fn code_labels_with<S: BitSink>(
+    sink: &mut S,
+    labels: &[Clers],
+    dec: &mut ReverseDecoder,
+) -> Result<(), Error> {
     let mut models = LabelModels::new();
     let mut prev = Clers::E;
     for &sym in labels.iter().rev() {
@@ -597,7 +620,7 @@ pub fn encode_connectivity_with_table_in(
             prev_pos = pos as u32;
         }
     }
-    code_labels(&mut enc, &summary.labels, &summary.splits)?;
+    code_labels(&mut enc, &summary.labels, &summary.splits, scratch)?;
     bytes.extend_from_slice(&enc.finish());
     Ok(EncodedConnectivity {
         bytes,
@@ -618,7 +641,7 @@ pub fn encode_connectivity_with_table_in(
 /// Bits the labels alone cost with whet's contexts (measurement for reports and tests).
 pub fn label_bits(labels: &[Clers], splits: &[SplitEvent]) -> Result<f64, Error> {
     let mut counter = CostCounter::new();
-    code_labels(&mut counter, labels, splits)?;
+    code_labels(&mut counter, labels, splits, &mut Scratch::new())?;
     Ok(counter.bits())
 }
 

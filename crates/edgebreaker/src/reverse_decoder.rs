@@ -91,15 +91,10 @@ pub(crate) struct ReverseDecoder {
 }
 
 impl ReverseDecoder {
-    /// A decoder for `symbols` labels with the given handle contacts. `capacity_faces` is
-    /// the number of faces to reserve (symbols plus components), already checked by the
-    /// caller against its limits.
-    pub fn new(symbols: u32, splits: &[SplitEvent], capacity_faces: usize) -> Self {
-        Self::with_buffers(symbols, splits, capacity_faces, ReverseBuffers::default())
-    }
-
-    /// [`ReverseDecoder::new`] filling the arrays of `buffers` (their contents ignored): a
-    /// decoder that kept them from an earlier stream does not fault their memory in again.
+    /// A decoder for `symbols` labels with the given handle contacts, filling the arrays of
+    /// `buffers` (their contents ignored: a decoder that kept them from an earlier stream
+    /// does not fault their memory in again). `capacity_faces` is the number of faces to
+    /// reserve (symbols plus components), already checked by the caller against its limits.
     pub fn with_buffers(
         symbols: u32,
         splits: &[SplitEvent],
