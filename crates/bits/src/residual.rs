@@ -67,7 +67,8 @@ impl CdfModel {
         self.update_in_line(s)
     }
 
-    /// [`CdfModel::update`] inlined, for the decoder's one hot call site.
+    /// [`CdfModel::update`] inlined, for the coder's hot call sites (`encode_cdf`,
+    /// `decode_cdf`).
     #[inline(always)]
     fn update_in_line(&mut self, s: usize) {
         let rate = RATE_MIN + (self.count / RATE_STEP) as u32;
@@ -124,7 +125,7 @@ impl RangeEncoder {
         };
         self.add_low(lo);
         self.range = range;
-        model.update(s);
+        model.update_in_line(s);
         self.normalize_pub();
     }
 
