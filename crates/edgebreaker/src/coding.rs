@@ -212,21 +212,6 @@ impl Connectivity {
         out
     }
 
-    /// [`Connectivity::output_triangles_ranked`] for a connectivity the caller owns: the
-    /// table's own triangle array renumbered and compacted in place, so a decoder's output
-    /// needs no second array (on a 1.3M-triangle mesh 15.7 MB of fresh pages, whose faults
-    /// cost more than the pass).
-    pub fn into_output_triangles(self, rank: &[u32]) -> Vec<[u32; 3]> {
-        let r = |v: u32| rank.get(v as usize).copied().unwrap_or(u32::MAX);
-        let mut triangles = self.table.into_triangles();
-        triangles.retain_mut(|t| {
-            let vs = t.map(r);
-            *t = vs;
-            !vs.contains(&u32::MAX)
-        });
-        triangles
-    }
-
     /// Gives the connectivity's arrays (its table's included) to `scratch` for a later
     /// encode.
     pub fn recycle(self, scratch: &mut Scratch) {
@@ -696,13 +681,6 @@ impl ConnectivityBuffers {
         if triangles.capacity() > self.reverse.v.capacity() {
             self.reverse.v = triangles;
         }
-    }
-
-    /// Takes the triangle list out (empty; with the capacity of the largest recycled).
-    pub fn take_triangles(&mut self) -> Vec<[u32; 3]> {
-        let mut t = std::mem::take(&mut self.reverse.v);
-        t.clear();
-        t
     }
 }
 

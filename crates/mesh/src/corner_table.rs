@@ -344,25 +344,21 @@ impl CornerTable {
         vertex_count: usize,
         check_fans: bool,
     ) -> Result<CornerTable, MeshError> {
-        Self::from_raw_closed_reusing(triangles, opposite, vertex_count, check_fans, Vec::new())
+        Self::from_raw_checked::<true>(
+            triangles,
+            opposite,
+            vertex_count,
+            check_fans,
+            Vec::new(),
+            None,
+        )
     }
 
     /// [`CornerTable::from_raw_closed`] that builds its per-vertex array in `buffer` (its
-    /// contents ignored), as a decoder that keeps the arrays of its last table does: memory
-    /// already mapped is not faulted in again. [`CornerTable::into_parts`] gives it back.
-    pub fn from_raw_closed_reusing(
-        triangles: Vec<[u32; 3]>,
-        opposite: Vec<u32>,
-        vertex_count: usize,
-        check_fans: bool,
-        buffer: Vec<u32>,
-    ) -> Result<CornerTable, MeshError> {
-        Self::from_raw_checked::<true>(triangles, opposite, vertex_count, check_fans, buffer, None)
-    }
-
-    /// [`CornerTable::from_raw_closed_reusing`] that also renumbers the vertices: vertex `v`
-    /// of `triangles` becomes `renumber[v]`, in the pass that checks the table (a decoder
-    /// that numbers its vertices in another order saves a pass over its triangles). The map
+    /// contents ignored: memory a decoder kept from its last table is not faulted in again)
+    /// and renumbers the vertices: vertex `v` of `triangles` becomes `renumber[v]`, in the
+    /// pass that checks the table (a decoder that numbers its vertices in another order saves
+    /// a pass over its triangles). The map
     /// must be injective on the vertices used; a vertex without a number (`u32::MAX`, or
     /// past the map) is [`MeshError::IndexOutOfRange`] against the map's length, and the new
     /// numbers must lie below `vertex_count`.
@@ -384,7 +380,7 @@ impl CornerTable {
     }
 
     /// The table's arrays: its triangles, the opposite of each corner, and each vertex's
-    /// start corner (for reuse by a decoder; see [`CornerTable::from_raw_closed_reusing`]).
+    /// start corner (for reuse by a decoder; see [`CornerTable::from_raw_closed_renumbering`]).
     pub fn into_parts(self) -> (Vec<[u32; 3]>, Vec<u32>, Vec<u32>) {
         (self.triangles, self.opposite, self.vertex_corner)
     }
