@@ -503,7 +503,7 @@ pub fn encode_connectivity_with_table_in(
     vertex_count: usize,
     scratch: &mut Scratch,
 ) -> Result<EncodedConnectivity, Error> {
-    let has_boundary = open.corners().any(|c| open.is_boundary_corner(c));
+    let has_boundary = open.first_boundary_corner().is_some();
     let (table, dummies) = if has_boundary {
         let (closed, dummies) = close_holes(triangles, &open, vertex_count)?;
         drop(open);

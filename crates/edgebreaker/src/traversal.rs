@@ -156,7 +156,7 @@ pub fn traverse_in(
     scratch: &mut Scratch,
 ) -> Result<TraversalSummary, TraversalError> {
     let nt = table.triangle_count();
-    if let Some(c) = table.corners().find(|&c| table.opposite(c).is_none()) {
+    if let Some(c) = table.first_boundary_corner() {
         return Err(TraversalError::Boundary(c.0));
     }
     let mut tri_mark = scratch.take_filled(nt, UNVISITED);

@@ -832,6 +832,22 @@ impl CornerTable {
         self.opposite[c.index()] == NONE
     }
 
+    /// The first corner without an opposite (its edge is on a boundary), `None` for a
+    /// closed table. Scans the opposites in blocks the compiler vectorizes: a corner by
+    /// corner search with its early exit ran a few cycles per corner (about 1 % of an exact
+    /// encode, which asks twice).
+    pub fn first_boundary_corner(&self) -> Option<CornerId> {
+        const BLOCK: usize = 256;
+        let block = self
+            .opposite
+            .chunks(BLOCK)
+            .position(|b| b.iter().fold(false, |open, &o| open | (o == NONE)))?;
+        let at = self.opposite[block * BLOCK..]
+            .iter()
+            .position(|&o| o == NONE)?;
+        Some(CornerId((block * BLOCK + at) as u32))
+    }
+
     /// True when `v` lies on a boundary (its fan is open).
     pub fn is_boundary_vertex(&self, v: VertexId) -> bool {
         match self.vertex_corner(v) {
@@ -1098,6 +1114,27 @@ mod tests {
                 count: 3
             })
         );
+    }
+
+    #[test]
+    fn the_first_boundary_corner_is_the_lowest_open_one() {
+        let t = tetrahedron();
+        assert_eq!(CornerTable::new(&t).unwrap().first_boundary_corner(), None);
+        // A strip long enough to span blocks, open at its ends and sides.
+        let n = 700u32;
+        let positions = (0..2 * n).map(|i| DVec3::new(i as f64, 0.0, 0.0)).collect();
+        let triangles = (0..n - 1)
+            .flat_map(|i| {
+                [
+                    [2 * i, 2 * i + 2, 2 * i + 1],
+                    [2 * i + 1, 2 * i + 2, 2 * i + 3],
+                ]
+            })
+            .collect();
+        let strip = CornerTable::new(&Mesh::new(positions, triangles)).unwrap();
+        let want = strip.corners().find(|&c| strip.is_boundary_corner(c));
+        assert!(want.is_some());
+        assert_eq!(strip.first_boundary_corner(), want);
     }
 
     #[test]
