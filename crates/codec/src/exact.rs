@@ -1155,25 +1155,25 @@ pub(crate) fn decode_exact(
     let mut positions = std::mem::take(&mut buffers.positions);
     positions.clear();
     positions.reserve(real);
-    // Every real vertex decoded and inside the grid (one branch-free pass), then the
-    // positions in one sequential pass.
+    // Every real vertex decoded and inside the grid, checked without branches in the pass
+    // that writes the positions (sequential: the output's ids are the traversal's).
     let outside = |g: &[i32; 3]| g.iter().fold(false, |o, &c| o | (c < 0) | (c > max));
-    let bad = match &states {
-        Some(s) => q[..real]
-            .iter()
-            .zip(&s[..real])
-            .fold(false, |b, (g, &st)| b | (st != KNOWN) | outside(g)),
-        None => q[..real]
-            .iter()
-            .zip(&known[..real])
-            .fold(false, |b, (g, &k)| b | !k | outside(g)),
-    };
+    let mut bad = false;
+    match &states {
+        Some(s) => positions.extend(q[..real].iter().zip(&s[..real]).map(|(g, &st)| {
+            bad |= (st != KNOWN) | outside(g);
+            quantizer.dequantize(*g)
+        })),
+        None => positions.extend(q[..real].iter().zip(&known[..real]).map(|(g, &k)| {
+            bad |= !k | outside(g);
+            quantizer.dequantize(*g)
+        })),
+    }
     if bad {
         return Err(crate::Error::Corrupt(
             "a decoded position falls outside the quantization grid".into(),
         ));
     }
-    positions.extend(q[..real].iter().map(|&g| quantizer.dequantize(g)));
     buffers.grid = q;
     if let Some(s) = states {
         buffers.states = s;
