@@ -113,10 +113,14 @@ impl ReverseDecoder {
         v.reserve(capacity_faces);
         o.clear();
         o.reserve(3 * capacity_faces);
+        // Vertices are made before merges identify them (one per R or L, three per E): on a
+        // mesh of C and R symbols a little over half a vertex per triangle, more than the
+        // mesh's own count, so room for one per triangle (reserved, not touched) saves the
+        // grown copy a one-shot decode otherwise ends with.
         leftmost.clear();
-        leftmost.reserve(capacity_faces / 2 + 3);
+        leftmost.reserve(capacity_faces + 3);
         valence.clear();
-        valence.reserve(capacity_faces / 2 + 3);
+        valence.reserve(capacity_faces + 3);
         ReverseDecoder {
             v,
             o,
