@@ -175,9 +175,10 @@ impl CornerTable {
         }
         let mut fill: Vec<u32> = scratch.take_empty(vertex_count + 1);
         fill.extend_from_slice(&offsets);
-        // Entries pack (higher vertex, corner) into one u64, so the small sorts compare one
-        // word (the same order as the pair). Every entry is written before it is read.
-        let mut bucket = scratch.take_overwritten(nc, 0u64);
+        // Entries are corners (the edge's higher vertex is read back from the triangle,
+        // which spatially ordered input keeps close): a u32 array of the corner count, the
+        // size and type later stages reuse. Every entry is written before it is read.
+        let mut bucket = scratch.take_overwritten(nc, 0u32);
         // One bit per corner: its edge runs from the lower vertex up. Read back when pairing
         // (twins must differ), it saves a random access to the corner vertices per edge.
         let mut upward = scratch.take_filled(nc.div_ceil(64), 0u64);
@@ -186,12 +187,23 @@ impl CornerTable {
             for (j, (a, b)) in edges(tri).into_iter().enumerate() {
                 let c = 3 * t + j;
                 let lo = a.min(b) as usize;
-                bucket[fill[lo] as usize] = (a.max(b) as u64) << 32 | c as u64;
+                bucket[fill[lo] as usize] = c as u32;
                 fill[lo] += 1;
                 upward[c / 64] |= ((a < b) as u64) << (c % 64);
             }
         }
         let is_upward = |c: usize| upward[c / 64] >> (c % 64) & 1 == 1;
+        // The higher vertex of the edge facing corner c: the vertex its edge runs to when
+        // upward, else the one it runs from.
+        let higher = |c: usize| {
+            let (t, j) = (c / 3, c % 3);
+            let tri = &triangles_out[t];
+            if is_upward(c) {
+                tri[PREV_IN_TRIANGLE[j] as usize]
+            } else {
+                tri[NEXT_IN_TRIANGLE[j] as usize]
+            }
+        };
         let mut opposite = scratch.take_filled(nc, NONE);
         // Corners that start an open fan, per vertex: the corner after each boundary corner
         // (the edge behind it is the boundary). The fan walk then starts there.
@@ -206,11 +218,12 @@ impl CornerTable {
         const PAIRED: u32 = NONE - 1;
         let mut mate = fill;
         mate.fill(NONE);
+        let mut sorted: Vec<u64> = Vec::new();
         for v in 0..vertex_count {
-            let s = &mut bucket[offsets[v] as usize..offsets[v + 1] as usize];
+            let s = &bucket[offsets[v] as usize..offsets[v + 1] as usize];
             let (mut pairs, mut irregular) = (0usize, false);
-            for &e in s.iter() {
-                let (w, c) = ((e >> 32) as usize, e as u32);
+            for &c in s.iter() {
+                let w = higher(c as usize) as usize;
                 let m = mate[w];
                 let open = m < PAIRED;
                 let twin = if open { m } else { c };
@@ -221,13 +234,20 @@ impl CornerTable {
                 mate[w] = if open { PAIRED } else { c };
                 pairs += open as usize;
             }
-            for &e in s.iter() {
-                mate[(e >> 32) as usize] = NONE;
+            for &c in s.iter() {
+                mate[higher(c as usize) as usize] = NONE;
             }
             if !irregular && 2 * pairs == s.len() {
                 continue;
             }
-            s.sort_unstable();
+            // (higher vertex, corner) packed, so that a sort groups each edge's half-edges.
+            sorted.clear();
+            sorted.extend(
+                s.iter()
+                    .map(|&c| (higher(c as usize) as u64) << 32 | c as u64),
+            );
+            sorted.sort_unstable();
+            let s = &sorted;
             let mut i = 0;
             while i < s.len() {
                 let mut j = i + 1;
@@ -893,6 +913,8 @@ impl Iterator for VertexCorners<'_> {
 
 /// Position in its triangle of the corner after the one at position `j`.
 const NEXT_IN_TRIANGLE: [u32; 3] = [1, 2, 0];
+/// Position in its triangle of the corner before the one at position `j`.
+const PREV_IN_TRIANGLE: [u32; 3] = [2, 0, 1];
 
 #[inline]
 fn next_raw(c: usize) -> usize {
