@@ -564,25 +564,30 @@ fn spatial_order(
     // mesh to the table's check, which names it.
     scratch.give(cell);
     scratch.give(start);
-    let mut renamed: Vec<([u32; 3], u32)> = scratch.take_empty(nt);
+    // The renamed triangles and their buckets in two arrays of types later stages take
+    // from the scratch again (one array of pairs would be memory nothing reuses).
+    let mut renamed: Vec<[u32; 3]> = scratch.take_empty(nt);
+    let mut bucket: Vec<u32> = scratch.take_empty(nt);
     for t in &mesh.triangles {
         let r = [
             *new_id.get(t[0] as usize)?,
             *new_id.get(t[1] as usize)?,
             *new_id.get(t[2] as usize)?,
         ];
-        renamed.push((r, r[0].min(r[1]).min(r[2]) >> shift));
+        renamed.push(r);
+        bucket.push(r[0].min(r[1]).min(r[2]) >> shift);
     }
     scratch.give(new_id);
-    let mut first = bucket_starts(renamed.iter().map(|&(_, b)| b as usize), buckets, scratch);
+    let mut first = bucket_starts(bucket.iter().map(|&b| b as usize), buckets, scratch);
     // Each written once below (a permutation).
     let mut triangles = scratch.take_overwritten(nt, [0u32; 3]);
-    for &(t, b) in &renamed {
+    for (&t, &b) in renamed.iter().zip(&bucket) {
         let slot = &mut first[b as usize];
         triangles[*slot as usize] = t;
         *slot += 1;
     }
     scratch.give(renamed);
+    scratch.give(bucket);
     scratch.give(first);
     Some((Mesh::new(positions, triangles), original))
 }
