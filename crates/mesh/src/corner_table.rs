@@ -222,8 +222,13 @@ impl CornerTable {
         for v in 0..vertex_count {
             let s = &bucket[offsets[v] as usize..offsets[v + 1] as usize];
             let (mut pairs, mut irregular) = (0usize, false);
-            for &c in s.iter() {
-                let w = higher(c as usize) as usize;
+            // Each half-edge's higher vertex, kept for the clearing below (a longer bucket
+            // reads them again).
+            let mut ws = [0u32; 16];
+            for (i, &c) in s.iter().enumerate() {
+                let w = higher(c as usize);
+                ws[i % 16] = w;
+                let w = w as usize;
                 let m = mate[w];
                 let open = m < PAIRED;
                 let twin = if open { m } else { c };
@@ -234,8 +239,14 @@ impl CornerTable {
                 mate[w] = if open { PAIRED } else { c };
                 pairs += open as usize;
             }
-            for &c in s.iter() {
-                mate[higher(c as usize) as usize] = NONE;
+            if s.len() <= ws.len() {
+                for &w in &ws[..s.len()] {
+                    mate[w as usize] = NONE;
+                }
+            } else {
+                for &c in s.iter() {
+                    mate[higher(c as usize) as usize] = NONE;
+                }
             }
             if !irregular && 2 * pairs == s.len() {
                 continue;
@@ -1157,6 +1168,29 @@ mod tests {
         let want = strip.corners().find(|&c| strip.is_boundary_corner(c));
         assert!(want.is_some());
         assert_eq!(strip.first_boundary_corner(), want);
+    }
+
+    #[test]
+    fn a_hub_vertex_with_a_long_bucket_is_paired() {
+        // A bipyramid over a 20-gon: vertex 0's bucket holds 40 half-edges (past the
+        // pairing's kept higher vertices), the table must still be consistent.
+        let n = 20u32;
+        let mut triangles = Vec::new();
+        for i in 0..n {
+            let (a, b) = (2 + i, 2 + (i + 1) % n);
+            triangles.push([0, a, b]);
+            triangles.push([1, b, a]);
+        }
+        let positions = (0..n + 2).map(|i| DVec3::new(i as f64, 0.0, 0.0)).collect();
+        let t = CornerTable::new(&Mesh::new(positions, triangles)).unwrap();
+        assert_eq!(t.first_boundary_corner(), None);
+        let raw = CornerTable::from_raw(
+            t.triangles().to_vec(),
+            t.opposites().to_vec(),
+            t.vertex_count(),
+            true,
+        );
+        assert_eq!(raw, Ok(t));
     }
 
     #[test]
