@@ -175,9 +175,12 @@ impl CornerTable {
         }
         let mut fill: Vec<u32> = scratch.take_empty(vertex_count + 1);
         fill.extend_from_slice(&offsets);
-        // Entries are corners (the edge's higher vertex is read back from the triangle,
-        // which spatially ordered input keeps close): a u32 array of the corner count, the
-        // size and type later stages reuse. Every entry is written before it is read.
+        // Entries are (higher vertex, corner) in two u32 arrays of the corner count: the
+        // size and type of arrays later stages take from the scratch again (one packed u64
+        // array would be memory nothing reuses; corners alone, reading the higher vertex
+        // back from the triangle, cost the pairing a random access per entry). Every entry
+        // is written before it is read.
+        let mut bucket_higher = scratch.take_overwritten(nc, 0u32);
         let mut bucket = scratch.take_overwritten(nc, 0u32);
         // One bit per corner: its edge runs from the lower vertex up. Read back when pairing
         // (twins must differ), it saves a random access to the corner vertices per edge.
@@ -187,23 +190,14 @@ impl CornerTable {
             for (j, (a, b)) in edges(tri).into_iter().enumerate() {
                 let c = 3 * t + j;
                 let lo = a.min(b) as usize;
-                bucket[fill[lo] as usize] = c as u32;
+                let at = fill[lo] as usize;
+                bucket_higher[at] = a.max(b);
+                bucket[at] = c as u32;
                 fill[lo] += 1;
                 upward[c / 64] |= ((a < b) as u64) << (c % 64);
             }
         }
         let is_upward = |c: usize| upward[c / 64] >> (c % 64) & 1 == 1;
-        // The higher vertex of the edge facing corner c: the vertex its edge runs to when
-        // upward, else the one it runs from.
-        let higher = |c: usize| {
-            let (t, j) = (c / 3, c % 3);
-            let tri = &triangles_out[t];
-            if is_upward(c) {
-                tri[PREV_IN_TRIANGLE[j] as usize]
-            } else {
-                tri[NEXT_IN_TRIANGLE[j] as usize]
-            }
-        };
         let mut opposite = scratch.take_filled(nc, NONE);
         // Corners that start an open fan, per vertex: the corner after each boundary corner
         // (the edge behind it is the boundary). The fan walk then starts there.
@@ -220,14 +214,10 @@ impl CornerTable {
         mate.fill(NONE);
         let mut sorted: Vec<u64> = Vec::new();
         for v in 0..vertex_count {
-            let s = &bucket[offsets[v] as usize..offsets[v + 1] as usize];
+            let range = offsets[v] as usize..offsets[v + 1] as usize;
+            let (s, hs) = (&bucket[range.clone()], &bucket_higher[range]);
             let (mut pairs, mut irregular) = (0usize, false);
-            // Each half-edge's higher vertex, kept for the clearing below (a longer bucket
-            // reads them again).
-            let mut ws = [0u32; 16];
-            for (i, &c) in s.iter().enumerate() {
-                let w = higher(c as usize);
-                ws[i % 16] = w;
+            for (&c, &w) in s.iter().zip(hs) {
                 let w = w as usize;
                 let m = mate[w];
                 let open = m < PAIRED;
@@ -239,24 +229,15 @@ impl CornerTable {
                 mate[w] = if open { PAIRED } else { c };
                 pairs += open as usize;
             }
-            if s.len() <= ws.len() {
-                for &w in &ws[..s.len()] {
-                    mate[w as usize] = NONE;
-                }
-            } else {
-                for &c in s.iter() {
-                    mate[higher(c as usize) as usize] = NONE;
-                }
+            for &w in hs {
+                mate[w as usize] = NONE;
             }
             if !irregular && 2 * pairs == s.len() {
                 continue;
             }
             // (higher vertex, corner) packed, so that a sort groups each edge's half-edges.
             sorted.clear();
-            sorted.extend(
-                s.iter()
-                    .map(|&c| (higher(c as usize) as u64) << 32 | c as u64),
-            );
+            sorted.extend(s.iter().zip(hs).map(|(&c, &w)| (w as u64) << 32 | c as u64));
             sorted.sort_unstable();
             let s = &sorted;
             let mut i = 0;
@@ -303,6 +284,7 @@ impl CornerTable {
         }
         scratch.give(mate);
         scratch.give(bucket);
+        scratch.give(bucket_higher);
         scratch.give(offsets);
         scratch.give(upward);
         let table = CornerTable {
@@ -924,8 +906,6 @@ impl Iterator for VertexCorners<'_> {
 
 /// Position in its triangle of the corner after the one at position `j`.
 const NEXT_IN_TRIANGLE: [u32; 3] = [1, 2, 0];
-/// Position in its triangle of the corner before the one at position `j`.
-const PREV_IN_TRIANGLE: [u32; 3] = [2, 0, 1];
 
 #[inline]
 fn next_raw(c: usize) -> usize {
@@ -1172,8 +1152,8 @@ mod tests {
 
     #[test]
     fn a_hub_vertex_with_a_long_bucket_is_paired() {
-        // A bipyramid over a 20-gon: vertex 0's bucket holds 40 half-edges (past the
-        // pairing's kept higher vertices), the table must still be consistent.
+        // A bipyramid over a 20-gon: vertex 0's bucket holds 40 half-edges, a long run of
+        // the one-pass pairing; the table must still be consistent.
         let n = 20u32;
         let mut triangles = Vec::new();
         for i in 0..n {
