@@ -515,7 +515,9 @@ impl CornerTable {
             if !check_fans {
                 for j in 0..3 {
                     let slot = &mut vertex_corner[tv[j] as usize];
-                    if *slot == NONE || to[(j + 2) % 3] == NONE {
+                    // A closed table has no open edge behind any corner (an open one was
+                    // refused above): the first corner is the start.
+                    if *slot == NONE || (!CLOSED && to[(j + 2) % 3] == NONE) {
                         *slot = (3 * t + j) as u32;
                     }
                 }
