@@ -985,8 +985,7 @@ fn encode_exact_with(
     }
     let vertex_order = enc
         .connectivity
-        .output_vertices()
-        .iter()
+        .output_vertices_iter()
         .map(|v| v.0)
         .collect();
     // Quantize in input order and scatter to the traversal order: on an input in random

@@ -242,12 +242,16 @@ impl Connectivity {
 
     /// The real vertices in output order (table ids).
     pub fn output_vertices(&self) -> Vec<VertexId> {
+        self.output_vertices_iter().collect()
+    }
+
+    /// [`Connectivity::output_vertices`] without collecting them.
+    pub fn output_vertices_iter(&self) -> impl Iterator<Item = VertexId> + '_ {
         self.summary
             .vertex_order
             .iter()
             .copied()
             .filter(|v| !self.is_dummy[v.index()])
-            .collect()
     }
 }
 

@@ -969,6 +969,20 @@ mod tests {
         )
     }
 
+    /// Two copies of [`tetrahedron`] sharing its vertices below `shared` (the second's
+    /// others renumbered from `shared` on, past the first's), `vertices` in all.
+    fn two_tetrahedra(shared: u32, vertices: usize) -> Mesh {
+        let t = tetrahedron();
+        let offset = vertices as u32 - 4;
+        let mut triangles = t.triangles.clone();
+        triangles.extend(
+            t.triangles
+                .iter()
+                .map(|tri| tri.map(|v| if v < shared { v } else { v + offset })),
+        );
+        Mesh::new(vec![DVec3::ZERO; vertices], triangles)
+    }
+
     #[test]
     fn a_closed_build_accepts_a_closed_table_and_names_an_unglued_corner() {
         let t = CornerTable::new(&tetrahedron()).unwrap();
@@ -1180,14 +1194,7 @@ mod tests {
         // Two tetrahedra glued along edge 0-1: every bucket pairs, but the bucket of vertex
         // 0 holds four half-edges to vertex 1 (the one-pass pairing must not pair them
         // two by two).
-        let t = tetrahedron();
-        let mut triangles = t.triangles.clone();
-        triangles.extend(
-            t.triangles
-                .iter()
-                .map(|tri| tri.map(|v| if v < 2 { v } else { v + 2 })),
-        );
-        let m = Mesh::new(vec![DVec3::ZERO; 6], triangles);
+        let m = two_tetrahedra(2, 6);
         assert_eq!(
             CornerTable::new(&m),
             Err(MeshError::NonManifoldEdge {
@@ -1217,15 +1224,8 @@ mod tests {
     #[test]
     fn deferred_fan_check_finds_pinched_closed_fans() {
         // Two tetrahedra sharing vertex 0: two closed fans around it.
+        let m = two_tetrahedra(1, 7);
         let t = tetrahedron();
-        let mut triangles = t.triangles.clone();
-        triangles.extend(
-            t.triangles
-                .iter()
-                .map(|tri| tri.map(|v| if v == 0 { 0 } else { v + 3 })),
-        );
-        let positions = vec![DVec3::ZERO; 7];
-        let m = Mesh::new(positions, triangles);
         assert!(matches!(
             CornerTable::new(&m),
             Err(MeshError::NonManifoldVertex { vertex: 0, .. })
