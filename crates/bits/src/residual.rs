@@ -34,7 +34,43 @@ pub struct CdfModel {
     c: [u16; CDF_SYMBOLS + 1],
     /// Symbols seen, saturating (sets the adaptation rate).
     count: u8,
+    /// Whether some count above the first [`CDF_LANES`] may still rise: while none can, an
+    /// update below [`CDF_LANES`] touches only those (see [`CdfModel::update`]).
+    wide: bool,
 }
+
+/// Per symbol `s` (0..=32), the mask of the counts that rise: all ones in the lanes above `s`.
+/// A load, where a compare of the lane index with `s` came out as 32-bit compares packed back
+/// to 16 bits, and, once the compiler knew `s` small, as a mix of scalar and vector code.
+static RISE_MASKS: [[u16; CDF_SYMBOLS]; CDF_SYMBOLS + 1] = {
+    let mut m = [[0u16; CDF_SYMBOLS]; CDF_SYMBOLS + 1];
+    let mut s = 0;
+    while s <= CDF_SYMBOLS {
+        let mut lane = s + 1;
+        while lane < CDF_SYMBOLS {
+            m[s][lane] = u16::MAX;
+            lane += 1;
+        }
+        s += 1;
+    }
+    m
+};
+
+/// Moves the counts `x` towards the symbol whose [`RISE_MASKS`] row is `rise`: those the mask
+/// selects rise, the rest fall, each by `1 / 2^rate` of its distance. Branch-free over whole
+/// vectors, so that it vectorises.
+#[inline(always)]
+fn update_lanes<const N: usize>(x: &mut [u16; N], rise: &[u16; N], rate: u32) {
+    for (x, &rise) in x.iter_mut().zip(rise) {
+        let up = (CDF_SPAN - *x) >> rate;
+        let down = *x >> rate;
+        *x = x.wrapping_add(up & rise).wrapping_sub(down & !rise);
+    }
+}
+
+/// The counts an update touches while the others cannot move (eight 16-bit lanes: one SSE2
+/// register).
+const CDF_LANES: usize = 8;
 
 impl Default for CdfModel {
     fn default() -> Self {
@@ -49,7 +85,11 @@ impl CdfModel {
         for (i, x) in c.iter_mut().enumerate() {
             *x = (CDF_SPAN as u32 * i as u32 / CDF_SYMBOLS as u32) as u16;
         }
-        CdfModel { c, count: 0 }
+        CdfModel {
+            c,
+            count: 0,
+            wide: true,
+        }
     }
 
     /// Cumulative frequency below symbol `s` (`s <= 32`), out of `2^15`.
@@ -75,27 +115,36 @@ impl CdfModel {
         if (self.count as u32) < RATE_STEP as u32 * RATE_STEPS {
             self.count += 1;
         }
-        // Branch-free over a whole number of vectors, so that it vectorises: entries above
-        // s rise, the rest fall. c[0] = 0 stays 0 (it falls by 0 >> rate); c[32] = CDF_SPAN
-        // is left alone (it would rise by 0). The entry index is a 16-bit lane and the
-        // choice a lane mask: a select on a usize index compiled to about three times the
-        // instructions.
-        const LANE: [u16; CDF_SYMBOLS] = {
-            let mut l = [0u16; CDF_SYMBOLS];
-            let mut i = 0;
-            while i < CDF_SYMBOLS {
-                l[i] = i as u16;
-                i += 1;
-            }
-            l
-        };
-        let s = s.min(CDF_SYMBOLS) as u16;
-        let (head, _) = self.c.split_at_mut(CDF_SYMBOLS);
-        for (x, &lane) in head.iter_mut().zip(&LANE) {
-            let rise = 0u16.wrapping_sub((lane > s) as u16);
-            let up = (CDF_SPAN - *x) >> rate;
-            let down = *x >> rate;
-            *x = x.wrapping_add(up & rise).wrapping_sub(down & !rise);
+        // Entries above s rise, the rest fall ([`update_lanes`]). c[0] = 0 stays 0 (it falls
+        // by 0 >> rate); c[32] = CDF_SPAN is left alone (it would rise by 0).
+        //
+        // A count above `s` rises by `(CDF_SPAN - x) >> rate`, which is 0 once it is within
+        // `2^rate` of the top; the rate never falls, so such a count stays put until a symbol
+        // at or above it makes it fall. While every count above the first vector stays put,
+        // a symbol below [`CDF_LANES`] updates the first vector alone (a skewed source, as
+        // residual lengths are, lives there): the counts come out the same as if all moved.
+        let s = s.min(CDF_SYMBOLS);
+        // Each mask row is copied out first: a local the counts cannot alias (read in place,
+        // the vectorised loop came with a runtime overlap check and a scalar fallback).
+        let (head, _) = self
+            .c
+            .split_first_chunk_mut::<CDF_SYMBOLS>()
+            .expect("33 counts");
+        if !self.wide && s < CDF_LANES {
+            let (low, _) = head
+                .split_first_chunk_mut::<CDF_LANES>()
+                .expect("32 counts");
+            let rise: [u16; CDF_LANES] = *RISE_MASKS[s].first_chunk().expect("32 masks");
+            update_lanes(low, &rise, rate);
+        } else {
+            let rise: [u16; CDF_SYMBOLS] = RISE_MASKS[s];
+            update_lanes(head, &rise, rate);
+            // Whether a count above the first vector can still rise at this rate (an OR, no
+            // early exit: it vectorises).
+            let room = head[CDF_LANES..]
+                .iter()
+                .fold(0u16, |m, &x| m | ((CDF_SPAN - x) >> rate));
+            self.wide = room != 0;
         }
     }
 
@@ -340,6 +389,50 @@ mod tests {
                 let _ = d.finish();
             }
         }
+    }
+
+    /// The update as docs/codec.md ("Exact mode geometry") states it: every count moves.
+    fn reference_update(c: &mut [u16; CDF_SYMBOLS + 1], count: &mut u8, s: usize) {
+        let rate = RATE_MIN + (*count / RATE_STEP) as u32;
+        if (*count as u32) < RATE_STEP as u32 * RATE_STEPS {
+            *count += 1;
+        }
+        for (i, x) in c.iter_mut().enumerate().take(CDF_SYMBOLS) {
+            if i > s {
+                *x += (CDF_SPAN - *x) >> rate;
+            } else {
+                *x -= *x >> rate;
+            }
+        }
+    }
+
+    proptest! {
+        #[test]
+        fn skipping_settled_counts_changes_no_count(
+            symbols in proptest::collection::vec(
+                prop_oneof![8 => 0usize..6, 1 => 0usize..40], 0..2000)
+        ) {
+            let mut model = CdfModel::new();
+            let (mut c, mut count) = (model.c, 0u8);
+            for s in symbols {
+                model.update(s);
+                reference_update(&mut c, &mut count, s.min(CDF_SYMBOLS));
+                prop_assert_eq!(model.c, c);
+            }
+        }
+    }
+
+    #[test]
+    fn a_skewed_source_settles_the_upper_counts() {
+        // Small symbols only: the counts above the first vector stop moving, and updates
+        // then touch the first vector alone; a large symbol wakes them up again.
+        let mut model = CdfModel::new();
+        for i in 0..2000usize {
+            model.update(i % 4);
+        }
+        assert!(!model.wide);
+        model.update(20);
+        assert!(model.wide);
     }
 
     #[test]
