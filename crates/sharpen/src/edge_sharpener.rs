@@ -184,6 +184,14 @@ pub(crate) struct Scratch {
     pub blend_creases: Vec<(u32, u32)>,
     /// Curved walls: a mark per vertex (on a red triangle), then per triangle (deep).
     pub wall_marks: Vec<u8>,
+    /// The triangles that are not red once the red set is final (ascending), listed by
+    /// [`Run::list_gray_triangles`]: every non-red edge lies between two of them, so the
+    /// passes that look for chamfer edges walk their corners instead of the whole mesh's
+    /// (a few percent of it on a fine sampling).
+    pub gray: Vec<u32>,
+    /// The lower corner of every interior edge whose angle is at least the smooth threshold
+    /// (ascending; [`Run::smooth_edges`]): the edges a pass looking for strong turns needs.
+    pub rough: Vec<u32>,
 }
 
 fn reset<T: Clone>(v: &mut Vec<T>, n: usize, x: T) {
@@ -580,9 +588,40 @@ impl<'a> Run<'a> {
         self.smooth_edges();
         self.filters();
         if self.opts.method == Method::Extended {
+            // Lists the gray triangles itself, once its demotions have settled the red set.
             self.extend_detection();
+        } else {
+            self.list_gray_triangles();
         }
         self.chamfer_edges();
+    }
+
+    /// Lists the triangles that are not red into `s.gray` (the red set must be final).
+    pub(crate) fn list_gray_triangles(&mut self) {
+        let s = &mut *self.s;
+        s.gray.clear();
+        s.gray.extend(
+            s.tflags
+                .iter()
+                .enumerate()
+                .filter(|(_, &f)| f & T_RED == 0)
+                .map(|(t, _)| t as u32),
+        );
+    }
+
+    /// The corners `c` of gray triangles whose edge is not red and is interior, each edge
+    /// once (from its lower corner), with the opposite corner, in ascending order of `c`:
+    /// the edges a pass over every corner would visit with the same tests.
+    pub(crate) fn non_red_edges(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+        let opposite = self.table.opposites();
+        self.s.gray.iter().flat_map(move |&t| {
+            let t = t as usize;
+            (3 * t..3 * t + 3).filter_map(move |c| {
+                let o = opposite[c];
+                (o != NONE && o as usize > c && self.s.cflags[c] & C_RED == 0)
+                    .then_some((c, o as usize))
+            })
+        })
     }
 
     /// The rest of [`Run::detect`]: the extended method's corner vertices and idle splits.
@@ -619,13 +658,18 @@ impl<'a> Run<'a> {
         let thr = threshold as f32;
         let mut smooth = 0;
         let s = &mut *self.s;
+        s.rough.clear();
         let opposite = self.table.opposites();
         for (c, (&a, &o)) in s.angles.iter().zip(opposite).enumerate() {
             // Only the lower corner of an interior edge holds its angle (-1 elsewhere).
-            if a >= 0.0 && a < thr && o != NONE {
-                s.cflags[c] |= C_BROWN;
-                s.cflags[o as usize] |= C_BROWN;
-                smooth += 1;
+            if a >= 0.0 && o != NONE {
+                if a < thr {
+                    s.cflags[c] |= C_BROWN;
+                    s.cflags[o as usize] |= C_BROWN;
+                    smooth += 1;
+                } else {
+                    s.rough.push(c as u32);
+                }
             }
         }
         self.report.smooth_edges = smooth;
@@ -868,37 +912,31 @@ impl<'a> Run<'a> {
     /// Filters 5 and 6: blue chamfer edges (interior, not red, two red ends; extended: two
     /// ends with non-parallel label planes) and green corner triangles (three blue edges).
     fn chamfer_edges(&mut self) {
-        let nt = self.mesh.triangles.len();
-        let nc = 3 * nt;
         let extended = self.opts.method == Method::Extended;
-        let mut blue = 0;
-        for c in 0..nc {
-            let Some(o) = self.table.opposite(CornerId(c as u32)) else {
-                continue;
-            };
-            if o.index() < c || self.s.cflags[c] & C_RED != 0 {
-                continue;
-            }
+        let mut blue_edges: Vec<(usize, usize)> = Vec::new();
+        for (c, o) in self.non_red_edges() {
             let (a, b) = (self.cv(next(c)), self.cv(prev(c)));
             let is_blue = if extended {
                 crate::extended::is_chamfer_edge(self, a, b)
             } else {
                 self.s.vflags[a as usize] & V_RED != 0 && self.s.vflags[b as usize] & V_RED != 0
             };
-            if is_blue && self.split_allowed(c, o.index()) {
-                self.s.cflags[c] |= C_BLUE;
-                self.s.cflags[o.index()] |= C_BLUE;
-                blue += 1;
+            if is_blue && self.split_allowed(c, o) {
+                blue_edges.push((c, o));
             }
         }
-        self.report.chamfer_edges = blue;
+        for &(c, o) in &blue_edges {
+            self.s.cflags[c] |= C_BLUE;
+            self.s.cflags[o] |= C_BLUE;
+        }
+        self.report.chamfer_edges = blue_edges.len();
         let mut green = 0;
-        for t in 0..nt {
+        // A red triangle has red edges only, so three blue edges need a gray triangle.
+        for i in 0..self.s.gray.len() {
+            let t = self.s.gray[i] as usize;
             let f = &self.s.cflags[3 * t..3 * t + 3];
             let corner = f.iter().all(|&x| x & C_BLUE != 0)
-                || (extended
-                    && self.s.tflags[t] & T_RED == 0
-                    && crate::extended::is_corner_triangle(self, self.mesh.triangles[t]));
+                || (extended && crate::extended::is_corner_triangle(self, self.mesh.triangles[t]));
             if corner {
                 self.s.tflags[t] |= T_GREEN;
                 green += 1;
@@ -961,15 +999,20 @@ impl<'a> Run<'a> {
                 self.s.tflags[t] &= !T_GREEN;
             }
         }
-        let nt = self.mesh.triangles.len();
-        self.report.chamfer_edges = (0..3 * nt)
+        // Blue edges and green triangles are gray: count there.
+        let gray = &self.s.gray;
+        let opposite = self.table.opposites();
+        self.report.chamfer_edges = gray
+            .iter()
+            .flat_map(|&t| 3 * t as usize..3 * t as usize + 3)
             .filter(|&c| {
-                self.s.cflags[c] & C_BLUE != 0
-                    && self.table.opposites()[c] != NONE
-                    && (self.table.opposites()[c] as usize) > c
+                self.s.cflags[c] & C_BLUE != 0 && opposite[c] != NONE && opposite[c] as usize > c
             })
             .count();
-        self.report.corner_triangles = self.s.tflags.iter().filter(|&&f| f & T_GREEN != 0).count();
+        self.report.corner_triangles = gray
+            .iter()
+            .filter(|&&t| self.s.tflags[t as usize] & T_GREEN != 0)
+            .count();
     }
 
     /// Whether the chamfer edge between corners `c` and `o` may be split: neither of its
@@ -999,12 +1042,16 @@ impl<'a> Run<'a> {
     /// not move, unless the triangle keeps three chamfer edges (which need a centre).
     #[inline(never)] // one call per run; kept out of line so profiles show it
     fn drop_idle_splits(&mut self) {
-        let nt = self.mesh.triangles.len();
         let mut blue = 0;
-        for c in 0..3 * nt {
-            if self.s.cflags[c] & C_BLUE == 0 {
-                continue;
-            }
+        // Blue edges lie between gray triangles (they are not red).
+        let corners = (0..self.s.gray.len())
+            .flat_map(|i| {
+                let t = self.s.gray[i] as usize;
+                3 * t..3 * t + 3
+            })
+            .filter(|&c| self.s.cflags[c] & C_BLUE != 0)
+            .collect::<Vec<usize>>();
+        for c in corners {
             let Some(o) = self.table.opposite(CornerId(c as u32)) else {
                 continue;
             };
@@ -1031,7 +1078,9 @@ impl<'a> Run<'a> {
         }
         self.report.chamfer_edges = blue;
         let mut green = 0;
-        for t in 0..nt {
+        // Green (corner) triangles are gray.
+        for i in 0..self.s.gray.len() {
+            let t = self.s.gray[i] as usize;
             if self.s.tflags[t] & T_GREEN == 0 {
                 continue;
             }

@@ -84,6 +84,8 @@ pub(crate) fn classify(run: &mut Run) {
         demote_corridors(run, &deep, &of);
         demote_strip_arms(run, &deep);
     }
+    // The red set is final from here on.
+    run.list_gray_triangles();
     border_planes(run);
     if run.surface_samples {
         region_turns(run);
@@ -141,14 +143,7 @@ pub(crate) const BLEND_PRIOR_EDGES: f64 = 4.0;
 fn blend_creases(run: &mut Run) {
     // (smaller label, larger label, edge has both ends inside)
     let mut counts: Vec<(u32, u32, bool)> = Vec::new();
-    let nc = run.mesh.triangles.len() * 3;
-    for c in 0..nc {
-        let Some(o) = run.table.opposite(CornerId(c as u32)) else {
-            continue;
-        };
-        if o.index() < c || run.s.cflags[c] & C_RED != 0 {
-            continue;
-        }
+    for (c, _) in run.non_red_edges() {
         let (a, b) = (run.cv(next(c)), run.cv(crate::edge_sharpener::prev(c)));
         if !is_chamfer_edge(run, a, b) {
             continue;
@@ -568,11 +563,11 @@ fn demote_strip_arms(run: &mut Run, deep: &[bool]) {
     let threshold = (STRONG_INNER_TURN * run.smooth_threshold) as f32;
     let opposite = run.table.opposites();
     let mut strong: Vec<(usize, usize)> = Vec::new();
-    for (c, &o) in opposite.iter().enumerate() {
-        if o == NONE || (o as usize) < c {
-            continue;
-        }
-        let o = o as usize;
+    // A strong turn is a rough edge (`Run::smooth_edges` lists them, lower corner first,
+    // which holds the angle): the threshold is at least the smooth one.
+    for &c in &run.s.rough {
+        let c = c as usize;
+        let o = opposite[c] as usize;
         let r = run.s.region[c / 3];
         if r != NONE && run.s.region[o / 3] == r && run.s.angles[c].max(run.s.angles[o]) > threshold
         {
@@ -598,12 +593,7 @@ fn demote_strip_arms(run: &mut Run, deep: &[bool]) {
             }
         }
     }
-    for (c, &o) in opposite.iter().enumerate() {
-        if o != NONE && run.s.region[c / 3] != run.s.region[o as usize / 3] {
-            edge_vertex[run.cv(next(c)) as usize] = true;
-            edge_vertex[run.cv(crate::edge_sharpener::prev(c)) as usize] = true;
-        }
-    }
+    let mut near_list = ring.clone();
     for _ in 0..ARM_RINGS {
         let mut next_ring = Vec::new();
         for &v in &ring {
@@ -615,7 +605,27 @@ fn demote_strip_arms(run: &mut Run, deep: &[bool]) {
                 }
             }
         }
+        near_list.extend_from_slice(&next_ring);
         ring = next_ring;
+    }
+    // The region borders, where arms need them only (`arm_like` asks about near vertices):
+    // a vertex is on one when an interior edge at it joins triangles of two regions (or a
+    // region and none). Both edges at the vertex in each triangle of its fan are opposite
+    // the triangle's other two corners.
+    for &v in &near_list {
+        if edge_vertex[v as usize] {
+            continue;
+        }
+        edge_vertex[v as usize] = run.table.vertex_corners(VertexId(v)).any(|vc| {
+            let c = vc.index();
+            let r = run.s.region[c / 3];
+            [next(c), crate::edge_sharpener::prev(c)]
+                .into_iter()
+                .any(|k| {
+                    let o = opposite[k];
+                    o != NONE && run.s.region[o as usize / 3] != r
+                })
+        });
     }
     let tri = |t: usize| run.mesh.triangles[t];
     let has_deep = |t: usize| tri(t).iter().any(|&v| deep[v as usize]);
