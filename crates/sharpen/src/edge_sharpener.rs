@@ -189,8 +189,11 @@ pub(crate) struct Scratch {
     /// passes that look for chamfer edges walk their corners instead of the whole mesh's
     /// (a few percent of it on a fine sampling).
     pub gray: Vec<u32>,
-    /// The lower corner of every interior edge whose angle is at least the smooth threshold
-    /// (ascending; [`Run::smooth_edges`]): the edges a pass looking for strong turns needs.
+    /// The lower corner of every interior edge that [`Run::smooth_edges`] did not find smooth
+    /// (ascending): its angle is at least the smooth threshold, or it has none (a triangle
+    /// without a normal). Two red triangles of different regions meet only across such an
+    /// edge (brown edges join regions, and only ever get added later), and a strong turn is
+    /// one.
     pub rough: Vec<u32>,
 }
 
@@ -476,6 +479,9 @@ pub(crate) struct Run<'a> {
     pub positions: Vec<DVec3>,
     /// Longest input edge.
     pub max_edge: f64,
+    /// Extended method: the mean input edge length, summed in the smooth-edge pass in the
+    /// order of [`CornerTable::mean_edge_length`] (the same value, without a pass of its own).
+    pub mean_edge: f64,
     /// On a welded input: the input and its welding, so that the smooth threshold is the
     /// input's (see [`crate::weld::WeldPatch`]).
     pub weld_patch: Option<crate::weld::WeldPatch<'a>>,
@@ -537,6 +543,7 @@ impl<'a> Run<'a> {
             report,
             positions: Vec::new(),
             max_edge: 0.0,
+            mean_edge: 0.0,
             weld_patch: None,
             limits: SnapLimits::new(0.0),
             smooth_threshold: 0.0,
@@ -662,14 +669,12 @@ impl<'a> Run<'a> {
         let opposite = self.table.opposites();
         for (c, (&a, &o)) in s.angles.iter().zip(opposite).enumerate() {
             // Only the lower corner of an interior edge holds its angle (-1 elsewhere).
-            if a >= 0.0 && o != NONE {
-                if a < thr {
-                    s.cflags[c] |= C_BROWN;
-                    s.cflags[o as usize] |= C_BROWN;
-                    smooth += 1;
-                } else {
-                    s.rough.push(c as u32);
-                }
+            if a >= 0.0 && a < thr && o != NONE {
+                s.cflags[c] |= C_BROWN;
+                s.cflags[o as usize] |= C_BROWN;
+                smooth += 1;
+            } else if o != NONE && (c as u32) < o {
+                s.rough.push(c as u32);
             }
         }
         self.report.smooth_edges = smooth;
@@ -689,6 +694,10 @@ impl<'a> Run<'a> {
         let mut sum = 0.0f64;
         let mut count = 0usize;
         let mut max_edge2 = 0.0f64;
+        // The extended method's mean edge: the edges in `CornerTable::mean_edge_length`'s
+        // order (this very walk), so the sum is the same to the bit.
+        let mean_edge = self.opts.method == Method::Extended;
+        let (mut edge_sum, mut edges) = (0.0f64, 0usize);
         // Triangle by triangle, in corner order: the vertices after and before corner j of
         // a triangle are at (j + 1) % 3 and (j + 2) % 3, with no division per corner. The
         // corner arrays are walked in step with the triangles (no index checks per corner).
@@ -709,7 +718,13 @@ impl<'a> Run<'a> {
                 }
                 let a = mesh.positions[tri[after] as usize];
                 let b = mesh.positions[tri[before] as usize];
-                max_edge2 = max_edge2.max(a.distance_squared(b));
+                let d2 = a.distance_squared(b);
+                max_edge2 = max_edge2.max(d2);
+                if mean_edge {
+                    // `distance` is the square root of `distance_squared`.
+                    edge_sum += d2.sqrt();
+                    edges += 1;
+                }
                 if o == NONE {
                     continue;
                 }
@@ -724,6 +739,11 @@ impl<'a> Run<'a> {
             }
         }
         self.max_edge = max_edge2.sqrt();
+        self.mean_edge = if edges == 0 {
+            0.0
+        } else {
+            edge_sum / edges as f64
+        };
         (sum, count)
     }
 

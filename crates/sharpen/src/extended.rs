@@ -563,8 +563,8 @@ fn demote_strip_arms(run: &mut Run, deep: &[bool]) {
     let threshold = (STRONG_INNER_TURN * run.smooth_threshold) as f32;
     let opposite = run.table.opposites();
     let mut strong: Vec<(usize, usize)> = Vec::new();
-    // A strong turn is a rough edge (`Run::smooth_edges` lists them, lower corner first,
-    // which holds the angle): the threshold is at least the smooth one.
+    // A strong turn is a rough edge (`Run::smooth_edges` lists their lower corners, which
+    // hold the angles): the threshold is at least the smooth one.
     for &c in &run.s.rough {
         let c = c as usize;
         let o = opposite[c] as usize;
@@ -861,30 +861,37 @@ fn border_planes(run: &mut Run) {
     run.s.lp_len.clear();
     run.s.lp_len.resize(nv, 0);
     run.s.lps.clear();
-    // Border vertices in one pass over the corners: a red vertex with a non-red triangle or
-    // triangles of two regions.
-    let mut first: Vec<u32> = vec![NONE; nv];
-    let mut border: Vec<bool> = vec![false; nv];
-    for (t, tri) in run.mesh.triangles.iter().enumerate() {
-        let t_region = run.s.region[t];
-        for &v in tri {
-            let v = v as usize;
-            if run.s.vflags[v] & V_RED == 0 {
-                continue;
-            }
-            if t_region == NONE {
-                border[v] = true;
-            } else if first[v] == NONE {
-                first[v] = t_region;
-            } else if first[v] != t_region {
-                border[v] = true;
-            }
-        }
+    // Border vertices: a red vertex with a non-red triangle or triangles of two regions.
+    // Going around its fan, two regions meet across an edge at the vertex that is rough (a
+    // brown edge joins its triangles into one region), unless a gray triangle lies between
+    // them: so every border vertex is a vertex of a gray triangle or an end of a rough edge,
+    // and only those are tested, in ascending order.
+    let mut candidates: Vec<u32> = Vec::new();
+    for &t in &run.s.gray {
+        candidates.extend_from_slice(&run.mesh.triangles[t as usize]);
     }
-    drop(first);
+    for &c in &run.s.rough {
+        let c = c as usize;
+        candidates.push(run.cv(next(c)));
+        candidates.push(run.cv(crate::edge_sharpener::prev(c)));
+    }
+    candidates.sort_unstable();
+    candidates.dedup();
     let mut acc: Vec<(u32, DVec3)> = Vec::new();
-    for v in 0..nv {
-        if !border[v] {
+    for v in candidates {
+        let v = v as usize;
+        if run.s.vflags[v] & V_RED == 0 {
+            continue;
+        }
+        let mut first = NONE;
+        let border = run.table.vertex_corners(VertexId(v as u32)).any(|c| {
+            let r = run.s.region[c.index() / 3];
+            if first == NONE {
+                first = r;
+            }
+            r == NONE || r != first
+        });
+        if !border {
             continue;
         }
         acc.clear();
@@ -1001,10 +1008,10 @@ fn gray_vertices(run: &mut Run) {
 #[inline(never)] // one call per run; kept out of line so profiles show it
 fn crease_vertices(run: &mut Run) {
     let nv = run.mesh.positions.len();
-    // The mesh's mean edge serves chamfer (gray) vertices only, which `gray_vertices` has
-    // just counted: one pass where there are any.
+    // The mesh's mean edge (from the smooth-edge pass) serves chamfer (gray) vertices only,
+    // which `gray_vertices` has just counted.
     let mesh_mean = if run.report.chamfer_vertices > 0 {
-        run.table.mean_edge_length(&run.mesh.positions)
+        run.mean_edge
     } else {
         0.0
     };
