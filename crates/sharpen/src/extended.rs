@@ -866,17 +866,26 @@ fn border_planes(run: &mut Run) {
     // brown edge joins its triangles into one region), unless a gray triangle lies between
     // them: so every border vertex is a vertex of a gray triangle or an end of a rough edge,
     // and only those are tested, in ascending order.
+    // Each listed once (a vertex is in about six gray triangles), then sorted.
+    let mut listed = vec![false; nv];
     let mut candidates: Vec<u32> = Vec::new();
+    let mut list = |v: u32| {
+        if !std::mem::replace(&mut listed[v as usize], true) {
+            candidates.push(v);
+        }
+    };
     for &t in &run.s.gray {
-        candidates.extend_from_slice(&run.mesh.triangles[t as usize]);
+        for v in run.mesh.triangles[t as usize] {
+            list(v);
+        }
     }
     for &c in &run.s.rough {
         let c = c as usize;
-        candidates.push(run.cv(next(c)));
-        candidates.push(run.cv(crate::edge_sharpener::prev(c)));
+        list(run.cv(next(c)));
+        list(run.cv(crate::edge_sharpener::prev(c)));
     }
+    drop(listed);
     candidates.sort_unstable();
-    candidates.dedup();
     let mut acc: Vec<(u32, DVec3)> = Vec::new();
     for v in candidates {
         let v = v as usize;
