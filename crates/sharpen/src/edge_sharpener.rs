@@ -354,7 +354,7 @@ impl EdgeSharpener {
                 input_table: &table,
                 welded: w,
             });
-            let (mut out, mut parents, mut tags) = run.run(judge.as_deref_mut());
+            let (mut out, mut parents, mut tagged) = run.run(judge.as_deref_mut());
             for p in &mut parents {
                 *p = FaceId(w.input_triangle[p.index()]);
             }
@@ -372,18 +372,11 @@ impl EdgeSharpener {
                 );
                 if restored.clusters > 0 {
                     report.output_triangles = out.triangles.len();
-                    // Only edges at a restored cluster changed, and those are sharp only
-                    // where its kept vertex is tagged.
-                    if restored
-                        .members
-                        .iter()
-                        .any(|&(_, r)| tags.is_tagged(whet_mesh::VertexId(r)))
-                    {
-                        tags = restored.retag(&tags, &out);
-                        report.tagged_vertices = tags.vertices.len();
-                        report.sharp_edges = tags.edges.len();
-                    }
+                    restored.retag(&mut tagged);
                 }
+                // The sharp edges once, on the final mesh (only edges at a restored cluster
+                // changed, and those are sharp only where its kept vertex is tagged).
+                let tags = sharp_tags(&mut report, &out, &tagged);
                 report.welded_vertices = restored.still_welded;
                 report.time = start.elapsed();
                 return Ok(Sharpened {
@@ -395,8 +388,9 @@ impl EdgeSharpener {
             }
         }
         let mut run = Run::new(mesh, &table, &self.options, &mut self.scratch, report);
-        let (out, parents, tags) = run.run(judge);
+        let (out, parents, tagged) = run.run(judge);
         let mut report = run.report;
+        let tags = sharp_tags(&mut report, &out, &tagged);
         report.time = start.elapsed();
         Ok(Sharpened {
             mesh: out,
@@ -405,6 +399,15 @@ impl EdgeSharpener {
             report,
         })
     }
+}
+
+/// The sharp-edge tags of `mesh` from its tagged vertices (seed 001 section 4.1: filter 3bis
+/// vertices and the new ones), counted in `report`.
+fn sharp_tags(report: &mut SharpenReport, mesh: &Mesh, tagged: &[bool]) -> SharpTags {
+    let tags = SharpTags::from_vertex_flags(mesh, tagged);
+    report.tagged_vertices = tags.vertices.len();
+    report.sharp_edges = tags.edges.len();
+    tags
 }
 
 /// `first` followed by `next`, a pass over `first.mesh`: `next`'s mesh, parents traced back
@@ -558,7 +561,7 @@ impl<'a> Run<'a> {
     fn run(
         &mut self,
         judge: Option<&mut (dyn crate::SnapJudge + '_)>,
-    ) -> (Mesh, Vec<FaceId>, SharpTags) {
+    ) -> (Mesh, Vec<FaceId>, Vec<bool>) {
         self.detect();
         self.insert_vertices();
         self.reset_reference_normals();
@@ -569,8 +572,8 @@ impl<'a> Run<'a> {
         let mut out = crate::slivers::Output::assemble(self);
         out.remove_slivers(self);
         let (mesh, parents) = out.finish(self);
-        let tags = self.tags(&mesh);
-        (mesh, parents, tags)
+        let tagged = self.tagged(&mesh);
+        (mesh, parents, tagged)
     }
 
     /// Smooth edges, the filters, the extended classification, chamfer edges and corner
@@ -2276,7 +2279,7 @@ impl<'a> Run<'a> {
 
     /// Tagged vertices (3bis plus the surviving new vertices) and the edges between them.
     #[inline(never)] // one call per run; kept out of line so profiles show it
-    fn tags(&mut self, mesh: &Mesh) -> SharpTags {
+    fn tagged(&self, mesh: &Mesh) -> Vec<bool> {
         let nv = self.mesh.positions.len();
         let mut flags = vec![false; mesh.positions.len()];
         for (v, f) in flags.iter_mut().enumerate() {
@@ -2286,10 +2289,7 @@ impl<'a> Run<'a> {
                 true
             };
         }
-        let tags = SharpTags::from_vertex_flags(mesh, &flags);
-        self.report.tagged_vertices = tags.vertices.len();
-        self.report.sharp_edges = tags.edges.len();
-        tags
+        flags
     }
 
     #[inline(never)] // one call per run; kept out of line so profiles show it

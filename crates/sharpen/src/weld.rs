@@ -19,7 +19,6 @@
 //! had two of them disappear. A cluster is left alone when it touches the boundary, when the
 //! merge would break the manifold around it, or when a changed triangle would be a sliver.
 
-use crate::SharpTags;
 use glam::DVec3;
 use whet_mesh::{CornerTable, FaceId, Mesh, VertexId};
 
@@ -386,22 +385,16 @@ pub(crate) struct Restored {
 }
 
 impl Restored {
-    /// `tags` of the output with every restored vertex tagged as the vertex it had been merged
-    /// into was (the sharp edges recomputed on `mesh`).
-    pub fn retag(&self, tags: &SharpTags, mesh: &Mesh) -> SharpTags {
-        let mut flags = vec![false; mesh.positions.len()];
-        for v in &tags.vertices {
-            if let Some(f) = flags.get_mut(v.index()) {
-                *f = true;
-            }
-        }
+    /// Tags every restored vertex as the vertex it had been merged into was, in the tagged
+    /// vertex flags of the output.
+    pub fn retag(&self, tagged: &mut [bool]) {
+        let before = tagged.to_vec();
         for &(v, root) in &self.members {
-            let tagged = tags.is_tagged(VertexId(root));
-            if let Some(f) = flags.get_mut(v as usize) {
-                *f = tagged;
+            let root_tagged = before.get(root as usize).copied().unwrap_or(false);
+            if let Some(f) = tagged.get_mut(v as usize) {
+                *f = root_tagged;
             }
         }
-        SharpTags::from_vertex_flags(mesh, &flags)
     }
 }
 
