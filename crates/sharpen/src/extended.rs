@@ -1087,27 +1087,28 @@ fn crease_vertices(run: &mut Run) {
             }
         }
     }
-    // Rebuild the lists with the additions (applied after the scan: order independent).
-    if extra.is_empty() {
-        return;
-    }
+    // The additions, applied after the scan (order independent): each vertex that gains
+    // labels gets its list again at the end, its own planes then the new ones by label (the
+    // old entries stay, unreferenced, as `move_to_corner` leaves them).
     extra.sort_by_key(|(v, lp)| (*v, lp.label));
-    let mut lps = Vec::with_capacity(run.s.lps.len() + extra.len());
-    let mut i = 0;
-    for v in 0..nv {
-        let start = lps.len() as u32;
-        lps.extend_from_slice(planes_of(run, v as u32));
-        while i < extra.len() && extra[i].0 as usize == v {
-            if lps.len() - (start as usize) < u8::MAX as usize {
-                lps.push(extra[i].1);
-            }
-            i += 1;
+    for group in extra.chunk_by(|x, y| x.0 == y.0) {
+        let v = group[0].0 as usize;
+        let start = run.s.lps.len();
+        let own = run.s.lp_start[v];
+        if own != NONE {
+            let own = own as usize;
+            run.s
+                .lps
+                .extend_from_within(own..own + run.s.lp_len[v] as usize);
         }
-        let len = lps.len() - start as usize;
-        run.s.lp_start[v] = if len == 0 { NONE } else { start };
-        run.s.lp_len[v] = len as u8;
+        for &(_, lp) in group {
+            if run.s.lps.len() - start < u8::MAX as usize {
+                run.s.lps.push(lp);
+            }
+        }
+        run.s.lp_start[v] = start as u32;
+        run.s.lp_len[v] = (run.s.lps.len() - start) as u8;
     }
-    run.s.lps = lps;
 }
 
 /// Whether giving `v` the label `lp` makes a triangle around it reach three surfaces that its
