@@ -195,6 +195,8 @@ pub(crate) struct Scratch {
     /// edge (brown edges join regions, and only ever get added later), and a strong turn is
     /// one.
     pub rough: Vec<u32>,
+    /// The corners facing a boundary edge ([`Run::smooth_edges`]).
+    pub open: Vec<u32>,
 }
 
 fn reset<T: Clone>(v: &mut Vec<T>, n: usize, x: T) {
@@ -669,6 +671,7 @@ impl<'a> Run<'a> {
         let mut smooth = 0;
         let s = &mut *self.s;
         s.rough.clear();
+        s.open.clear();
         let opposite = self.table.opposites();
         for (c, (&a, &o)) in s.angles.iter().zip(opposite).enumerate() {
             // Only the lower corner of an interior edge holds its angle (-1 elsewhere).
@@ -676,7 +679,9 @@ impl<'a> Run<'a> {
                 s.cflags[c] |= C_BROWN;
                 s.cflags[o as usize] |= C_BROWN;
                 smooth += 1;
-            } else if o != NONE && (c as u32) < o {
+            } else if o == NONE {
+                s.open.push(c as u32);
+            } else if (c as u32) < o {
                 s.rough.push(c as u32);
             }
         }
@@ -755,17 +760,23 @@ impl<'a> Run<'a> {
     fn paint_red(&mut self) {
         let mesh = self.mesh;
         let table = self.table;
-        let nt = mesh.triangles.len();
         let s = &mut *self.s;
-        // Filter 1: red (core) vertices, all of whose edges are brown.
-        for (t, tri) in mesh.triangles.iter().enumerate() {
-            let cf = &s.cflags[3 * t..3 * t + 3];
-            for (j, (after, before)) in AFTER_BEFORE.into_iter().enumerate() {
-                let v = tri[j] as usize;
-                s.vflags[v] |= V_USED;
-                if cf[after] & cf[before] & C_BROWN == 0 {
-                    s.vflags[v] |= V_NOT_SMOOTH;
-                }
+        let opposite = table.opposites();
+        // Filter 1: red (core) vertices, all of whose edges are brown. A vertex is used when
+        // it has a corner, and not smooth when an edge at it is not brown: a boundary edge,
+        // or an interior edge the smooth pass listed as rough that no later step turned
+        // brown (curved walls add brown edges, none are taken away).
+        for (v, f) in s.vflags.iter_mut().enumerate() {
+            if table.vertex_corner(VertexId(v as u32)).is_some() {
+                *f |= V_USED;
+            }
+        }
+        let cv = table.corner_vertices();
+        for &c in s.open.iter().chain(&s.rough) {
+            let c = c as usize;
+            if s.cflags[c] & C_BROWN == 0 {
+                s.vflags[cv[next(c)] as usize] |= V_NOT_SMOOTH;
+                s.vflags[cv[prev(c)] as usize] |= V_NOT_SMOOTH;
             }
         }
         for f in s.vflags.iter_mut() {
@@ -773,33 +784,47 @@ impl<'a> Run<'a> {
                 *f |= V_CORE;
             }
         }
-        // Filter 2: triangles with a core vertex.
+        // Filter 2: triangles with a core vertex; the others are listed for filter 3.
+        let mut pending = std::mem::take(&mut s.gray);
+        pending.clear();
         for (t, tri) in mesh.triangles.iter().enumerate() {
             if tri.iter().any(|&v| s.vflags[v as usize] & V_CORE != 0) {
                 s.tflags[t] |= T_RED;
+            } else {
+                pending.push(t as u32);
             }
         }
-        // Filter 3: grow through brown edges (explicit stack). The red set is the closure of
-        // the core triangles, so growing from each in turn gives what growing from all at once
-        // does, and the stack holds only the triangles the growth adds, not every red one (a
-        // grown triangle is looked at again when the scan reaches it, and adds nothing).
-        let opposite = table.opposites();
+        // Filter 3: the closure of the core triangles through brown edges. A triangle joins
+        // when a brown edge leads to a red one (brown flags are set on both corners of an
+        // edge), and the growth from it (explicit stack) takes every triangle it reaches; a
+        // triangle reached only through a later one is taken by that one's growth. The same
+        // set as growing from every red triangle, for a look at the few that are not.
         let mut stack = std::mem::take(&mut s.stack);
         stack.clear();
-        for t0 in 0..nt {
-            if s.tflags[t0] & T_RED == 0 {
+        for &u in &pending {
+            let u = u as usize;
+            if s.tflags[u] & T_RED != 0 {
                 continue;
             }
+            let joins = (3 * u..3 * u + 3).any(|c| {
+                let o = opposite[c];
+                s.cflags[c] & C_BROWN != 0 && o != NONE && s.tflags[o as usize / 3] & T_RED != 0
+            });
+            if !joins {
+                continue;
+            }
+            s.tflags[u] |= T_RED;
             let tflags = &mut s.tflags;
-            grow_through_brown(t0, &s.cflags, opposite, &mut stack, |u| {
-                let grows = tflags[u] & T_RED == 0;
+            grow_through_brown(u, &s.cflags, opposite, &mut stack, |w| {
+                let grows = tflags[w] & T_RED == 0;
                 if grows {
-                    tflags[u] |= T_RED;
+                    tflags[w] |= T_RED;
                 }
                 grows
             });
         }
         s.stack = stack;
+        s.gray = pending;
     }
 
     /// Curved walls (`SharpenOptions::curved_wall_factor`, docs/sharpen.md): after filter 3,
