@@ -77,12 +77,23 @@ pub(crate) struct LabelPlane {
 /// Labels regions and border vertices, then classifies the gray vertices.
 pub(crate) fn classify(run: &mut Run) {
     run.surface_samples = is_surface_sampling(run.mesh);
+    // Regions with a deep vertex (marching cubes only; see `tube_creases`).
+    let mut thick: Vec<bool> = Vec::new();
     if !run.surface_samples {
         // Deep vertices depend on filter 1's core flags alone, which demotion leaves as they
         // are: one pass serves both demotions.
         let (deep, of) = deep_vertices(run);
         demote_corridors(run, &deep, &of);
         demote_strip_arms(run, &deep);
+        for (&d, &r) in deep.iter().zip(&of) {
+            if d && r != NONE {
+                let r = r as usize;
+                if thick.len() <= r {
+                    thick.resize(r + 1, false);
+                }
+                thick[r] = true;
+            }
+        }
     }
     // The red set is final from here on.
     run.list_gray_triangles();
@@ -95,7 +106,7 @@ pub(crate) fn classify(run: &mut Run) {
     crease_vertices(run);
     run.s.blend_creases.clear();
     if !run.surface_samples {
-        blend_creases(run);
+        blend_creases(run, &thick);
     }
     snap_chamfer_vertices(run);
 }
@@ -139,8 +150,11 @@ pub(crate) const BLEND_PRIOR_EDGES: f64 = 4.0;
 /// most 0.07 on every crease of five edges or more of cube, pyramid, fandisk and cylinder at
 /// 32-128 cells (generic rotations, grid-aligned and slightly turned). A fillet under about
 /// 1.5 cells in radius looks like a cut crease (blend at 32 cells: 0-0.26) and is sharpened.
+///
+/// The creases between the facets of a thin tube ([`tube_creases`]) are listed too: their
+/// planes are no more trusted than a blend's. `thick` tells the regions with a deep vertex.
 #[inline(never)] // one call per run; kept out of line so profiles show it
-fn blend_creases(run: &mut Run) {
+fn blend_creases(run: &mut Run, thick: &[bool]) {
     // (smaller label, larger label, edge has both ends inside)
     let mut counts: Vec<(u32, u32, bool)> = Vec::new();
     for (c, _) in run.non_red_edges() {
@@ -177,13 +191,94 @@ fn blend_creases(run: &mut Run) {
         }
     }
     counts.sort_unstable();
+    let creases: Vec<(u32, u32)> = counts
+        .chunk_by(|p, q| (p.0, p.1) == (q.0, q.1))
+        .map(|g| (g[0].0, g[0].1))
+        .collect();
+    let tubes = tube_creases(&creases, |r| {
+        !thick.get(r as usize).copied().unwrap_or(false)
+    });
     for group in counts.chunk_by(|p, q| (p.0, p.1) == (q.0, q.1)) {
         let inside = group.iter().filter(|e| e.2).count();
         let (n, k) = (group.len() as f64, BLEND_PRIOR_EDGES);
-        if inside as f64 + k * global > BLEND_FRACTION * (n + k) {
-            run.s.blend_creases.push((group[0].0, group[0].1));
+        let pair = (group[0].0, group[0].1);
+        if inside as f64 + k * global > BLEND_FRACTION * (n + k)
+            || tubes.binary_search(&pair).is_ok()
+        {
+            run.s.blend_creases.push(pair);
         }
     }
+}
+
+/// A closed band of at least this many thin regions, each meeting exactly two others of the
+/// band at a crease, is the wall of a tube ([`tube_creases`]). Measured (2026-12-05, ninth
+/// session; docs/results.md, "Tubes of thin facets"): the torus-box's hole turned near a grid
+/// axis forms bands of 8 facets at 25 cells; the synth fandisk's thin regions meet in groups
+/// of 2-7 with more creases than a band has (one closed band of 3 at 48 cells, generic
+/// rotation, a corner where three narrow faces meet, which the rule must leave alone: at 3
+/// the table's fandisk 48 r1 lost RMS gain, 3.05x -> 2.89x). 5 changes no row of the
+/// marching-cubes table.
+pub(crate) const TUBE_FACETS: usize = 5;
+
+/// Marching cubes: the creases between the facets of a *thin tube*, out of the sorted label
+/// pairs `creases` (smaller label first), where `thin(label)` tells a region without a deep
+/// vertex (a corridor the corridor test kept, as a real narrow face). A hole's wall or a
+/// boss a few cells across, turned near a grid axis, comes out of marching cubes as flat
+/// grid-aligned strips, each its own thin region, each meeting the two next to it at a
+/// crease: the planes of two neighbours meet outside the round wall (by `r (1 / cos(t/2) -
+/// 1)` for strips turned by `t`: 16 % of the radius for the torus-box's 8 strips at 25
+/// cells), and every strip is flat, so the consistency test sees nothing curved. Such a
+/// closed band of at least [`TUBE_FACETS`] thin regions, each with exactly two creases to
+/// others of the band, is taken for a tube and its creases are not sharpened (the creases
+/// between a strip and a thick face, a hole's rim, still are). Sorted.
+fn tube_creases(creases: &[(u32, u32)], thin: impl Fn(u32) -> bool) -> Vec<(u32, u32)> {
+    let pairs: Vec<(u32, u32)> = creases
+        .iter()
+        .copied()
+        .filter(|&(a, b)| thin(a) && thin(b))
+        .collect();
+    if pairs.len() < TUBE_FACETS {
+        return Vec::new();
+    }
+    let mut labels: Vec<u32> = pairs.iter().flat_map(|&(a, b)| [a, b]).collect();
+    labels.sort_unstable();
+    labels.dedup();
+    let index = |x: u32| labels.partition_point(|&l| l < x);
+    // Components through thin-thin creases (union-find), with their sizes and whether every
+    // member has exactly two creases: a connected component of such members is one closed
+    // band.
+    let n = labels.len();
+    let mut root: Vec<usize> = (0..n).collect();
+    fn find(root: &mut [usize], mut x: usize) -> usize {
+        while root[x] != x {
+            root[x] = root[root[x]];
+            x = root[x];
+        }
+        x
+    }
+    let mut degree = vec![0usize; n];
+    for &(a, b) in &pairs {
+        let (i, j) = (index(a), index(b));
+        degree[i] += 1;
+        degree[j] += 1;
+        let (ri, rj) = (find(&mut root, i), find(&mut root, j));
+        if ri != rj {
+            root[ri.max(rj)] = ri.min(rj);
+        }
+    }
+    let (mut size, mut band) = (vec![0usize; n], vec![true; n]);
+    for i in 0..n {
+        let r = find(&mut root, i);
+        size[r] += 1;
+        band[r] &= degree[i] == 2;
+    }
+    pairs
+        .into_iter()
+        .filter(|&(a, _)| {
+            let r = find(&mut root, index(a));
+            band[r] && size[r] >= TUBE_FACETS
+        })
+        .collect()
 }
 
 /// Whether labels `a` and `b` meet in a rounded blend ([`blend_creases`]).
@@ -1925,5 +2020,59 @@ fn better(best: Option<f64>, d: f64) -> bool {
     match best {
         None => true,
         Some(b) => d < b,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The creases of a closed band of `n` labels from `first` on.
+    fn band(first: u32, n: u32) -> Vec<(u32, u32)> {
+        (0..n)
+            .map(|i| {
+                let (a, b) = (first + i, first + (i + 1) % n);
+                (a.min(b), a.max(b))
+            })
+            .collect()
+    }
+
+    fn sorted(mut v: Vec<(u32, u32)>) -> Vec<(u32, u32)> {
+        v.sort_unstable();
+        v.dedup();
+        v
+    }
+
+    #[test]
+    fn a_closed_band_of_thin_regions_is_a_tube() {
+        let all_thin = |_: u32| true;
+        // Eight facets around a hole: every crease between them.
+        let ring = sorted(band(10, 8));
+        assert_eq!(tube_creases(&ring, all_thin), ring);
+        // With a thick face along the band (the hole's rim): only the band's creases.
+        let mut with_rim = ring.clone();
+        with_rim.extend((10..18).map(|l| (0, l)));
+        let with_rim = sorted(with_rim);
+        assert_eq!(tube_creases(&with_rim, |l| l != 0), ring);
+        // Too few facets: a corner where narrow faces meet, left alone.
+        let small = sorted(band(10, TUBE_FACETS as u32 - 1));
+        assert!(tube_creases(&small, all_thin).is_empty());
+    }
+
+    #[test]
+    fn open_chains_and_dense_groups_are_not_tubes() {
+        // An open chain (a curved face's strips between two real creases).
+        let mut chain = band(10, 8);
+        chain.retain(|&(a, b)| (a, b) != (10, 17));
+        assert!(tube_creases(&sorted(chain), |_| true).is_empty());
+        // A band with a chord: a member with three creases.
+        let mut chord = band(10, 8);
+        chord.push((10, 14));
+        assert!(tube_creases(&sorted(chord), |_| true).is_empty());
+        // A band one of whose members is thick.
+        assert!(tube_creases(&sorted(band(10, 8)), |l| l != 13).is_empty());
+        // Two bands: both are tubes.
+        let two = sorted([band(10, 6), band(30, 5)].concat());
+        assert_eq!(tube_creases(&two, |_| true), two);
     }
 }

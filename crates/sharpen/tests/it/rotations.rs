@@ -180,13 +180,49 @@ fn a_coarse_near_axis_fandisk_keeps_its_max() {
 }
 
 #[test]
-#[ignore = "known gap: 3 of 120 near-axis samplings at 25-37 cells come out with a larger max error"]
+fn a_near_axis_hole_is_not_cut_into_a_polygon() {
+    // A case of the near-axis sweep below: torus-box at 25 cells turned by 0.6 degrees. Its
+    // hole, about three cells in radius, comes out of marching cubes as a band of 8 flat
+    // grid-aligned strips, each a thin region; the crease lines of neighbouring strips lie
+    // outside the round wall, and sharpening them moved a row of vertices into the part:
+    // max 1.335 % -> 1.764 %, RMS 0.1510 % -> 0.1624 % of the diagonal (Metro, 100k samples a
+    // direction). Since tubes of thin facets are left alone (`TUBE_FACETS`): max 1.311 %,
+    // RMS 0.0930 %.
+    let axis = DVec3::new(
+        0.008343512590354957,
+        0.23646319450722295,
+        0.9716046230031503,
+    );
+    let params =
+        ShapeParams::default().with_rotation(DQuat::from_axis_angle(axis, 0.010425430626566435));
+    let shape = Shape::new(ShapeKind::TorusBox, &params).unwrap();
+    let input = marching_cubes(&shape, 25).unwrap();
+    let out = sharpen(&input, &SharpenOptions::DEFAULT).unwrap();
+    let truth = shape.truth_mesh();
+    let before = crate::support::error(&truth, &input, Some(100_000));
+    let after = crate::support::error(&truth, &out.mesh, Some(100_000));
+    // The RMS bound is loose (measured 1.62x), so that it holds whatever the next change
+    // does to the hole's rim; the point is that the wall is not cut.
+    assert!(
+        after.max_pct <= before.max_pct && after.rms_pct * 1.3 < before.rms_pct,
+        "max {:.3} -> {:.3} %, RMS {:.4} -> {:.4} %",
+        before.max_pct,
+        after.max_pct,
+        before.rms_pct,
+        after.rms_pct
+    );
+}
+
+#[test]
+#[ignore = "known gap: 2 of 120 near-axis samplings at 33 and 37 cells come out with a larger max error"]
 fn near_axis_aligned_rotations_never_make_the_error_worse() {
     // Measured 2026-12-05 (Metro, 100k samples a direction): 4 of these 120 cases had a
     // larger max than their input (fandisk at 24, 33 and 37 cells: 0.70x, 0.76x, 0.86x;
     // torus-box at 25: 0.76x, RMS 0.93x), none a larger RMS otherwise; 3 since the
     // unlabelled-corner rule needs regions of `MIN_CORNER_REGION` triangles (fandisk 24:
-    // 1.46x, test `a_coarse_near_axis_fandisk_keeps_its_max`). Traced on fandisk 48
+    // 1.46x, test `a_coarse_near_axis_fandisk_keeps_its_max`); 2 since tubes of thin facets are
+    // left alone (torus-box 25: 1.02x, RMS 1.62x, test
+    // `a_near_axis_hole_is_not_cut_into_a_polygon`). Traced on fandisk 48
     // turned by 0.16 degrees (max 0.79x, `sharpen_diag` with `DIAG_ROT`): a cone split into
     // two smooth regions by a staircase along a grid line, whose two tangent planes and the
     // top face's meet 1.15 edges from the crease vertex that the unlabelled-corner rule moved

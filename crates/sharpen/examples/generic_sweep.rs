@@ -1,0 +1,69 @@
+//! Throwaway: random generic rotations of every sharp synth shape, worse cases listed.
+#![allow(clippy::unwrap_used)]
+mod support;
+use glam::{DQuat, DVec3};
+use whet_sharpen::{sharpen, Method, SharpenOptions};
+use whet_synth::{marching_cubes, Shape, ShapeKind, ShapeParams};
+
+struct Lcg(u64);
+impl Lcg {
+    fn unit(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let seed: u64 = args.get(1).and_then(|a| a.parse().ok()).unwrap_or(7);
+    let n: usize = args.get(2).and_then(|a| a.parse().ok()).unwrap_or(40);
+    let method = match args.get(3).map(String::as_str) {
+        Some("papers") => Method::Papers,
+        _ => Method::Extended,
+    };
+    let kinds = [
+        ShapeKind::Cube,
+        ShapeKind::Box,
+        ShapeKind::Pyramid,
+        ShapeKind::Octahedron,
+        ShapeKind::Cylinder,
+        ShapeKind::Cone,
+        ShapeKind::Fandisk,
+        ShapeKind::ThinFace,
+        ShapeKind::TorusBox,
+    ];
+    let mut rng = Lcg(seed);
+    let mut worse = 0;
+    for i in 0..n {
+        let kind = kinds[i % kinds.len()];
+        let res = 24 + (rng.unit() * 80.0) as usize;
+        let axis = DVec3::new(
+            rng.unit() * 2.0 - 1.0,
+            rng.unit() * 2.0 - 1.0,
+            rng.unit() * 2.0 - 1.0 + 1e-3,
+        )
+        .normalize();
+        let angle = rng.unit() * std::f64::consts::PI;
+        let shape = Shape::new(
+            kind,
+            &ShapeParams::default().with_rotation(DQuat::from_axis_angle(axis, angle)),
+        )
+        .unwrap();
+        let input = marching_cubes(&shape, res).unwrap();
+        let out = sharpen(&input, &SharpenOptions::DEFAULT.with_method(method)).unwrap();
+        let truth = shape.truth_mesh();
+        let b = support::error(&truth, &input, Some(50_000));
+        let a = support::error(&truth, &out.mesh, Some(50_000));
+        let bad = a.rms_pct > b.rms_pct || a.max_pct > b.max_pct;
+        if bad {
+            worse += 1;
+        }
+        println!("{}{} res {res} DIAG_ROT={},{},{},{}: RMS {:.4} -> {:.4} ({:.2}x), max {:.3} -> {:.3} ({:.2}x)",
+            if bad { "WORSE " } else { "" }, kind.name(), axis.x, axis.y, axis.z, angle,
+            b.rms_pct, a.rms_pct, b.rms_pct / a.rms_pct, b.max_pct, a.max_pct, b.max_pct / a.max_pct);
+    }
+    println!("{worse} of {n} worse");
+}
