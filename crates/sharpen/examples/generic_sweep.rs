@@ -15,17 +15,7 @@ mod support;
 use glam::{DQuat, DVec3};
 use whet_sharpen::{sharpen, Method, SharpenOptions};
 use whet_synth::{marching_cubes, Shape, ShapeKind, ShapeParams};
-
-struct Lcg(u64);
-impl Lcg {
-    fn unit(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
+use whet_testkit::Lcg;
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -35,17 +25,10 @@ fn main() {
         Some("papers") => Method::Papers,
         _ => Method::Extended,
     };
-    let kinds = [
-        ShapeKind::Cube,
-        ShapeKind::Box,
-        ShapeKind::Pyramid,
-        ShapeKind::Octahedron,
-        ShapeKind::Cylinder,
-        ShapeKind::Cone,
-        ShapeKind::Fandisk,
-        ShapeKind::ThinFace,
-        ShapeKind::TorusBox,
-    ];
+    let kinds: Vec<ShapeKind> = ShapeKind::ALL
+        .into_iter()
+        .filter(|k| k.has_sharp_edges())
+        .collect();
     let mut rng = Lcg(seed);
     let mut worse = 0;
     for i in 0..n {

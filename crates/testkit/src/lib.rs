@@ -15,6 +15,22 @@ use std::path::{Path, PathBuf};
 
 pub mod meshes;
 
+/// A small deterministic generator for sweeps whose cases must not change between runs
+/// (Knuth's MMIX linear congruential step; the top 53 bits as a float).
+#[derive(Clone, Debug)]
+pub struct Lcg(pub u64);
+
+impl Lcg {
+    /// The next number, uniform in [0, 1).
+    pub fn unit(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
 /// The workspace root (the folder holding the root `Cargo.toml`).
 pub fn workspace_root() -> PathBuf {
     // This crate lives at <root>/crates/testkit.
