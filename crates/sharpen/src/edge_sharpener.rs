@@ -187,7 +187,8 @@ pub(crate) struct Scratch {
     /// The triangles that are not red once the red set is final (ascending), listed by
     /// [`Run::list_gray_triangles`]: every non-red edge lies between two of them, so the
     /// passes that look for chamfer edges walk their corners instead of the whole mesh's
-    /// (a few percent of it on a fine sampling).
+    /// (a few percent of it on a fine sampling). Filters 2 and 3 use its memory for the
+    /// triangles filter 2 leaves gray, before the red set is final.
     pub gray: Vec<u32>,
     /// The lower corner of every interior edge that [`Run::smooth_edges`] did not find smooth
     /// (ascending): its angle is at least the smooth threshold, or it has none (a triangle

@@ -77,23 +77,15 @@ pub(crate) struct LabelPlane {
 /// Labels regions and border vertices, then classifies the gray vertices.
 pub(crate) fn classify(run: &mut Run) {
     run.surface_samples = is_surface_sampling(run.mesh);
-    // Regions with a deep vertex (marching cubes only; see `tube_creases`).
+    // Regions with a deep vertex (marching cubes only: the corridors and `tube_creases`).
     let mut thick: Vec<bool> = Vec::new();
     if !run.surface_samples {
         // Deep vertices depend on filter 1's core flags alone, which demotion leaves as they
-        // are: one pass serves both demotions.
+        // are: one pass serves both demotions (and the regions keep their labels).
         let (deep, of) = deep_vertices(run);
-        demote_corridors(run, &deep, &of);
+        thick = thick_regions(run, &deep, &of);
+        demote_corridors(run, &thick);
         demote_strip_arms(run, &deep);
-        for (&d, &r) in deep.iter().zip(&of) {
-            if d && r != NONE {
-                let r = r as usize;
-                if thick.len() <= r {
-                    thick.resize(r + 1, false);
-                }
-                thick[r] = true;
-            }
-        }
     }
     // The red set is final from here on.
     run.list_gray_triangles();
@@ -530,26 +522,10 @@ pub(crate) const CORRIDOR_ON_PLANE: f64 = 0.1;
 /// vertices are classified like any chamfer vertex. This reaches what the papers' core test
 /// (filter 1) misses on coarse samplings.
 #[inline(never)] // one call per run; kept out of line so profiles show it
-fn demote_corridors(run: &mut Run, deep: &[bool], of: &[u32]) {
+fn demote_corridors(run: &mut Run, thick: &[bool]) {
     let nv = run.mesh.positions.len();
     let nt = run.mesh.triangles.len();
-    let nregions = run
-        .s
-        .region
-        .iter()
-        .filter(|&&r| r != NONE)
-        .max()
-        .map_or(0, |&m| m as usize + 1);
-    if nregions == 0 {
-        return;
-    }
-    // A region is thick when it has a deep vertex.
-    let mut thick = vec![false; nregions];
-    for v in 0..nv {
-        if deep[v] && of[v] != NONE {
-            thick[of[v] as usize] = true;
-        }
-    }
+    let nregions = thick.len();
     if thick.iter().all(|&t| t) {
         return;
     }
@@ -596,6 +572,25 @@ fn demote_corridors(run: &mut Run, deep: &[bool], of: &[u32]) {
         })
         .collect();
     demote(run, &gone);
+}
+
+/// Per region label (up to the highest one in use), whether it has a deep vertex (see
+/// [`deep_vertices`]): the thin ones are the corridors' candidates.
+fn thick_regions(run: &Run, deep: &[bool], of: &[u32]) -> Vec<bool> {
+    let nregions = run
+        .s
+        .region
+        .iter()
+        .filter(|&&r| r != NONE)
+        .max()
+        .map_or(0, |&m| m as usize + 1);
+    let mut thick = vec![false; nregions];
+    for (&d, &r) in deep.iter().zip(of) {
+        if d && r != NONE {
+            thick[r as usize] = true;
+        }
+    }
+    thick
 }
 
 /// The *deep* vertices, each a core vertex (filter 1: all its edges smooth, so its whole fan
