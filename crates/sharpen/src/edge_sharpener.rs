@@ -222,6 +222,7 @@ fn reset<T: Clone>(v: &mut Vec<T>, n: usize, x: T) {
 pub struct EdgeSharpener {
     options: SharpenOptions,
     scratch: Scratch,
+    weld_scratch: crate::weld::WeldScratch,
 }
 
 impl EdgeSharpener {
@@ -230,6 +231,7 @@ impl EdgeSharpener {
         EdgeSharpener {
             options,
             scratch: Scratch::default(),
+            weld_scratch: crate::weld::WeldScratch::default(),
         }
     }
 
@@ -332,12 +334,17 @@ impl EdgeSharpener {
             }));
         }
         let welded = if self.options.method == Method::Extended && self.options.weld_clusters {
-            crate::weld::weld_clusters(mesh, &table, self.options.min_angle_degrees.to_radians())
-                .and_then(|w| {
-                    let welded_table = crate::weld::welded_table(&table, &w)
-                        .or_else(|| CornerTable::new(&w.mesh).ok())?;
-                    Some((w, welded_table))
-                })
+            crate::weld::weld_clusters(
+                mesh,
+                &table,
+                self.options.min_angle_degrees.to_radians(),
+                &mut self.weld_scratch,
+            )
+            .and_then(|w| {
+                let welded_table = crate::weld::welded_table(&table, &w)
+                    .or_else(|| CornerTable::new(&w.mesh).ok())?;
+                Some((w, welded_table))
+            })
         } else {
             None
         };
@@ -354,7 +361,6 @@ impl EdgeSharpener {
             // of every region (synth pyramid 64 r1: 2.29 -> 2.35 degrees, a corner lost).
             run.weld_patch = Some(crate::weld::WeldPatch {
                 input: mesh,
-                input_table: &table,
                 welded: w,
             });
             let (mut out, mut parents, mut tagged) = run.run(judge.as_deref_mut());
@@ -656,11 +662,11 @@ impl<'a> Run<'a> {
     fn smooth_edges(&mut self) {
         let (mut sum, mut count) = self.edge_angles();
         if let Some(patch) = self.weld_patch {
-            // The input's own edges in place of the welded ones around the clusters: the
-            // same sum as a pass over the input, for the price of the clusters' fans.
-            let (removed, added) = patch.angle_sums(self.table, &self.s.normals);
-            sum += added.0 - removed.0;
-            count = (count + added.1).saturating_sub(removed.1);
+            // The input's own edges in place of the welded ones around the clusters (which
+            // `edge_angles` left out): the input's sum, for the price of the clusters' fans.
+            let (added, n) = patch.welded.input_edges;
+            sum += added;
+            count += n;
         }
         let mean = if count > 0 { sum / count as f64 } else { 0.0 };
         let threshold = self.opts.smooth_factor * mean;
@@ -691,7 +697,8 @@ impl<'a> Run<'a> {
 
     /// Face normals, the angle of every interior edge (at its lower corner; -1 elsewhere) and
     /// the longest edge; returns the sum of the angles and their count (edges between two
-    /// triangles with a normal).
+    /// triangles with a normal), on a welded input without the edges beside a triangle
+    /// welding changed (where [`crate::weld::Welded::input_edges`] has the input's).
     fn edge_angles(&mut self) -> (f64, usize) {
         let mesh = self.mesh;
         let nt = mesh.triangles.len();
@@ -712,6 +719,9 @@ impl<'a> Run<'a> {
         // corner arrays are walked in step with the triangles (no index checks per corner).
         let opposite = self.table.opposites();
         let normals = &s.normals[..];
+        // A bit per welded triangle that welding changed (none on an input not welded).
+        let patch: &[u64] = self.weld_patch.map_or(&[], |p| &p.welded.welded_changed);
+        let in_patch = |k: usize| patch.get(k / 64).is_some_and(|w| w >> (k % 64) & 1 != 0);
         for (t, ((tri, o3), a3)) in mesh
             .triangles
             .iter()
@@ -743,8 +753,10 @@ impl<'a> Run<'a> {
                 }
                 let angle = normal_angle(n1, n2);
                 a3[j] = angle as f32;
-                sum += angle;
-                count += 1;
+                if !in_patch(t) && !in_patch(o as usize / 3) {
+                    sum += angle;
+                    count += 1;
+                }
             }
         }
         self.max_edge = max_edge2.sqrt();
