@@ -60,6 +60,17 @@ impl CornerTable {
         CornerTable::build(triangles, vertex_count, true, &mut Scratch::new())
     }
 
+    /// [`CornerTable::from_triangles`] in the memory of `scratch` (its working arrays taken
+    /// from it and given back, the table's own taken from it): the same table, or the same
+    /// error. [`CornerTable::recycle`] gives the table's arrays back.
+    pub fn from_triangles_in(
+        triangles: &[[u32; 3]],
+        vertex_count: usize,
+        scratch: &mut Scratch,
+    ) -> Result<CornerTable, MeshError> {
+        CornerTable::build(triangles, vertex_count, true, scratch)
+    }
+
     /// [`CornerTable::from_triangles`] without the walk around closed fans: it checks
     /// indices, edges, orientation and that no vertex starts two open fans, but a vertex
     /// whose corners form several closed fans (two closed surfaces pinched at it) is not

@@ -198,6 +198,10 @@ pub(crate) struct Scratch {
     pub rough: Vec<u32>,
     /// The corners facing a boundary edge ([`Run::smooth_edges`]).
     pub open: Vec<u32>,
+    /// The sliver pass's slot arrays (`crate::slivers::Output`) and per-vertex slot-list
+    /// heads, kept between runs (on a million triangles some 40 MB the kernel faulted in
+    /// afresh at every run).
+    pub slots: crate::slivers::SlotArrays,
 }
 
 fn reset<T: Clone>(v: &mut Vec<T>, n: usize, x: T) {
@@ -223,6 +227,18 @@ pub struct EdgeSharpener {
     options: SharpenOptions,
     scratch: Scratch,
     weld_scratch: crate::weld::WeldScratch,
+    pool: Pool,
+}
+
+/// Vectors kept between runs for the tables and the welded mesh ([`whet_mesh::Scratch`]); a
+/// clone of the engine starts with an empty pool.
+#[derive(Debug, Default)]
+struct Pool(whet_mesh::Scratch);
+
+impl Clone for Pool {
+    fn clone(&self) -> Self {
+        Pool::default()
+    }
 }
 
 impl EdgeSharpener {
@@ -232,6 +248,7 @@ impl EdgeSharpener {
             options,
             scratch: Scratch::default(),
             weld_scratch: crate::weld::WeldScratch::default(),
+            pool: Pool::default(),
         }
     }
 
@@ -300,7 +317,7 @@ impl EdgeSharpener {
     fn sharpen_once(
         &mut self,
         mesh: &Mesh,
-        mut judge: Option<&mut (dyn crate::SnapJudge + '_)>,
+        judge: Option<&mut (dyn crate::SnapJudge + '_)>,
     ) -> Result<Sharpened, Error> {
         let start = Instant::now();
         if let Some(v) = mesh.positions.iter().position(|p| !p.is_finite()) {
@@ -326,7 +343,26 @@ impl EdgeSharpener {
                 report,
             });
         }
-        let table = CornerTable::new(mesh).map_err(Error::InvalidInput)?;
+        // The input's table in memory kept between runs (and given back below): a
+        // million-triangle input's table and its working arrays are some 80 MB, which the
+        // kernel faulted in afresh at every run.
+        let table =
+            CornerTable::from_triangles_in(&mesh.triangles, mesh.positions.len(), &mut self.pool.0)
+                .map_err(Error::InvalidInput)?;
+        let out = self.sharpen_on_table(mesh, &table, report, start, judge);
+        table.recycle(&mut self.pool.0);
+        out
+    }
+
+    /// [`Self::sharpen_once`] once the input's table is built.
+    fn sharpen_on_table(
+        &mut self,
+        mesh: &Mesh,
+        table: &CornerTable,
+        report: SharpenReport,
+        start: Instant,
+        mut judge: Option<&mut (dyn crate::SnapJudge + '_)>,
+    ) -> Result<Sharpened, Error> {
         if mesh.positions.len() as u64 + 2 * mesh.triangles.len() as u64 >= u64::from(NONE) {
             return Err(Error::InvalidInput(MeshError::TooLarge {
                 what: "vertex count after sharpening",
@@ -334,74 +370,93 @@ impl EdgeSharpener {
             }));
         }
         let welded = if self.options.method == Method::Extended && self.options.weld_clusters {
+            let pool = &mut self.pool.0;
             crate::weld::weld_clusters(
                 mesh,
-                &table,
+                table,
                 self.options.min_angle_degrees.to_radians(),
                 &mut self.weld_scratch,
+                pool,
             )
             .and_then(|w| {
-                let welded_table = crate::weld::welded_table(&table, &w)
+                let welded_table = crate::weld::welded_table(table, &w, pool)
                     .or_else(|| CornerTable::new(&w.mesh).ok())?;
                 Some((w, welded_table))
             })
         } else {
             None
         };
-        if let Some((w, welded_table)) = &welded {
-            let mut run = Run::new(
-                &w.mesh,
-                welded_table,
-                &self.options,
-                &mut self.scratch,
-                report.clone(),
-            );
-            // The smooth threshold is the input's: welding straightens or kinks the triangles
-            // around each cluster, and the mean angle it would measure moved the threshold
-            // of every region (synth pyramid 64 r1: 2.29 -> 2.35 degrees, a corner lost).
-            run.weld_patch = Some(crate::weld::WeldPatch {
-                input: mesh,
-                welded: w,
-            });
-            let (mut out, mut parents, mut tagged) = run.run(judge.as_deref_mut());
-            for p in &mut parents {
-                *p = FaceId(w.input_triangle[p.index()]);
-            }
-            let mut report = run.report;
-            // A run that sharpened nothing gives the input back, as it would unwelded (the
-            // clusters of an already sharp or smooth mesh are not the sharpener's business).
-            if report.new_vertices > 0 || report.moved_input_vertices > 0 {
-                let restored = crate::weld::restore_untouched(
-                    mesh,
-                    &table,
-                    w,
-                    welded_table,
-                    &mut out,
-                    &mut parents,
-                );
-                if restored.clusters > 0 {
-                    report.output_triangles = out.triangles.len();
-                    restored.retag(&mut tagged);
-                }
-                // The sharp edges once, on the final mesh (only edges at a restored cluster
-                // changed, and those are sharp only where its kept vertex is tagged).
-                let tags = sharp_tags(&mut report, &out, &tagged);
-                report.welded_vertices = restored.still_welded;
-                report.time = start.elapsed();
-                return Ok(Sharpened {
-                    mesh: out,
-                    parents,
-                    tags,
-                    report,
-                });
+        if let Some((w, welded_table)) = welded {
+            let sharpened =
+                self.sharpen_welded(mesh, table, &w, &welded_table, &report, start, &mut judge);
+            w.recycle(&mut self.pool.0);
+            welded_table.recycle(&mut self.pool.0);
+            if let Some(out) = sharpened {
+                return Ok(out);
             }
         }
-        let mut run = Run::new(mesh, &table, &self.options, &mut self.scratch, report);
+        let mut run = Run::new(mesh, table, &self.options, &mut self.scratch, report);
         let (out, parents, tagged) = run.run(judge);
         let mut report = run.report;
         let tags = sharp_tags(&mut report, &out, &tagged);
         report.time = start.elapsed();
         Ok(Sharpened {
+            mesh: out,
+            parents,
+            tags,
+            report,
+        })
+    }
+
+    /// The run on the welded input `w` (table `welded_table`) with the untouched clusters
+    /// put back; `None` when it sharpened nothing (the caller runs on the input instead).
+    #[allow(clippy::too_many_arguments)] // the pieces of one pass, split for the borrows
+    fn sharpen_welded(
+        &mut self,
+        mesh: &Mesh,
+        table: &CornerTable,
+        w: &crate::weld::Welded,
+        welded_table: &CornerTable,
+        report: &SharpenReport,
+        start: Instant,
+        judge: &mut Option<&mut (dyn crate::SnapJudge + '_)>,
+    ) -> Option<Sharpened> {
+        let mut run = Run::new(
+            &w.mesh,
+            welded_table,
+            &self.options,
+            &mut self.scratch,
+            report.clone(),
+        );
+        // The smooth threshold is the input's: welding straightens or kinks the triangles
+        // around each cluster, and the mean angle it would measure moved the threshold of
+        // every region (synth pyramid 64 r1: 2.29 -> 2.35 degrees, a corner lost).
+        run.weld_patch = Some(crate::weld::WeldPatch {
+            input: mesh,
+            welded: w,
+        });
+        let (mut out, mut parents, mut tagged) = run.run(judge.as_deref_mut());
+        for p in &mut parents {
+            *p = FaceId(w.input_triangle[p.index()]);
+        }
+        let mut report = run.report;
+        // A run that sharpened nothing gives the input back, as it would unwelded (the
+        // clusters of an already sharp or smooth mesh are not the sharpener's business).
+        if report.new_vertices == 0 && report.moved_input_vertices == 0 {
+            return None;
+        }
+        let restored =
+            crate::weld::restore_untouched(mesh, table, w, welded_table, &mut out, &mut parents);
+        if restored.clusters > 0 {
+            report.output_triangles = out.triangles.len();
+            restored.retag(&mut tagged);
+        }
+        // The sharp edges once, on the final mesh (only edges at a restored cluster changed,
+        // and those are sharp only where its kept vertex is tagged).
+        let tags = sharp_tags(&mut report, &out, &tagged);
+        report.welded_vertices = restored.still_welded;
+        report.time = start.elapsed();
+        Some(Sharpened {
             mesh: out,
             parents,
             tags,

@@ -61,6 +61,20 @@ pub(crate) struct Output {
     min_angle_rad: f64,
 }
 
+/// The memory of an [`Output`]'s slots and of its slot lists' per-vertex arrays, kept in
+/// the run's scratch between runs.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct SlotArrays {
+    tris: Vec<[u32; 3]>,
+    alive: Vec<bool>,
+    parent: Vec<u32>,
+    is_new: Vec<bool>,
+    slot_of_input: Vec<u32>,
+    head: Vec<u32>,
+    tail: Vec<u32>,
+    len: Vec<u32>,
+}
+
 /// Union-find with path halving that also lists each set's members: a linked list per set
 /// that starts at its root, the smaller list appended to the larger (so a member moves
 /// O(log n) times), in flat arrays rather than one vector per set.
@@ -146,15 +160,29 @@ impl SlotLists {
     /// Longest list whose membership test walks it.
     const SCAN: u32 = 32;
 
-    fn new(vertex_count: usize) -> SlotLists {
+    /// Empty lists for `vertex_count` vertices, in the memory of `arrays` (given back by
+    /// [`SlotLists::recycle`]).
+    fn new(vertex_count: usize, arrays: &mut SlotArrays) -> SlotLists {
+        let take = |v: &mut Vec<u32>, x: u32| {
+            let mut v = std::mem::take(v);
+            v.clear();
+            v.resize(vertex_count, x);
+            v
+        };
         SlotLists {
-            head: vec![NONE; vertex_count],
-            tail: vec![NONE; vertex_count],
-            len: vec![0; vertex_count],
+            head: take(&mut arrays.head, NONE),
+            tail: take(&mut arrays.tail, NONE),
+            len: take(&mut arrays.len, 0),
             slot: Vec::new(),
             next: Vec::new(),
             long: Default::default(),
         }
+    }
+
+    fn recycle(self, arrays: &mut SlotArrays) {
+        arrays.head = self.head;
+        arrays.tail = self.tail;
+        arrays.len = self.len;
     }
     fn key(v: u32, s: u32) -> u64 {
         (u64::from(v) << 32) | u64::from(s)
@@ -260,15 +288,23 @@ fn fixable(q: &[u32; 3], p: &[DVec3; 3], nv: u32) -> bool {
 
 impl Output {
     /// Lays out the output triangles from the run's subdivision.
-    pub(crate) fn assemble(run: &Run) -> Output {
+    pub(crate) fn assemble(run: &mut Run) -> Output {
         let nt = run.mesh.triangles.len();
         let extra = run.s.touched.len() * 3;
+        // The slot arrays of the last run, emptied.
+        fn empty<T>(v: &mut Vec<T>, n: usize) -> Vec<T> {
+            let mut v = std::mem::take(v);
+            v.clear();
+            v.reserve(n);
+            v
+        }
+        let a = &mut run.s.slots;
         let mut o = Output {
-            tris: Vec::with_capacity(nt + extra),
-            alive: Vec::new(),
-            parent: Vec::with_capacity(nt + extra),
-            is_new: Vec::with_capacity(nt + extra),
-            slot_of_input: Vec::with_capacity(nt),
+            tris: empty(&mut a.tris, nt + extra),
+            alive: empty(&mut a.alive, nt + extra),
+            parent: empty(&mut a.parent, nt + extra),
+            is_new: empty(&mut a.is_new, nt + extra),
+            slot_of_input: empty(&mut a.slot_of_input, nt),
             ranges: Vec::with_capacity(run.s.touched.len()),
             min_angle_rad: run.opts.min_angle_degrees.to_radians(),
         };
@@ -288,7 +324,7 @@ impl Output {
                 o.is_new.push(false);
             }
         }
-        o.alive = vec![true; o.tris.len()];
+        o.alive.resize(o.tris.len(), true);
         o
     }
 
@@ -365,7 +401,8 @@ impl Output {
         if heap.is_empty() {
             return;
         }
-        let mut local = self.build_local(run);
+        let mut arrays = std::mem::take(&mut run.s.slots);
+        let mut local = self.build_local(run, &mut arrays);
         while let Some(Reverse((_, s))) = heap.pop() {
             let s = s as usize;
             if !self.alive[s] || !self.is_new[s] || self.badness(run, s).is_none() {
@@ -400,10 +437,12 @@ impl Output {
                 self.push_bad(run, &mut heap, x as usize);
             }
         }
+        local.slots.recycle(&mut arrays);
+        run.s.slots = arrays;
     }
 
-    fn build_local(&self, run: &Run) -> Local {
-        let mut slots = SlotLists::new(run.positions.len());
+    fn build_local(&self, run: &Run, arrays: &mut SlotArrays) -> Local {
+        let mut slots = SlotLists::new(run.positions.len(), arrays);
         for s in 0..self.tris.len() {
             if self.is_new[s] {
                 for &v in &self.tris[s] {
@@ -1008,6 +1047,12 @@ impl Output {
         r.moved_input_vertices = moved;
         r.output_vertices = positions.len();
         r.output_triangles = tris.len();
+        let a = &mut run.s.slots;
+        a.tris = self.tris;
+        a.alive = self.alive;
+        a.parent = self.parent;
+        a.is_new = self.is_new;
+        a.slot_of_input = self.slot_of_input;
         (Mesh::new(positions, tris), parents)
     }
 }
@@ -1039,7 +1084,7 @@ mod tests {
 
     #[test]
     fn slot_lists_keep_insertion_order_and_clear_per_vertex() {
-        let mut l = SlotLists::new(4);
+        let mut l = SlotLists::new(4, &mut SlotArrays::default());
         for (v, s) in [(1, 10), (2, 20), (1, 11), (3, 30), (1, 12), (2, 21)] {
             l.push(v, s);
         }
@@ -1056,7 +1101,7 @@ mod tests {
     #[test]
     fn slot_lists_hold_a_slot_once_per_vertex() {
         // A re-cut or flipped slot is pushed again at vertices that list it already.
-        let mut l = SlotLists::new(3);
+        let mut l = SlotLists::new(3, &mut SlotArrays::default());
         for (v, s) in [(1, 10), (1, 11), (1, 10), (2, 10), (1, 11), (2, 10)] {
             l.push(v, s);
         }

@@ -53,6 +53,18 @@ pub(crate) struct Welded {
     pub input_edges: (f64, usize),
 }
 
+impl Welded {
+    /// Gives the arrays back to `pool`.
+    pub fn recycle(self, pool: &mut whet_mesh::Scratch) {
+        pool.give(self.mesh.positions);
+        pool.give(self.mesh.triangles);
+        pool.give(self.input_triangle);
+        pool.give(self.welded_index);
+        pool.give(self.rep);
+        pool.give(self.welded_changed);
+    }
+}
+
 /// Working memory of [`weld_clusters`], kept between runs by the engine: a million-triangle
 /// input needs about 6 MB of it, which fresh each run cost page faults, and the merge
 /// checks of every cluster (thousands a run) ran on vectors allocated per cluster.
@@ -81,11 +93,13 @@ struct MergeScratch {
 /// Welds the clusters of `mesh` (whose table is `table`), each seeded by a triangle whose
 /// shortest edge is under [`CLUSTER_EDGE`] mean edges; `min_angle` (radians) is the sliver
 /// threshold no changed triangle may fall under. `None` when no cluster could be welded.
+/// The welded mesh's arrays are taken from `pool` ([`Welded::recycle`] gives them back).
 pub(crate) fn weld_clusters(
     mesh: &Mesh,
     table: &CornerTable,
     min_angle: f64,
     scratch: &mut WeldScratch,
+    pool: &mut whet_mesh::Scratch,
 ) -> Option<Welded> {
     let nv = mesh.positions.len();
     // One pass over the triangles for the mean edge length (each edge once, in the order
@@ -155,7 +169,8 @@ pub(crate) fn weld_clusters(
             continue;
         }
         if rep.is_empty() {
-            rep = (0..nv as u32).collect();
+            rep = pool.take_empty(nv);
+            rep.extend(0..nv as u32);
             alive.clear();
             alive.resize(mesh.triangles.len(), true);
             in_cluster.clear();
@@ -208,12 +223,14 @@ pub(crate) fn weld_clusters(
         }
     }
     if merged == 0 {
+        pool.give(rep);
         return None;
     }
-    let mut triangles = Vec::with_capacity(mesh.triangles.len());
-    let mut input_triangle = Vec::with_capacity(mesh.triangles.len());
-    let mut welded_index = Vec::with_capacity(mesh.triangles.len());
-    let mut welded_changed = vec![0u64; mesh.triangles.len().div_ceil(64)];
+    let nt = mesh.triangles.len();
+    let mut triangles = pool.take_empty(nt);
+    let mut input_triangle = pool.take_empty(nt);
+    let mut welded_index = pool.take_empty(nt);
+    let mut welded_changed = pool.take_filled(nt.div_ceil(64), 0u64);
     // Only merged vertices map elsewhere, and a removed triangle holds one.
     let is_changed = |t: usize| mesh.triangles[t].iter().any(|&v| rep[v as usize] != v);
     let (mut sum, mut count) = (0.0f64, 0usize);
@@ -254,8 +271,10 @@ pub(crate) fn weld_clusters(
         }
     }
     welded_changed.truncate(triangles.len().div_ceil(64));
+    let mut positions = pool.take_empty(nv);
+    positions.extend_from_slice(&mesh.positions);
     Some(Welded {
-        mesh: Mesh::new(mesh.positions.clone(), triangles),
+        mesh: Mesh::new(positions, triangles),
         input_triangle,
         welded_index,
         rep,
@@ -333,17 +352,22 @@ fn merge_cluster(
 /// which pair up anew by their vertices. (The merge checks keep every fan one cycle, so this
 /// pairing is the whole table.) `None` when an edge does not pair with exactly one reversed
 /// twin, or the arrays are out of range: then the caller builds the table from scratch,
-/// which says why.
-pub(crate) fn welded_table(input_table: &CornerTable, welded: &Welded) -> Option<CornerTable> {
+/// which says why. The table's arrays are taken from `pool`.
+pub(crate) fn welded_table(
+    input_table: &CornerTable,
+    welded: &Welded,
+    pool: &mut whet_mesh::Scratch,
+) -> Option<CornerTable> {
     const NONE: u32 = u32::MAX;
     let new_index = &welded.welded_index;
     if new_index.len() != input_table.triangle_count() {
         return None;
     }
     let nt = welded.mesh.triangles.len();
-    let triangles = welded.mesh.triangles.clone();
+    let mut triangles = pool.take_empty(nt);
+    triangles.extend_from_slice(&welded.mesh.triangles);
     let input_opposite = input_table.opposites();
-    let mut opposite = vec![NONE; 3 * nt];
+    let mut opposite = pool.take_filled(3 * nt, NONE);
     // Corners whose opposite triangle was removed, by their edge (from, to).
     let mut loose: Vec<(u64, u32)> = Vec::new();
     for (k, &t) in welded.input_triangle.iter().enumerate() {
@@ -371,7 +395,7 @@ pub(crate) fn welded_table(input_table: &CornerTable, welded: &Welded) -> Option
         let i = loose.binary_search_by_key(&twin, |e| e.0).ok()?;
         opposite[c as usize] = loose[i].1;
     }
-    CornerTable::from_relabelled(triangles, opposite, welded.mesh.positions.len()).ok()
+    CornerTable::from_relabelled_in(triangles, opposite, welded.mesh.positions.len(), pool).ok()
 }
 
 /// An input and its welding, for a run on the welded mesh: its smooth threshold is the
@@ -762,6 +786,7 @@ mod tests {
             &table,
             1f64.to_radians(),
             &mut WeldScratch::default(),
+            &mut whet_mesh::Scratch::new(),
         )
         .unwrap();
         assert_eq!(merged(&w), 1);
@@ -795,6 +820,7 @@ mod tests {
             &table,
             1f64.to_radians(),
             &mut WeldScratch::default(),
+            &mut whet_mesh::Scratch::new(),
         )
         .unwrap();
         (mesh, table, w)
@@ -809,16 +835,17 @@ mod tests {
             &table,
             1f64.to_radians(),
             &mut WeldScratch::default(),
+            &mut whet_mesh::Scratch::new(),
         )
         .unwrap();
         assert_eq!(
-            welded_table(&table, &w),
+            welded_table(&table, &w, &mut whet_mesh::Scratch::new()),
             Some(CornerTable::new(&w.mesh).unwrap())
         );
         let (_, table, w) = welded_cube();
         assert!(merged(&w) > 10, "{}", merged(&w));
         assert_eq!(
-            welded_table(&table, &w),
+            welded_table(&table, &w, &mut whet_mesh::Scratch::new()),
             Some(CornerTable::new(&w.mesh).unwrap())
         );
     }
@@ -842,7 +869,7 @@ mod tests {
             (sum, count)
         }
         let (mesh, table, w) = welded_cube();
-        let wt = welded_table(&table, &w).unwrap();
+        let wt = welded_table(&table, &w, &mut whet_mesh::Scratch::new()).unwrap();
         let (ws, wc) = sums(&w.mesh, &wt);
         // The welded edges beside no changed triangle, as the smooth pass adds them.
         let changed = |t: usize| w.welded_changed[t / 64] >> (t % 64) & 1 != 0;
@@ -868,7 +895,7 @@ mod tests {
     #[test]
     fn untouched_clusters_come_back_as_they_were() {
         let (mesh, table, w) = welded_cube();
-        let wt = welded_table(&table, &w).unwrap();
+        let wt = welded_table(&table, &w, &mut whet_mesh::Scratch::new()).unwrap();
         // A run that changed nothing: everything comes back, in the input's order.
         let mut out = w.mesh.clone();
         let mut parents: Vec<FaceId> = w.input_triangle.iter().map(|&t| FaceId(t)).collect();
@@ -930,7 +957,8 @@ mod tests {
             &far,
             &far_table,
             1f64.to_radians(),
-            &mut WeldScratch::default()
+            &mut WeldScratch::default(),
+            &mut whet_mesh::Scratch::new()
         )
         .is_none());
         // A minimum angle no remapped triangle meets refuses the merge.
@@ -938,7 +966,8 @@ mod tests {
             &mesh,
             &table,
             50f64.to_radians(),
-            &mut WeldScratch::default()
+            &mut WeldScratch::default(),
+            &mut whet_mesh::Scratch::new()
         )
         .is_none());
         // A tetrahedron with two coincident vertices: merging them leaves a two-triangle
@@ -952,7 +981,8 @@ mod tests {
             &tet,
             &tet_table,
             1f64.to_radians(),
-            &mut WeldScratch::default()
+            &mut WeldScratch::default(),
+            &mut whet_mesh::Scratch::new()
         )
         .is_none());
     }
@@ -968,6 +998,7 @@ mod tests {
             &table,
             1f64.to_radians(),
             &mut WeldScratch::default(),
+            &mut whet_mesh::Scratch::new(),
         )
         .unwrap();
         assert_eq!(merged(&w), 1);
@@ -980,7 +1011,8 @@ mod tests {
             &open,
             &table,
             1f64.to_radians(),
-            &mut WeldScratch::default()
+            &mut WeldScratch::default(),
+            &mut whet_mesh::Scratch::new()
         )
         .is_none());
     }

@@ -165,6 +165,17 @@ fn deterministic_and_engine_reuse() {
     assert_eq!(first.mesh, fresh.mesh);
     assert_eq!(first.tags, fresh.tags);
     assert_eq!(first.parents, fresh.parents);
+    // The engine keeps its tables', welding's and sliver pass's memory: a smaller mesh
+    // after a larger one (arrays longer than it needs, holding the larger one's values)
+    // comes out as from a fresh engine.
+    let (_, large) = sampled(ShapeKind::Cube, 40, 1);
+    let _ = engine.sharpen(&large).unwrap();
+    let after_large = engine.sharpen(&b).unwrap();
+    let fresh_b = sharpen(&b, &SharpenOptions::DEFAULT).unwrap();
+    assert_eq!(after_large.mesh, fresh_b.mesh);
+    assert_eq!(after_large.tags, fresh_b.tags);
+    assert_eq!(after_large.parents, fresh_b.parents);
+    assert!(fresh_b.report.new_vertices > 0, "the pyramid is sharpened");
 }
 
 #[test]
