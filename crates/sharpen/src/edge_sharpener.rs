@@ -202,6 +202,9 @@ pub(crate) struct Scratch {
     /// heads, kept between runs (on a million triangles some 40 MB the kernel faulted in
     /// afresh at every run).
     pub slots: crate::slivers::SlotArrays,
+    /// On a welded input: the output triangles holding a cluster's kept vertex, ascending
+    /// (`crate::slivers::Output::finish`).
+    pub around_roots: Vec<u32>,
 }
 
 fn reset<T: Clone>(v: &mut Vec<T>, n: usize, x: T) {
@@ -388,7 +391,7 @@ impl EdgeSharpener {
         };
         if let Some((w, welded_table)) = welded {
             let sharpened =
-                self.sharpen_welded(mesh, table, &w, &welded_table, &report, start, &mut judge);
+                self.sharpen_welded(mesh, &w, &welded_table, &report, start, &mut judge);
             w.recycle(&mut self.pool.0);
             welded_table.recycle(&mut self.pool.0);
             if let Some(out) = sharpened {
@@ -410,11 +413,9 @@ impl EdgeSharpener {
 
     /// The run on the welded input `w` (table `welded_table`) with the untouched clusters
     /// put back; `None` when it sharpened nothing (the caller runs on the input instead).
-    #[allow(clippy::too_many_arguments)] // the pieces of one pass, split for the borrows
     fn sharpen_welded(
         &mut self,
         mesh: &Mesh,
-        table: &CornerTable,
         w: &crate::weld::Welded,
         welded_table: &CornerTable,
         report: &SharpenReport,
@@ -435,18 +436,21 @@ impl EdgeSharpener {
             input: mesh,
             welded: w,
         });
+        // Parents come out named by their input triangles (the output pass maps them).
         let (mut out, mut parents, mut tagged) = run.run(judge.as_deref_mut());
-        for p in &mut parents {
-            *p = FaceId(w.input_triangle[p.index()]);
-        }
         let mut report = run.report;
         // A run that sharpened nothing gives the input back, as it would unwelded (the
         // clusters of an already sharp or smooth mesh are not the sharpener's business).
         if report.new_vertices == 0 && report.moved_input_vertices == 0 {
             return None;
         }
-        let restored =
-            crate::weld::restore_untouched(mesh, table, w, welded_table, &mut out, &mut parents);
+        let restored = crate::weld::restore_untouched(
+            mesh,
+            w,
+            &mut out,
+            &mut parents,
+            &self.scratch.around_roots,
+        );
         if restored.clusters > 0 {
             report.output_triangles = out.triangles.len();
             restored.retag(&mut tagged);

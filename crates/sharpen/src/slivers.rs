@@ -997,22 +997,38 @@ impl Output {
         // The output triangles holding a new vertex (the pieces: a few percent), renumbered
         // below without a second pass over all of them.
         let mut pieces: Vec<u32> = Vec::new();
+        // On a welded input: parents are named by their input triangle, and the triangles
+        // holding a cluster's kept vertex are listed for putting the clusters back
+        // (`crate::weld::restore_untouched`), in this pass rather than one more over the
+        // output.
+        let welded = run.weld_patch.map(|p| p.welded);
+        let input_of: &[u32] = welded.map_or(&[], |w| &w.input_triangle);
+        let mut around_roots = std::mem::take(&mut run.s.around_roots);
+        around_roots.clear();
         for (s, t) in self.tris.iter().enumerate() {
             if self.alive[s] {
                 let mut new = false;
+                let mut root = false;
                 for &v in t {
                     if v as usize >= nv {
                         remap[v as usize - nv] = 0;
                         new = true;
+                    } else if welded.is_some_and(|w| w.is_root(v)) {
+                        root = true;
                     }
                 }
                 if new {
                     pieces.push(tris.len() as u32);
                 }
+                if root {
+                    around_roots.push(tris.len() as u32);
+                }
                 tris.push(*t);
-                parents.push(FaceId(self.parent[s]));
+                let p = self.parent[s];
+                parents.push(FaceId(input_of.get(p as usize).copied().unwrap_or(p)));
             }
         }
+        run.s.around_roots = around_roots;
         let mut positions = std::mem::take(&mut run.positions);
         let mut next = nv as u32;
         let mut snapped = 0;

@@ -51,6 +51,51 @@ pub(crate) struct Welded {
     /// this one is the input's, up to the order of the additions: the run's smooth
     /// threshold is the input's (see `Run::smooth_edges`).
     pub input_edges: (f64, usize),
+    /// The merged clusters, for putting them back ([`restore_untouched`]).
+    pub clusters: Clusters,
+    /// A bit per input vertex: set on the clusters' kept vertices.
+    pub root_bits: Vec<u64>,
+}
+
+impl Welded {
+    /// Whether `v` is the kept vertex of a cluster (false past the input's vertices).
+    #[inline]
+    pub fn is_root(&self, v: u32) -> bool {
+        self.root_bits
+            .get(v as usize / 64)
+            .is_some_and(|w| w >> (v % 64) & 1 != 0)
+    }
+}
+
+/// The clusters [`weld_clusters`] merged, in merge order, as flat lists.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Clusters {
+    /// Each cluster's vertices, its kept vertex first; `member_ends` holds where each ends.
+    pub members: Vec<u32>,
+    pub member_ends: Vec<u32>,
+    /// Each cluster's input triangles around its vertices (those welding removed included),
+    /// ascending; `fan_ends` holds where each ends.
+    pub fans: Vec<u32>,
+    pub fan_ends: Vec<u32>,
+}
+
+impl Clusters {
+    /// Number of clusters.
+    pub fn len(&self) -> usize {
+        self.member_ends.len()
+    }
+
+    /// The vertices of cluster `c`, its kept vertex first.
+    pub fn members(&self, c: usize) -> &[u32] {
+        let start = if c == 0 { 0 } else { self.member_ends[c - 1] };
+        &self.members[start as usize..self.member_ends[c] as usize]
+    }
+
+    /// The input triangles around cluster `c`, ascending.
+    pub fn fan(&self, c: usize) -> &[u32] {
+        let start = if c == 0 { 0 } else { self.fan_ends[c - 1] };
+        &self.fans[start as usize..self.fan_ends[c] as usize]
+    }
 }
 
 impl Welded {
@@ -62,6 +107,7 @@ impl Welded {
         pool.give(self.welded_index);
         pool.give(self.rep);
         pool.give(self.welded_changed);
+        pool.give(self.root_bits);
     }
 }
 
@@ -153,6 +199,7 @@ pub(crate) fn weld_clusters(
     // Representative of each vertex (itself unless merged).
     let mut rep: Vec<u32> = Vec::new();
     let mut merged = 0usize;
+    let mut clusters = Clusters::default();
     refused.clear();
     refused_ends.clear();
     // Above this, a triangle's rounded shortest side cannot hide an exact one under `limit2`.
@@ -203,7 +250,16 @@ pub(crate) fn weld_clusters(
             // On the boundary (welding would change it), or not a marching-cubes cluster.
             continue;
         }
-        if let Some(n) = merge_cluster(mesh, table, cluster, &mut rep, alive, min_angle, merge) {
+        if let Some(n) = merge_cluster(
+            mesh,
+            table,
+            cluster,
+            &mut rep,
+            alive,
+            min_angle,
+            merge,
+            &mut clusters,
+        ) {
             merged += n;
         } else {
             refused.extend_from_slice(cluster);
@@ -218,7 +274,16 @@ pub(crate) fn weld_clusters(
     for &end in refused_ends.iter() {
         let cluster = &refused[start..end as usize];
         start = end as usize;
-        if let Some(n) = merge_cluster(mesh, table, cluster, &mut rep, alive, min_angle, merge) {
+        if let Some(n) = merge_cluster(
+            mesh,
+            table,
+            cluster,
+            &mut rep,
+            alive,
+            min_angle,
+            merge,
+            &mut clusters,
+        ) {
             merged += n;
         }
     }
@@ -280,13 +345,23 @@ pub(crate) fn weld_clusters(
         rep,
         welded_changed,
         input_edges: (sum, count),
+        root_bits: {
+            let mut bits = pool.take_filled(nv.div_ceil(64), 0u64);
+            for c in 0..clusters.len() {
+                let r = clusters.members(c)[0];
+                bits[r as usize / 64] |= 1 << (r % 64);
+            }
+            bits
+        },
+        clusters,
     })
 }
 
 /// Merges `cluster` into the member whose position turns the triangles around it least, if
 /// they stay an oriented manifold with no new sliver ([`merge_keeps_manifold`]): updates
-/// `rep` and `alive` and returns the number of vertices merged away; `None`, with `rep` as it
-/// was, when refused.
+/// `rep` and `alive`, appends the cluster to `merged` and returns the number of vertices
+/// merged away; `None`, with `rep` as it was, when refused.
+#[allow(clippy::too_many_arguments)] // the welding's state, passed down to each cluster
 fn merge_cluster(
     mesh: &Mesh,
     table: &CornerTable,
@@ -295,6 +370,7 @@ fn merge_cluster(
     alive: &mut [bool],
     min_angle: f64,
     scratch: &mut MergeScratch,
+    merged: &mut Clusters,
 ) -> Option<usize> {
     let MergeScratch {
         around,
@@ -309,6 +385,9 @@ fn merge_cluster(
     }
     around.sort_unstable();
     around.dedup();
+    // Every triangle around the cluster, kept for putting it back.
+    let fan_start = merged.fans.len();
+    merged.fans.extend_from_slice(around);
     around.retain(|&t| alive[t as usize]);
     // The member whose position turns the remapped triangles least: the largest cosine of
     // the worst turn (no arc cosine per candidate and triangle).
@@ -338,8 +417,15 @@ fn merge_cluster(
                 alive[t as usize] = false;
             }
         }
+        merged.fan_ends.push(merged.fans.len() as u32);
+        merged.members.push(root);
+        merged
+            .members
+            .extend(cluster.iter().copied().filter(|&v| v != root));
+        merged.member_ends.push(merged.members.len() as u32);
         Some(cluster.len() - 1)
     } else {
+        merged.fans.truncate(fan_start);
         for &v in cluster {
             rep[v as usize] = v;
         }
@@ -431,43 +517,40 @@ impl Restored {
     }
 }
 
-/// After a run on `welded` (the welding of `input`; their tables `input_table` and
-/// `welded_table`): puts back the clusters the run left untouched, as they were in the input.
+/// After a run on `welded` (the welding of `input`): puts back the clusters the run left
+/// untouched, as they were in the input.
 /// A cluster is untouched when its kept vertex did not move and every output triangle around
 /// it is a welded triangle as it was, of unmoved input vertices, all of them there. Clusters
 /// sharing an input triangle are put back together or not at all, so every fan put back is
 /// the input's. `out` and `parents` (input triangle indices) are rewritten in place; the
 /// triangles put back keep their place in parent order (an output without any change
-/// elsewhere is the input again).
+/// elsewhere is the input again). `around_roots` lists, ascending, the output triangles
+/// holding a kept vertex (the run's output pass collects them).
 pub(crate) fn restore_untouched(
     input: &Mesh,
-    input_table: &CornerTable,
     welded: &Welded,
-    welded_table: &CornerTable,
     out: &mut Mesh,
     parents: &mut Vec<FaceId>,
+    around_roots: &[u32],
 ) -> Restored {
     let nv = input.positions.len();
     let rep = &welded.rep;
+    let merged = &welded.clusters;
     // Cluster index of every vertex of a cluster (its kept vertex included), and a bit per
     // kept vertex (the scan of the output tests three per triangle: a bitset stays in cache).
     let mut cluster = vec![NO_CLUSTER; nv];
-    let mut roots: Vec<u32> = Vec::new();
-    let mut clustered: Vec<u32> = Vec::new();
+    let mut roots: Vec<u32> = Vec::with_capacity(merged.len());
     let mut root_bits = vec![0u64; nv.div_ceil(64)];
-    for v in 0..nv {
-        let r = rep[v] as usize;
-        if r != v {
-            if cluster[r] == NO_CLUSTER {
-                cluster[r] = roots.len() as u32;
-                roots.push(r as u32);
-                clustered.push(r as u32);
-                root_bits[r / 64] |= 1 << (r % 64);
-            }
-            cluster[v] = cluster[r];
-            clustered.push(v as u32);
+    for c in 0..merged.len() {
+        let members = merged.members(c);
+        let r = members[0];
+        roots.push(r);
+        root_bits[r as usize / 64] |= 1 << (r % 64);
+        for &v in members {
+            cluster[v as usize] = c as u32;
         }
     }
+    let clustered = &merged.members;
     let n = roots.len();
     // Bits for every output vertex (new ones clear), so the scan of the output tests its
     // three vertices without a range check or a branch each.
@@ -485,20 +568,22 @@ pub(crate) fn restore_untouched(
         .iter()
         .map(|&r| out.positions.get(r as usize) != Some(&input.positions[r as usize]))
         .collect();
-    // Output triangles around each kept vertex: as many as welded ones, each as it was.
-    let mut missing: Vec<i64> = roots
-        .iter()
-        .map(|&r| welded_table.vertex_corners(VertexId(r)).count() as i64)
+    // Output triangles around each kept vertex: as many as welded ones (the triangles around
+    // its cluster that welding kept), each as it was.
+    let welded_index = &welded.welded_index;
+    let mut missing: Vec<i64> = (0..merged.len())
+        .map(|c| {
+            let fan = merged.fan(c).iter();
+            fan.filter(|&&t| welded_index[t as usize] != u32::MAX)
+                .count() as i64
+        })
         .collect();
     let unmoved =
         |v: u32| (v as usize) < nv && out.positions[v as usize] == input.positions[v as usize];
     // Output triangles around the kept vertices (only they can change below).
-    let mut around_roots: Vec<u32> = Vec::new();
-    for (i, (tri, p)) in out.triangles.iter().zip(parents.iter()).enumerate() {
-        if !touches(&root_bits, tri) {
-            continue;
-        }
-        around_roots.push(i as u32);
+    for &i in around_roots {
+        let (tri, p) = (&out.triangles[i as usize], parents[i as usize]);
+        debug_assert!(touches(&root_bits, tri));
         let same = *tri == input.triangles[p.index()].map(|x| rep[x as usize])
             && tri.iter().all(|&x| unmoved(x));
         for &v in tri {
@@ -522,13 +607,20 @@ pub(crate) fn restore_untouched(
         x
     }
     let mut group: Vec<u32> = (0..n as u32).collect();
-    // Input triangles around the clustered vertices (each at most three times).
-    let mut fan: Vec<u32> = clustered
-        .iter()
-        .flat_map(|&v| input_table.vertex_corners(VertexId(v)).map(|c| c.0 / 3))
-        .collect();
-    fan.sort_unstable();
-    fan.dedup();
+    // Input triangles around the clustered vertices, ascending (a bit each, then read in
+    // order: the clusters' fans overlap and come in merge order).
+    let mut fan_bits = vec![0u64; input.triangles.len().div_ceil(64)];
+    for &t in &merged.fans {
+        fan_bits[t as usize / 64] |= 1 << (t % 64);
+    }
+    let mut fan: Vec<u32> = Vec::with_capacity(merged.fans.len());
+    for (i, &word) in fan_bits.iter().enumerate() {
+        let mut w = word;
+        while w != 0 {
+            fan.push((64 * i) as u32 + w.trailing_zeros());
+            w &= w - 1;
+        }
+    }
     for &t in &fan {
         let cs = input.triangles[t as usize].map(|v| cluster[v as usize]);
         for k in 0..3 {
@@ -554,7 +646,7 @@ pub(crate) fn restore_untouched(
     let clusters = restore.iter().filter(|&&r| r).count();
     let mut members = Vec::new();
     let mut still_welded = 0;
-    for &v in &clustered {
+    for &v in clustered {
         let r = rep[v as usize];
         if r != v {
             if restore[cluster[v as usize] as usize] {
@@ -598,7 +690,7 @@ pub(crate) fn restore_untouched(
         })
         .collect();
     // The triangles around restored kept vertices become the input's again...
-    for &i in &around_roots {
+    for &i in around_roots {
         let i = i as usize;
         if touches(&restored_bits, &out.triangles[i]) {
             out.triangles[i] = input.triangles[parents[i].index()].map(map);
@@ -892,14 +984,31 @@ mod tests {
         assert!((kept + added - is).abs() < 1e-9 * is, "{kept} {added} {is}");
     }
 
+    /// The triangles of `out` holding a kept vertex, as the run's output pass lists them.
+    fn around_roots(w: &Welded, out: &Mesh) -> Vec<u32> {
+        let roots = out.triangles.iter().enumerate();
+        let roots = roots.filter(|(_, t)| t.iter().any(|&v| w.is_root(v)));
+        roots.map(|(i, _)| i as u32).collect()
+    }
+
     #[test]
     fn untouched_clusters_come_back_as_they_were() {
         let (mesh, table, w) = welded_cube();
         let wt = welded_table(&table, &w, &mut whet_mesh::Scratch::new()).unwrap();
+        // The triangles welding kept around a cluster are its kept vertex's fan in the
+        // welded table (the count the restoration expects around it).
+        assert!(w.clusters.len() > 1);
+        for c in 0..w.clusters.len() {
+            let root = w.clusters.members(c)[0];
+            let kept = w.clusters.fan(c).iter();
+            let kept = kept.filter(|&&t| w.welded_index[t as usize] != u32::MAX);
+            assert_eq!(kept.count(), wt.vertex_corners(VertexId(root)).count());
+        }
         // A run that changed nothing: everything comes back, in the input's order.
         let mut out = w.mesh.clone();
         let mut parents: Vec<FaceId> = w.input_triangle.iter().map(|&t| FaceId(t)).collect();
-        let r = restore_untouched(&mesh, &table, &w, &wt, &mut out, &mut parents);
+        let roots = around_roots(&w, &out);
+        let r = restore_untouched(&mesh, &w, &mut out, &mut parents, &roots);
         assert_eq!(r.still_welded, 0);
         assert_eq!(r.members.len(), merged(&w));
         assert_eq!(out.triangles, mesh.triangles);
@@ -921,7 +1030,8 @@ mod tests {
         let mut out = w.mesh.clone();
         out.positions[root as usize] += DVec3::splat(1e-3);
         let mut parents: Vec<FaceId> = w.input_triangle.iter().map(|&t| FaceId(t)).collect();
-        let r = restore_untouched(&mesh, &table, &w, &wt, &mut out, &mut parents);
+        let roots = around_roots(&w, &out);
+        let r = restore_untouched(&mesh, &w, &mut out, &mut parents, &roots);
         assert!(
             r.still_welded >= 1 && r.still_welded < merged(&w),
             "{}",
