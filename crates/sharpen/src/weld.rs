@@ -202,6 +202,10 @@ pub(crate) fn weld_clusters(
     let mut clusters = Clusters::default();
     refused.clear();
     refused_ends.clear();
+    let mut merge_one =
+        |cluster: &[u32], rep: &mut [u32], alive: &mut [bool], to: &mut Clusters| {
+            merge_cluster(mesh, table, cluster, rep, alive, min_angle, merge, to)
+        };
     // Above this, a triangle's rounded shortest side cannot hide an exact one under `limit2`.
     let candidate = limit2 * (1.0 + 1e-6);
     for (t, &tri) in mesh.triangles.iter().enumerate() {
@@ -250,16 +254,7 @@ pub(crate) fn weld_clusters(
             // On the boundary (welding would change it), or not a marching-cubes cluster.
             continue;
         }
-        if let Some(n) = merge_cluster(
-            mesh,
-            table,
-            cluster,
-            &mut rep,
-            alive,
-            min_angle,
-            merge,
-            &mut clusters,
-        ) {
+        if let Some(n) = merge_one(cluster, &mut rep, alive, &mut clusters) {
             merged += n;
         } else {
             refused.extend_from_slice(cluster);
@@ -274,16 +269,7 @@ pub(crate) fn weld_clusters(
     for &end in refused_ends.iter() {
         let cluster = &refused[start..end as usize];
         start = end as usize;
-        if let Some(n) = merge_cluster(
-            mesh,
-            table,
-            cluster,
-            &mut rep,
-            alive,
-            min_angle,
-            merge,
-            &mut clusters,
-        ) {
+        if let Some(n) = merge_one(cluster, &mut rep, alive, &mut clusters) {
             merged += n;
         }
     }
@@ -860,6 +846,19 @@ mod tests {
         (Mesh::new(positions, triangles), sliver)
     }
 
+    /// [`weld_clusters`] with fresh scratch, the sliver threshold in degrees.
+    fn weld(mesh: &Mesh, table: &CornerTable, min_angle_degrees: f64) -> Option<Welded> {
+        let scratch = &mut WeldScratch::default();
+        let radians = min_angle_degrees.to_radians();
+        weld_clusters(
+            mesh,
+            table,
+            radians,
+            scratch,
+            &mut whet_mesh::Scratch::new(),
+        )
+    }
+
     /// Vertices merged into another.
     fn merged(w: &Welded) -> usize {
         w.rep
@@ -873,14 +872,7 @@ mod tests {
     fn a_cluster_welds_into_one_of_its_vertices() {
         let (mesh, _) = split_bipyramid();
         let table = CornerTable::new(&mesh).unwrap();
-        let w = weld_clusters(
-            &mesh,
-            &table,
-            1f64.to_radians(),
-            &mut WeldScratch::default(),
-            &mut whet_mesh::Scratch::new(),
-        )
-        .unwrap();
+        let w = weld(&mesh, &table, 1.0).unwrap();
         assert_eq!(merged(&w), 1);
         // The two slivers are gone; every other triangle is kept, with one apex for both.
         assert_eq!(w.mesh.triangles.len(), mesh.triangles.len() - 2);
@@ -907,14 +899,7 @@ mod tests {
         .unwrap();
         let mesh = marching_cubes(&shape, 40).unwrap();
         let table = CornerTable::new(&mesh).unwrap();
-        let w = weld_clusters(
-            &mesh,
-            &table,
-            1f64.to_radians(),
-            &mut WeldScratch::default(),
-            &mut whet_mesh::Scratch::new(),
-        )
-        .unwrap();
+        let w = weld(&mesh, &table, 1.0).unwrap();
         (mesh, table, w)
     }
 
@@ -922,14 +907,7 @@ mod tests {
     fn the_welded_table_from_the_input_table_is_the_table_built_afresh() {
         let (mesh, _) = split_bipyramid();
         let table = CornerTable::new(&mesh).unwrap();
-        let w = weld_clusters(
-            &mesh,
-            &table,
-            1f64.to_radians(),
-            &mut WeldScratch::default(),
-            &mut whet_mesh::Scratch::new(),
-        )
-        .unwrap();
+        let w = weld(&mesh, &table, 1.0).unwrap();
         assert_eq!(
             welded_table(&table, &w, &mut whet_mesh::Scratch::new()),
             Some(CornerTable::new(&w.mesh).unwrap())
@@ -1063,23 +1041,9 @@ mod tests {
         let mut far = mesh.clone();
         far.positions[8] = DVec3::new(0.2, 0.0, 1.0);
         let far_table = CornerTable::new(&far).unwrap();
-        assert!(weld_clusters(
-            &far,
-            &far_table,
-            1f64.to_radians(),
-            &mut WeldScratch::default(),
-            &mut whet_mesh::Scratch::new()
-        )
-        .is_none());
+        assert!(weld(&far, &far_table, 1.0).is_none());
         // A minimum angle no remapped triangle meets refuses the merge.
-        assert!(weld_clusters(
-            &mesh,
-            &table,
-            50f64.to_radians(),
-            &mut WeldScratch::default(),
-            &mut whet_mesh::Scratch::new()
-        )
-        .is_none());
+        assert!(weld(&mesh, &table, 50.0).is_none());
         // A tetrahedron with two coincident vertices: merging them leaves a two-triangle
         // pillow, which is refused.
         let tet = Mesh::new(
@@ -1087,14 +1051,7 @@ mod tests {
             vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]],
         );
         let tet_table = CornerTable::new(&tet).unwrap();
-        assert!(weld_clusters(
-            &tet,
-            &tet_table,
-            1f64.to_radians(),
-            &mut WeldScratch::default(),
-            &mut whet_mesh::Scratch::new()
-        )
-        .is_none());
+        assert!(weld(&tet, &tet_table, 1.0).is_none());
     }
 
     #[test]
@@ -1103,27 +1060,13 @@ mod tests {
         // Open the bottom: the equator becomes a boundary, but the apex cluster is inside.
         mesh.triangles.drain(0..6);
         let table = CornerTable::new(&mesh).unwrap();
-        let w = weld_clusters(
-            &mesh,
-            &table,
-            1f64.to_radians(),
-            &mut WeldScratch::default(),
-            &mut whet_mesh::Scratch::new(),
-        )
-        .unwrap();
+        let w = weld(&mesh, &table, 1.0).unwrap();
         assert_eq!(merged(&w), 1);
         // A cluster on the boundary: split an equator vertex instead.
         let (mut open, _) = split_bipyramid();
         open.triangles.drain(0..6);
         open.triangles.retain(|t| !t.contains(&2));
         let table = CornerTable::new(&open).unwrap();
-        assert!(weld_clusters(
-            &open,
-            &table,
-            1f64.to_radians(),
-            &mut WeldScratch::default(),
-            &mut whet_mesh::Scratch::new()
-        )
-        .is_none());
+        assert!(weld(&open, &table, 1.0).is_none());
     }
 }
