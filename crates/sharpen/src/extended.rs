@@ -103,13 +103,15 @@ pub(crate) fn classify(run: &mut Run) {
     snap_chamfer_vertices(run);
 }
 
-/// A chamfer-edge end lies *inside* its own plane when it is more than this fraction of the
-/// edge's length under it (see [`blend_creases`]; fillet arcs put their gray vertices 0.1-0.3
-/// edges under the planes they are labelled with, cut creases theirs on them).
+/// A chamfer-edge end lies *off* its own plane when it is more than this fraction of the
+/// edge's length under it (inside) or over it (outside; see [`blend_creases`]; convex fillet
+/// arcs put their gray vertices 0.1-0.3 edges under the planes they are labelled with,
+/// concave ones over them, cut creases theirs on them).
 pub(crate) const BLEND_DEPTH: f64 = 0.05;
 
 /// A crease is a rounded blend when more than this fraction of its chamfer edges have both
-/// ends inside their own planes (after [`BLEND_PRIOR_EDGES`]; see [`blend_creases`]).
+/// ends off their own planes on one side (after [`BLEND_PRIOR_EDGES`]; see
+/// [`blend_creases`]).
 /// Swept with `sharpen_diag` on 31 cases of ten synth shapes (2026-12-03; docs/results.md,
 /// "Rounded blends"): 0.4 leaves the blend at 64 cells r0 1.4x worse in RMS than its input
 /// (0.3 and 0.2 restore it); 0.3 still sharpens the blend at 48 cells r0 (RMS 0.083 % against
@@ -143,11 +145,19 @@ pub(crate) const BLEND_PRIOR_EDGES: f64 = 4.0;
 /// 32-128 cells (generic rotations, grid-aligned and slightly turned). A fillet under about
 /// 1.5 cells in radius looks like a cut crease (blend at 32 cells: 0-0.26) and is sharpened.
 ///
+/// A concave blend (a fillet in a valley, or a concave face curved at the sampling's scale
+/// that the grid split into two smooth regions) is the mirror image: its arc lies outside
+/// both planes, whose line lies under it, and a snap there digs into the part (near-axis
+/// fandisk at 33 cells: a row of snaps 0.5 edges under a concave face, max 1.128 -> 1.481 %).
+/// An edge whose ends both lie more than [`BLEND_DEPTH`] outside their own planes counts as
+/// one whose ends both lie inside; a cut concave crease, like a convex one, has an end of
+/// nearly every chamfer edge on its plane.
+///
 /// The creases between the facets of a thin tube ([`tube_creases`]) are listed too: their
 /// planes are no more trusted than a blend's. `thick` tells the regions with a deep vertex.
 #[inline(never)] // one call per run; kept out of line so profiles show it
 fn blend_creases(run: &mut Run, thick: &[bool]) {
-    // (smaller label, larger label, edge has both ends inside)
+    // (smaller label, larger label, edge has both ends off their planes on one side)
     let mut counts: Vec<(u32, u32, bool)> = Vec::new();
     for (c, _) in run.non_red_edges() {
         let (a, b) = (run.cv(next(c)), run.cv(crate::edge_sharpener::prev(c)));
@@ -156,11 +166,13 @@ fn blend_creases(run: &mut Run, thick: &[bool]) {
         }
         let (pa, pb) = (run.positions[a as usize], run.positions[b as usize]);
         let depth = BLEND_DEPTH * pa.distance(pb);
-        let inside = |p: DVec3, lp: &LabelPlane| (p - lp.plane.point).dot(lp.plane.normal) < -depth;
+        let height = |p: DVec3, lp: &LabelPlane| (p - lp.plane.point).dot(lp.plane.normal);
         for x in planes_of(run, a) {
             for y in planes_of(run, b) {
                 let key = (x.label.min(y.label), x.label.max(y.label));
-                counts.push((key.0, key.1, inside(pa, x) && inside(pb, y)));
+                let (ha, hb) = (height(pa, x), height(pb, y));
+                let off = (ha < -depth && hb < -depth) || (ha > depth && hb > depth);
+                counts.push((key.0, key.1, off));
             }
         }
     }
