@@ -212,7 +212,11 @@ fn reset<T: Clone>(v: &mut Vec<T>, n: usize, x: T) {
     v.resize(n, x);
 }
 
-/// The EdgeSharpener engine: options plus scratch buffers kept between calls.
+/// The EdgeSharpener engine: options plus scratch buffers kept between calls (the run's
+/// arrays, the input's corner table, the welded mesh and its table, the sliver pass's slots),
+/// so that sharpening mesh after mesh works in memory already mapped. It holds that memory,
+/// sized by the largest mesh it has sharpened, until it is dropped; a clone starts with the
+/// run's arrays copied and the tables' pool empty.
 ///
 /// ```
 /// use whet_sharpen::{EdgeSharpener, SharpenOptions};
