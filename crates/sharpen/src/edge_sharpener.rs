@@ -385,8 +385,8 @@ impl EdgeSharpener {
                 &mut self.weld_scratch,
                 pool,
             )
-            .and_then(|w| {
-                let welded_table = crate::weld::welded_table(table, &w, pool)
+            .and_then(|mut w| {
+                let welded_table = crate::weld::welded_table(&mut w, pool)
                     .or_else(|| CornerTable::new(&w.mesh).ok())?;
                 Some((w, welded_table))
             })

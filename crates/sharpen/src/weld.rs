@@ -55,7 +55,13 @@ pub(crate) struct Welded {
     pub clusters: Clusters,
     /// A bit per input vertex: set on the clusters' kept vertices.
     pub root_bits: Vec<u64>,
+    /// The welded table's triangles and opposites as the copy left them, with the corners
+    /// still to pair across removed triangles, until [`welded_table`] takes them.
+    pub table_parts: Option<TableParts>,
 }
+
+/// See [`Welded::table_parts`].
+pub(crate) type TableParts = (Vec<[u32; 3]>, Vec<u32>, Vec<(u64, u32)>);
 
 impl Welded {
     /// Whether `v` is the kept vertex of a cluster (false past the input's vertices).
@@ -108,6 +114,10 @@ impl Welded {
         pool.give(self.rep);
         pool.give(self.welded_changed);
         pool.give(self.root_bits);
+        if let Some((triangles, opposite, _)) = self.table_parts {
+            pool.give(triangles);
+            pool.give(opposite);
+        }
     }
 }
 
@@ -278,10 +288,25 @@ pub(crate) fn weld_clusters(
         return None;
     }
     let nt = mesh.triangles.len();
-    let mut triangles = pool.take_empty(nt);
-    let mut input_triangle = pool.take_empty(nt);
-    let mut welded_index = pool.take_empty(nt);
+    // Each input triangle's welded index first, so that the copy below pairs the welded
+    // table's corners as it goes.
+    let mut welded_index: Vec<u32> = pool.take_empty(nt);
+    let mut next = 0u32;
+    welded_index.extend(alive.iter().map(|&a| {
+        let k = if a { next } else { u32::MAX };
+        next += u32::from(a);
+        k
+    }));
+    let nw = next as usize;
+    let mut triangles = pool.take_empty(nw);
+    let mut input_triangle = pool.take_empty(nw);
     let mut welded_changed = pool.take_filled(nt.div_ceil(64), 0u64);
+    // The welded table's arrays: a welded triangle's corners face the same triangles as in
+    // the input, except across the edges of removed triangles, paired anew by their vertices
+    // afterwards (`loose`, by edge from -> to). Every corner is written once below.
+    let mut table_triangles = pool.take_empty(nw);
+    let mut table_opposite = pool.take_overwritten(3 * nw, u32::MAX);
+    let mut loose: Vec<(u64, u32)> = Vec::new();
     // Only merged vertices map elsewhere, and a removed triangle holds one.
     let is_changed = |t: usize| mesh.triangles[t].iter().any(|&v| rep[v as usize] != v);
     let (mut sum, mut count) = (0.0f64, 0usize);
@@ -314,11 +339,25 @@ pub(crate) fn weld_clusters(
             if changed {
                 welded_changed[k / 64] |= 1 << (k % 64);
             }
-            welded_index.push(k as u32);
-            triangles.push(tri.map(|v| rep[v as usize]));
+            let welded = tri.map(|v| rep[v as usize]);
+            for (j, &o) in opposite[3 * t..3 * t + 3].iter().enumerate() {
+                let ot = welded_index
+                    .get(o as usize / 3)
+                    .copied()
+                    .unwrap_or(u32::MAX);
+                table_opposite[3 * k + j] = if o == u32::MAX {
+                    u32::MAX
+                } else if ot != u32::MAX {
+                    3 * ot + o % 3
+                } else {
+                    let (a, b) = (welded[(j + 1) % 3], welded[(j + 2) % 3]);
+                    loose.push((u64::from(a) << 32 | u64::from(b), (3 * k + j) as u32));
+                    u32::MAX
+                };
+            }
+            triangles.push(welded);
+            table_triangles.push(welded);
             input_triangle.push(t as u32);
-        } else {
-            welded_index.push(u32::MAX);
         }
     }
     welded_changed.truncate(triangles.len().div_ceil(64));
@@ -331,6 +370,7 @@ pub(crate) fn weld_clusters(
         rep,
         welded_changed,
         input_edges: (sum, count),
+        table_parts: Some((table_triangles, table_opposite, loose)),
         root_bits: {
             let mut bits = pool.take_filled(nv.div_ceil(64), 0u64);
             for c in 0..clusters.len() {
@@ -419,45 +459,18 @@ fn merge_cluster(
     }
 }
 
-/// The corner table of `welded`, from the table of its input: a welded triangle's corners
-/// face the same triangles as in the input, except across the edges of removed triangles,
-/// which pair up anew by their vertices. (The merge checks keep every fan one cycle, so this
-/// pairing is the whole table.) `None` when an edge does not pair with exactly one reversed
-/// twin, or the arrays are out of range: then the caller builds the table from scratch,
-/// which says why. The table's arrays are taken from `pool`.
+/// The corner table of `welded` (the welding of the input whose table gave its corners'
+/// opposites): a welded triangle's corners face the same triangles as in the input, except
+/// across the edges of removed triangles, which pair up anew by their vertices. (The merge
+/// checks keep every fan one cycle, so this pairing is the whole table.) `None` when an edge
+/// does not pair with exactly one reversed twin, the arrays are out of range, or the arrays
+/// were taken already: then the caller builds the table from scratch, which says why. Takes
+/// [`Welded::table_parts`]; the table's per-vertex array comes from `pool`.
 pub(crate) fn welded_table(
-    input_table: &CornerTable,
-    welded: &Welded,
+    welded: &mut Welded,
     pool: &mut whet_mesh::Scratch,
 ) -> Option<CornerTable> {
-    const NONE: u32 = u32::MAX;
-    let new_index = &welded.welded_index;
-    if new_index.len() != input_table.triangle_count() {
-        return None;
-    }
-    let nt = welded.mesh.triangles.len();
-    let mut triangles = pool.take_empty(nt);
-    triangles.extend_from_slice(&welded.mesh.triangles);
-    let input_opposite = input_table.opposites();
-    let mut opposite = pool.take_filled(3 * nt, NONE);
-    // Corners whose opposite triangle was removed, by their edge (from, to).
-    let mut loose: Vec<(u64, u32)> = Vec::new();
-    for (k, &t) in welded.input_triangle.iter().enumerate() {
-        for j in 0..3 {
-            let o = input_opposite[3 * t as usize + j];
-            if o == NONE {
-                continue;
-            }
-            let ot = new_index[o as usize / 3];
-            if ot != NONE {
-                opposite[3 * k + j] = 3 * ot + o % 3;
-            } else {
-                let a = triangles[k][(j + 1) % 3];
-                let b = triangles[k][(j + 2) % 3];
-                loose.push((u64::from(a) << 32 | u64::from(b), (3 * k + j) as u32));
-            }
-        }
-    }
+    let (triangles, mut opposite, mut loose) = welded.table_parts.take()?;
     loose.sort_unstable();
     if loose.windows(2).any(|w| w[0].0 == w[1].0) {
         return None;
@@ -465,7 +478,7 @@ pub(crate) fn welded_table(
     for &(key, c) in &loose {
         let twin = key.rotate_left(32);
         let i = loose.binary_search_by_key(&twin, |e| e.0).ok()?;
-        opposite[c as usize] = loose[i].1;
+        *opposite.get_mut(c as usize)? = loose[i].1;
     }
     CornerTable::from_relabelled_in(triangles, opposite, welded.mesh.positions.len(), pool).ok()
 }
@@ -907,15 +920,17 @@ mod tests {
     fn the_welded_table_from_the_input_table_is_the_table_built_afresh() {
         let (mesh, _) = split_bipyramid();
         let table = CornerTable::new(&mesh).unwrap();
-        let w = weld(&mesh, &table, 1.0).unwrap();
+        let mut w = weld(&mesh, &table, 1.0).unwrap();
         assert_eq!(
-            welded_table(&table, &w, &mut whet_mesh::Scratch::new()),
+            welded_table(&mut w, &mut whet_mesh::Scratch::new()),
             Some(CornerTable::new(&w.mesh).unwrap())
         );
-        let (_, table, w) = welded_cube();
+        // Its arrays are taken: a second call says so.
+        assert_eq!(welded_table(&mut w, &mut whet_mesh::Scratch::new()), None);
+        let (_, _, mut w) = welded_cube();
         assert!(merged(&w) > 10, "{}", merged(&w));
         assert_eq!(
-            welded_table(&table, &w, &mut whet_mesh::Scratch::new()),
+            welded_table(&mut w, &mut whet_mesh::Scratch::new()),
             Some(CornerTable::new(&w.mesh).unwrap())
         );
     }
@@ -938,8 +953,8 @@ mod tests {
             }
             (sum, count)
         }
-        let (mesh, table, w) = welded_cube();
-        let wt = welded_table(&table, &w, &mut whet_mesh::Scratch::new()).unwrap();
+        let (mesh, table, mut w) = welded_cube();
+        let wt = welded_table(&mut w, &mut whet_mesh::Scratch::new()).unwrap();
         let (ws, wc) = sums(&w.mesh, &wt);
         // The welded edges beside no changed triangle, as the smooth pass adds them.
         let changed = |t: usize| w.welded_changed[t / 64] >> (t % 64) & 1 != 0;
@@ -971,8 +986,8 @@ mod tests {
 
     #[test]
     fn untouched_clusters_come_back_as_they_were() {
-        let (mesh, table, w) = welded_cube();
-        let wt = welded_table(&table, &w, &mut whet_mesh::Scratch::new()).unwrap();
+        let (mesh, _, mut w) = welded_cube();
+        let wt = welded_table(&mut w, &mut whet_mesh::Scratch::new()).unwrap();
         // The triangles welding kept around a cluster are its kept vertex's fan in the
         // welded table (the count the restoration expects around it).
         assert!(w.clusters.len() > 1);
