@@ -238,9 +238,20 @@ pub struct EdgeSharpener {
 }
 
 /// Vectors kept between runs for the tables and the welded mesh ([`whet_mesh::Scratch`]); a
-/// clone of the engine starts with an empty pool.
+/// clone of the engine starts with an empty pool. Behind a mutex that is never locked (the
+/// engine reaches it through `&mut self`, `Mutex::get_mut`) only so that the engine stays
+/// `Sync`, as it was before it kept a pool: the pool's boxed vectors are `Send` but not
+/// `Sync`.
 #[derive(Debug, Default)]
-struct Pool(whet_mesh::Scratch);
+struct Pool(std::sync::Mutex<whet_mesh::Scratch>);
+
+impl Pool {
+    fn get(&mut self) -> &mut whet_mesh::Scratch {
+        self.0
+            .get_mut()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
+}
 
 impl Clone for Pool {
     fn clone(&self) -> Self {
@@ -354,10 +365,10 @@ impl EdgeSharpener {
         // million-triangle input's table and its working arrays are some 80 MB, which the
         // kernel faulted in afresh at every run.
         let table =
-            CornerTable::from_triangles_in(&mesh.triangles, mesh.positions.len(), &mut self.pool.0)
+            CornerTable::from_triangles_in(&mesh.triangles, mesh.positions.len(), self.pool.get())
                 .map_err(Error::InvalidInput)?;
         let out = self.sharpen_on_table(mesh, &table, report, start, judge);
-        table.recycle(&mut self.pool.0);
+        table.recycle(self.pool.get());
         out
     }
 
@@ -377,7 +388,7 @@ impl EdgeSharpener {
             }));
         }
         let welded = if self.options.method == Method::Extended && self.options.weld_clusters {
-            let pool = &mut self.pool.0;
+            let pool = self.pool.get();
             crate::weld::weld_clusters(
                 mesh,
                 table,
@@ -396,8 +407,8 @@ impl EdgeSharpener {
         if let Some((w, welded_table)) = welded {
             let sharpened =
                 self.sharpen_welded(mesh, &w, &welded_table, &report, start, &mut judge);
-            w.recycle(&mut self.pool.0);
-            welded_table.recycle(&mut self.pool.0);
+            w.recycle(self.pool.get());
+            welded_table.recycle(self.pool.get());
             if let Some(out) = sharpened {
                 return Ok(out);
             }

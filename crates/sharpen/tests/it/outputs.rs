@@ -153,6 +153,15 @@ fn no_case_gets_worse() {
 }
 
 #[test]
+fn the_engine_can_be_sent_and_shared_between_threads() {
+    // Servers keep engines in pools and hand them to worker threads; keeping memory
+    // between runs must not cost the auto traits.
+    fn send_and_sync<T: Send + Sync>() {}
+    send_and_sync::<whet_sharpen::EdgeSharpener>();
+    send_and_sync::<whet_sharpen::SharpenOptions>();
+}
+
+#[test]
 fn deterministic_and_engine_reuse() {
     let (_, a) = sampled(ShapeKind::Fandisk, 24, 1);
     let (_, b) = sampled(ShapeKind::Pyramid, 24, 0);
