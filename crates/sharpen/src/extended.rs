@@ -586,16 +586,17 @@ fn demote_corridors(run: &mut Run, thick: &[bool]) {
     demote(run, &gone);
 }
 
+/// One past the highest region label in use (0 without red triangles): the length of the
+/// per-region arrays.
+fn region_count(run: &Run) -> usize {
+    let labels = run.s.region.iter().filter(|&&r| r != NONE);
+    labels.max().map_or(0, |&m| m as usize + 1)
+}
+
 /// Per region label (up to the highest one in use), whether it has a deep vertex (see
 /// [`deep_vertices`]): the thin ones are the corridors' candidates.
 fn thick_regions(run: &Run, deep: &[bool], of: &[u32]) -> Vec<bool> {
-    let nregions = run
-        .s
-        .region
-        .iter()
-        .filter(|&&r| r != NONE)
-        .max()
-        .map_or(0, |&m| m as usize + 1);
+    let nregions = region_count(run);
     let mut thick = vec![false; nregions];
     for (&d, &r) in deep.iter().zip(of) {
         if d && r != NONE {
@@ -890,13 +891,7 @@ fn neighbour_plane_distance(run: &Run, v: u32, r: u32) -> f64 {
 /// pull a mean up; the median is the turn of most of the region.
 #[inline(never)] // one call per run; kept out of line so profiles show it
 pub(crate) fn region_turns(run: &mut Run) {
-    let nregions = run
-        .s
-        .region
-        .iter()
-        .filter(|&&r| r != NONE)
-        .max()
-        .map_or(0, |&m| m as usize + 1);
+    let nregions = region_count(run);
     let s = &mut *run.s;
     s.region_turn.clear();
     s.region_turn.resize(nregions, 0.0);

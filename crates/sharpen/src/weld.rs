@@ -535,25 +535,22 @@ pub(crate) fn restore_untouched(
     let nv = input.positions.len();
     let rep = &welded.rep;
     let merged = &welded.clusters;
-    // Cluster index of every vertex of a cluster (its kept vertex included), and a bit per
-    // kept vertex (the scan of the output tests three per triangle: a bitset stays in cache).
+    // Cluster index of every vertex of a cluster (its kept vertex included).
     let mut cluster = vec![NO_CLUSTER; nv];
     let mut roots: Vec<u32> = Vec::with_capacity(merged.len());
-    let mut root_bits = vec![0u64; nv.div_ceil(64)];
     for c in 0..merged.len() {
         let members = merged.members(c);
-        let r = members[0];
-        roots.push(r);
-        root_bits[r as usize / 64] |= 1 << (r % 64);
+        roots.push(members[0]);
         for &v in members {
             cluster[v as usize] = c as u32;
         }
     }
     let clustered = &merged.members;
     let n = roots.len();
-    // Bits for every output vertex (new ones clear), so the scan of the output tests its
-    // three vertices without a range check or a branch each.
+    // The welding's bit per kept vertex, widened to every output vertex (new ones clear), so
+    // the tests below read three per triangle without a range check or a branch each.
     let no = out.positions.len().max(nv);
+    let mut root_bits = welded.root_bits.clone();
     root_bits.resize(no.div_ceil(64), 0);
     let is_root = |bits: &[u64], v: u32| bits[v as usize / 64] >> (v % 64) & 1 != 0;
     let touches = |bits: &[u64], t: &[u32; 3]| {
