@@ -311,7 +311,10 @@ pub(crate) fn weld_clusters(
     let is_changed = |t: usize| mesh.triangles[t].iter().any(|&v| rep[v as usize] != v);
     let (mut sum, mut count) = (0.0f64, 0usize);
     for (t, tri) in mesh.triangles.iter().enumerate() {
-        let changed = is_changed(t);
+        // The welded triangle, and whether welding changed it (`is_changed`, without reading
+        // the merges twice).
+        let welded = tri.map(|v| rep[v as usize]);
+        let changed = welded != *tri;
         if changed {
             // The input's edges here, while its neighbourhood is in cache (the patch is
             // spread over the whole mesh: summed in the run, its reads missed).
@@ -339,7 +342,6 @@ pub(crate) fn weld_clusters(
             if changed {
                 welded_changed[k / 64] |= 1 << (k % 64);
             }
-            let welded = tri.map(|v| rep[v as usize]);
             for (j, &o) in opposite[3 * t..3 * t + 3].iter().enumerate() {
                 let ot = welded_index
                     .get(o as usize / 3)
