@@ -585,10 +585,11 @@ impl CornerTable {
         open_fans: &[u8],
         walk_fans: bool,
     ) -> Result<(), MeshError> {
+        if walk_fans {
+            return self.walk_vertex_fans(valence, open_fans);
+        }
         for v in 0..self.vertex_corner.len() {
-            if walk_fans {
-                self.check_fan(v, valence, open_fans)?;
-            } else if open_fans[v] > 1 {
+            if open_fans[v] > 1 {
                 return Err(MeshError::NonManifoldVertex {
                     vertex: v as u32,
                     fans: self.count_fans(VertexId(v as u32)),
@@ -596,6 +597,73 @@ impl CornerTable {
             }
         }
         Ok(())
+    }
+
+    /// [`Self::check_fan`] for every vertex, the same first error, the walks of
+    /// [`FAN_LANES`] consecutive vertices at a time advancing together ([`Self::fan_walks`]).
+    fn walk_vertex_fans(&self, valence: &[u32], open_fans: &[u8]) -> Result<(), MeshError> {
+        let nv = self.vertex_corner.len();
+        for first in (0..nv).step_by(FAN_LANES) {
+            let lanes = FAN_LANES.min(nv - first);
+            let mut starts = [NONE; FAN_LANES];
+            let mut caps = [0u64; FAN_LANES];
+            starts[..lanes].copy_from_slice(&self.vertex_corner[first..first + lanes]);
+            for (cap, &k) in caps.iter_mut().zip(&valence[first..first + lanes]) {
+                *cap = u64::from(k);
+            }
+            let seen = self.fan_walks(&starts, &caps);
+            for i in 0..lanes {
+                let v = first + i;
+                if starts[i] != NONE && (open_fans[v] > 1 || seen[i] != caps[i]) {
+                    // The error as the single walk names it.
+                    return self.check_fan(v, valence, open_fans);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// [`Self::fan_walk`] from each of `starts` (`NONE`: no walk, 0 met) with its cap, the
+    /// walks advancing a step each in turn: their reads of the opposites (scattered over the
+    /// table on an input in file order) overlap instead of each waiting for the one before.
+    /// A finished walk keeps its state (selects, not branches: which walk ends when is
+    /// data).
+    fn fan_walks(&self, starts: &[u32; FAN_LANES], caps: &[u64; FAN_LANES]) -> [u64; FAN_LANES] {
+        let opposite = self.opposite.as_slice();
+        let mut after = [0u32; FAN_LANES];
+        let mut seen = [0u64; FAN_LANES];
+        let mut live = [false; FAN_LANES];
+        for i in 0..FAN_LANES {
+            let s = starts[i];
+            if s != NONE {
+                let j = s % 3;
+                after[i] = s - j + NEXT_IN_TRIANGLE[j as usize];
+                seen[i] = 1;
+                live[i] = true;
+            }
+        }
+        loop {
+            let mut any = false;
+            for i in 0..FAN_LANES {
+                let o = opposite.get(after[i] as usize).copied().unwrap_or(NONE);
+                let jo = o % 3;
+                let base = o.wrapping_sub(jo);
+                let jn = NEXT_IN_TRIANGLE[jo as usize];
+                let stop = o == NONE || base.wrapping_add(jn) == starts[i] || seen[i] > caps[i];
+                let go = live[i] & !stop;
+                seen[i] += u64::from(go);
+                after[i] = if go {
+                    base + NEXT_IN_TRIANGLE[jn as usize]
+                } else {
+                    after[i]
+                };
+                live[i] = go;
+                any |= go;
+            }
+            if !any {
+                return seen;
+            }
+        }
     }
 
     /// Per vertex: corners, and corners that start an open fan.
@@ -609,11 +677,12 @@ impl CornerTable {
     fn fans_cover_all_corners(&self) -> bool {
         let nc = self.corner_count() as u64;
         let mut met = 0u64;
-        for &start in &self.vertex_corner {
-            if start == NONE {
-                continue;
-            }
-            met += self.fan_walk(start, nc - met);
+        for chunk in self.vertex_corner.chunks(FAN_LANES) {
+            let mut starts = [NONE; FAN_LANES];
+            starts[..chunk.len()].copy_from_slice(chunk);
+            // Each walk capped by what is left: the work stays linear on any table.
+            let seen = self.fan_walks(&starts, &[nc - met; FAN_LANES]);
+            met += seen.iter().sum::<u64>();
             if met > nc {
                 // Only an inconsistent table walks past its corner count.
                 return false;
@@ -919,6 +988,9 @@ impl Iterator for VertexCorners<'_> {
 
 /// Position in its triangle of the corner after the one at position `j`.
 const NEXT_IN_TRIANGLE: [u32; 3] = [1, 2, 0];
+
+/// Fan walks [`CornerTable::walk_vertex_fans`] advances together.
+const FAN_LANES: usize = 8;
 
 #[inline]
 fn next_raw(c: usize) -> usize {
@@ -1249,6 +1321,72 @@ mod tests {
         let ok = CornerTable::from_triangles_deferring_fans(&t.triangles, 4).unwrap();
         assert_eq!(ok.check_fans(), Ok(()));
         assert_eq!(ok, CornerTable::new(&t).unwrap());
+    }
+
+    /// `count` tetrahedra, each sharing one vertex with the one before where `pinch` says
+    /// so (a vertex with two closed fans), vertex labels spread by `stride` (or the next
+    /// number coprime to the vertex count) so that the pinched vertices fall in various lanes and chunks of the
+    /// fan walks.
+    fn tetrahedron_chain(count: usize, pinch: &[bool], stride: usize) -> (Vec<[u32; 3]>, usize) {
+        let t = tetrahedron();
+        let mut triangles = Vec::new();
+        let mut next = 0u32;
+        let mut last = 0u32;
+        for k in 0..count {
+            let shared = k > 0 && pinch[k % pinch.len()];
+            let ids: Vec<u32> = (0..4)
+                .map(|j| {
+                    if j == 0 && shared {
+                        last
+                    } else {
+                        next += 1;
+                        next - 1
+                    }
+                })
+                .collect();
+            last = ids[3];
+            triangles.extend(t.triangles.iter().map(|tri| tri.map(|v| ids[v as usize])));
+        }
+        let nv = next as usize;
+        let gcd = |mut a: usize, mut b: usize| {
+            while b != 0 {
+                (a, b) = (b, a % b);
+            }
+            a
+        };
+        let stride = (stride..).find(|&s| gcd(s, nv) == 1).unwrap_or(1);
+        let label = |v: u32| ((v as usize * stride) % nv) as u32;
+        (triangles.iter().map(|tri| tri.map(label)).collect(), nv)
+    }
+
+    #[test]
+    fn walking_fans_together_finds_what_single_walks_find() {
+        for (count, pinch, stride) in [
+            (12, &[false][..], 5),
+            (12, &[false, false, true][..], 5),
+            (30, &[false, false, false, false, false, true][..], 7),
+            (30, &[true, false][..], 11),
+            (40, &[false; 9][..], 13),
+            (
+                40,
+                &[false, false, false, false, false, false, false, false, true][..],
+                3,
+            ),
+        ] {
+            let (tris, nv) = tetrahedron_chain(count, pinch, stride);
+            let deferred = CornerTable::from_triangles_deferring_fans(&tris, nv).unwrap();
+            let (valence, open_fans) = deferred.fan_counts();
+            // The reference: one walk per vertex, in vertex order.
+            let single = (0..nv).try_for_each(|v| deferred.check_fan(v, &valence, &open_fans));
+            assert_eq!(single.is_err(), pinch.contains(&true));
+            assert_eq!(
+                deferred.check_vertex_fans(&valence, &open_fans, true),
+                single
+            );
+            assert_eq!(deferred.fans_cover_all_corners(), single.is_ok());
+            assert_eq!(deferred.check_fans(), single);
+            assert_eq!(CornerTable::from_triangles(&tris, nv).err(), single.err());
+        }
     }
 
     #[test]
