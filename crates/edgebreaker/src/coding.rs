@@ -536,6 +536,8 @@ pub fn encode_connectivity_with_table_in(
     let summary = traverse_in(
         &table,
         None,
+        // In line in the traversal's loop (a call per triangle otherwise).
+        #[inline(always)]
         |step| {
             let f = match step {
                 Step::Start { corner } => {

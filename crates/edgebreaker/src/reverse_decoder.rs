@@ -161,6 +161,7 @@ impl ReverseDecoder {
         })
     }
 
+    #[inline(always)]
     fn new_vertex(&mut self, corner: u32) -> u32 {
         let id = self.leftmost.len() as u32;
         self.leftmost.push(corner);
