@@ -157,37 +157,44 @@ impl CornerTable {
         let mut offsets = scratch.take_filled(vertex_count + 1, 0u32);
         let mut valence = scratch.take_filled(vertex_count, 0u32);
         let mut vertex_corner = scratch.take_filled(vertex_count, NONE);
-        for (t, tri) in triangles.iter().enumerate() {
-            for &v in tri {
-                if v as usize >= vertex_count {
-                    return Err(MeshError::IndexOutOfRange {
+        {
+            // Slices of the lengths the index check below bounds (so that the compiler drops
+            // the per-access bounds checks).
+            let offsets = &mut offsets[..vertex_count + 1];
+            let valence = &mut valence[..vertex_count];
+            let vertex_corner = &mut vertex_corner[..vertex_count];
+            for (t, tri) in triangles.iter().enumerate() {
+                for &v in tri {
+                    if v as usize >= vertex_count {
+                        return Err(MeshError::IndexOutOfRange {
+                            triangle: t as u32,
+                            index: v,
+                            vertex_count: vertex_count as u32,
+                        });
+                    }
+                }
+                if tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] {
+                    let vertex = if tri[0] == tri[1] || tri[0] == tri[2] {
+                        tri[0]
+                    } else {
+                        tri[1]
+                    };
+                    return Err(MeshError::RepeatedVertex {
                         triangle: t as u32,
-                        index: v,
-                        vertex_count: vertex_count as u32,
+                        vertex,
                     });
                 }
-            }
-            if tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] {
-                let vertex = if tri[0] == tri[1] || tri[0] == tri[2] {
-                    tri[0]
-                } else {
-                    tri[1]
-                };
-                return Err(MeshError::RepeatedVertex {
-                    triangle: t as u32,
-                    vertex,
-                });
-            }
-            triangles_out.push(*tri);
-            for (j, &v) in tri.iter().enumerate() {
-                valence[v as usize] += 1;
-                let slot = &mut vertex_corner[v as usize];
-                if *slot == NONE {
-                    *slot = (3 * t + j) as u32;
+                triangles_out.push(*tri);
+                for (j, &v) in tri.iter().enumerate() {
+                    valence[v as usize] += 1;
+                    let slot = &mut vertex_corner[v as usize];
+                    if *slot == NONE {
+                        *slot = (3 * t + j) as u32;
+                    }
                 }
-            }
-            for (a, b) in edges(tri) {
-                offsets[a.min(b) as usize + 1] += 1;
+                for (a, b) in edges(tri) {
+                    offsets[a.min(b) as usize + 1] += 1;
+                }
             }
         }
 
