@@ -129,10 +129,16 @@ pub enum TraversalError {
     Unreached(usize),
 }
 
-const UNVISITED: u32 = 0;
-const VISITED: u32 = 1;
-// A triangle mark of `S_MARK + s` records that it is the S triangle of symbol `s`.
-const S_MARK: u32 = 2;
+/// Bit `i` of a bit array.
+#[inline(always)]
+fn bit(bits: &[u64], i: usize) -> bool {
+    bits[i / 64] >> (i % 64) & 1 != 0
+}
+
+#[inline(always)]
+fn set_bit(bits: &mut [u64], i: usize) {
+    bits[i / 64] |= 1 << (i % 64);
+}
 
 /// Runs the traversal over every triangle of `table`, calling `visit` for each step.
 ///
@@ -159,8 +165,14 @@ pub fn traverse_in(
     if let Some(c) = table.first_boundary_corner() {
         return Err(TraversalError::Boundary(c.0));
     }
-    let mut tri_mark = scratch.take_filled(nt, UNVISITED);
-    let mut vertex_seen = scratch.take_filled(table.vertex_count(), false);
+    // Marks in bit arrays (a bit per triangle, a tenth of a 4-byte mark's memory): the
+    // traversal is one chain of dependent reads, each step waiting for its neighbours'
+    // marks, and bits stay in a nearer cache. The symbol of an S triangle is kept apart,
+    // read only when its bit says it is one.
+    let mut visited: Vec<u64> = scratch.take_filled(nt.div_ceil(64), 0);
+    let mut s_marked: Vec<u64> = scratch.take_filled(nt.div_ceil(64), 0);
+    let mut split_symbol: Vec<u32> = scratch.take_filled(nt, 0);
+    let mut vertex_seen: Vec<u64> = scratch.take_filled(table.vertex_count().div_ceil(64), 0);
     let mut summary = TraversalSummary {
         labels: scratch.take_empty(nt),
         vertex_order: scratch.take_empty(table.vertex_count()),
@@ -178,8 +190,7 @@ pub fn traverse_in(
         let start = match given.as_mut() {
             Some(it) => match it.next() {
                 Some(&c) => {
-                    if c.index() >= table.corner_count() || tri_mark[c.face().index()] != UNVISITED
-                    {
+                    if c.index() >= table.corner_count() || bit(&visited, c.face().index()) {
                         return Err(TraversalError::BadStart(c.0));
                     }
                     c
@@ -187,9 +198,15 @@ pub fn traverse_in(
                 None => break,
             },
             None => {
-                while next_auto < nt && tri_mark[next_auto] != UNVISITED {
-                    next_auto += 1;
+                // Whole words of visited triangles at a time.
+                while next_auto < nt && bit(&visited, next_auto) {
+                    if next_auto % 64 == 0 && visited[next_auto / 64] == u64::MAX {
+                        next_auto += 64;
+                    } else {
+                        next_auto += 1;
+                    }
                 }
+                next_auto = next_auto.min(nt);
                 if next_auto == nt {
                     break;
                 }
@@ -197,11 +214,11 @@ pub fn traverse_in(
             }
         };
         summary.starts.push(start);
-        tri_mark[start.face().index()] = VISITED;
+        set_bit(&mut visited, start.face().index());
         visited_count += 1;
         for c in [start, table.next(start), table.prev(start)] {
             let v = table.vertex(c);
-            vertex_seen[v.index()] = true;
+            set_bit(&mut vertex_seen, v.index());
             summary.vertex_order.push(v);
         }
         visit(Step::Start { corner: start });
@@ -210,14 +227,14 @@ pub fn traverse_in(
         let first = opposite(table, table.next(start));
         stack.push(first);
         while let Some(mut c) = stack.pop() {
-            if tri_mark[c.face().index()] != UNVISITED {
+            if bit(&visited, c.face().index()) {
                 // The branch was swallowed by a handle.
                 continue;
             }
             loop {
                 let t = c.face().index();
                 let symbol = summary.labels.len() as u32;
-                tri_mark[t] = VISITED;
+                set_bit(&mut visited, t);
                 visited_count += 1;
                 let v = table.vertex(c);
                 let right = opposite(table, table.next(c));
@@ -230,35 +247,36 @@ pub fn traverse_in(
                     .wrapping_add(opposites[right.index()])
                     .wrapping_add(corner_vertices[left.index()])
                     .wrapping_add(opposites[left.index()]);
-                let right_mark = tri_mark[right.face().index()];
-                let left_mark = tri_mark[left.face().index()];
-                let label = if !vertex_seen[v.index()] {
-                    vertex_seen[v.index()] = true;
+                let (rf, lf) = (right.face().index(), left.face().index());
+                let right_visited = bit(&visited, rf);
+                let left_visited = bit(&visited, lf);
+                let label = if !bit(&vertex_seen, v.index()) {
+                    set_bit(&mut vertex_seen, v.index());
                     summary.vertex_order.push(v);
                     Clers::C
-                } else if right_mark != UNVISITED {
-                    if left_mark != UNVISITED {
+                } else if right_visited {
+                    if left_visited {
                         Clers::E
                     } else {
                         Clers::R
                     }
-                } else if left_mark != UNVISITED {
+                } else if left_visited {
                     Clers::L
                 } else {
                     Clers::S
                 };
                 if label != Clers::C && label != Clers::S {
-                    if right_mark >= S_MARK {
+                    if bit(&s_marked, rf) {
                         summary.splits.push(SplitEvent {
                             source: symbol,
-                            split: right_mark - S_MARK,
+                            split: split_symbol[rf],
                             right: true,
                         });
                     }
-                    if left_mark >= S_MARK {
+                    if bit(&s_marked, lf) {
                         summary.splits.push(SplitEvent {
                             source: symbol,
-                            split: left_mark - S_MARK,
+                            split: split_symbol[lf],
                             right: false,
                         });
                     }
@@ -273,7 +291,8 @@ pub fn traverse_in(
                     Clers::C | Clers::L => c = right,
                     Clers::R => c = left,
                     Clers::S => {
-                        tri_mark[t] = S_MARK + symbol;
+                        set_bit(&mut s_marked, t);
+                        split_symbol[t] = symbol;
                         stack.push(left);
                         c = right;
                     }
@@ -283,7 +302,9 @@ pub fn traverse_in(
         }
     }
     std::hint::black_box(touched);
-    scratch.give(tri_mark);
+    scratch.give(visited);
+    scratch.give(s_marked);
+    scratch.give(split_symbol);
     scratch.give(vertex_seen);
     if visited_count != nt {
         return Err(TraversalError::Unreached(nt - visited_count));
