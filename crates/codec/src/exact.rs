@@ -370,6 +370,11 @@ impl ResidualIo for ResidualReader<'_, '_> {
     }
 }
 
+/// Per position `j` of a corner in its triangle, `(j, next)` and `(j, prev)`: the corner
+/// after corner `c` is `c - j + next`, the one before `c - j + prev`.
+const AFTER_BEFORE_CORNER: [((usize, usize), (usize, usize)); 3] =
+    [((0, 1), (0, 2)), ((1, 2), (1, 0)), ((2, 0), (2, 1))];
+
 /// Whether grid coordinate `c` lies outside `0..=max_level` (`max_level >= 0`): one
 /// unsigned compare, a negative `c` wrapping above every level.
 #[inline(always)]
@@ -810,9 +815,10 @@ pub(crate) fn code_positions_traversal<I: ResidualIo>(
                     if state[v] != UNKNOWN {
                         return;
                     }
-                    let base = t - t % 3;
-                    let a = cv[base + (t + 1) % 3] as usize;
-                    let b = cv[base + (t + 2) % 3] as usize;
+                    // The corners after and before the tip from one modulo.
+                    let (after, before) = AFTER_BEFORE_CORNER[t % 3];
+                    let a = cv[t - after.0 + after.1] as usize;
+                    let b = cv[t - before.0 + before.1] as usize;
                     let o = opp[t] as usize;
                     let w = if o < nc { cv[o] as usize } else { v };
                     let (a_known, b_known) = (state[a] == KNOWN, state[b] == KNOWN);

@@ -12,6 +12,7 @@
 
 use crate::traversal::{Clers, SplitEvent};
 use crate::Error;
+use whet_mesh::is_multiple_of_three;
 
 pub(crate) const NONE: u32 = u32::MAX;
 
@@ -20,19 +21,20 @@ pub const VALENCE_CONTEXTS: usize = 6;
 
 #[inline]
 fn next(c: u32) -> u32 {
-    if c % 3 == 2 {
-        c - 2
+    // c % 3 == 2 exactly when c + 1 is a multiple of 3.
+    if is_multiple_of_three(c.wrapping_add(1)) {
+        c.wrapping_sub(2)
     } else {
-        c + 1
+        c.wrapping_add(1)
     }
 }
 
 #[inline]
 fn prev(c: u32) -> u32 {
-    if c % 3 == 0 {
-        c + 2
+    if is_multiple_of_three(c) {
+        c.wrapping_add(2)
     } else {
-        c - 1
+        c.wrapping_sub(1)
     }
 }
 

@@ -914,14 +914,22 @@ impl CornerTable {
     /// Next corner of the same triangle (counter-clockwise).
     #[inline]
     pub fn next(&self, c: CornerId) -> CornerId {
-        // On u32: a 32-bit modulo is a shorter multiply-and-shift than the usize one.
-        CornerId(if c.0 % 3 == 2 { c.0 - 2 } else { c.0 + 1 })
+        // c % 3 == 2 exactly when c + 1 is a multiple of 3 (corners stay below u32::MAX - 3).
+        CornerId(if is_multiple_of_three(c.0 + 1) {
+            c.0 - 2
+        } else {
+            c.0 + 1
+        })
     }
 
     /// Previous corner of the same triangle.
     #[inline]
     pub fn prev(&self, c: CornerId) -> CornerId {
-        CornerId(if c.0 % 3 == 0 { c.0 + 2 } else { c.0 - 1 })
+        CornerId(if is_multiple_of_three(c.0) {
+            c.0 + 2
+        } else {
+            c.0 - 1
+        })
     }
 
     /// Corner across the edge opposite `c`; `None` when that edge is a boundary edge.
@@ -1023,6 +1031,15 @@ const NEXT_IN_TRIANGLE: [u32; 3] = [1, 2, 0];
 
 /// The direction bit of the build's bucket entries (see `CornerTable::build`).
 const DOWN: u32 = 1 << 31;
+
+/// Whether `x` is a multiple of 3: `x` times the inverse of 3 modulo 2^32 is at most
+/// `(2^32 - 1) / 3` exactly for the multiples. One multiply and a compare, where `x % 3 == k`
+/// takes a wide multiply, a shift and a subtraction: corner arithmetic (the corner after or
+/// before another in its triangle) runs in the inner loops of every table walk.
+#[inline(always)]
+pub const fn is_multiple_of_three(x: u32) -> bool {
+    x.wrapping_mul(0xAAAA_AAAB) <= 0x5555_5555
+}
 
 /// Fan walks [`CornerTable::walk_vertex_fans`] advances together.
 const FAN_LANES: usize = 8;
@@ -1425,6 +1442,13 @@ mod tests {
         let stride = (stride..).find(|&s| gcd(s, nv) == 1).unwrap_or(1);
         let label = |v: u32| ((v as usize * stride) % nv) as u32;
         (triangles.iter().map(|tri| tri.map(label)).collect(), nv)
+    }
+
+    #[test]
+    fn multiples_of_three_by_the_inverse() {
+        for x in (0..100_000u32).chain(u32::MAX - 100_000..=u32::MAX) {
+            assert_eq!(is_multiple_of_three(x), x % 3 == 0, "{x}");
+        }
     }
 
     #[test]

@@ -29,7 +29,7 @@ mod mesh;
 mod scratch;
 mod topology;
 
-pub use corner_table::{CornerTable, VertexCorners};
+pub use corner_table::{is_multiple_of_three, CornerTable, VertexCorners};
 pub use ids::{CornerId, FaceId, VertexId};
 pub use make_manifold::ManifoldRepair;
 pub use mesh::{angle_between, edge_key, morton_spread, Aabb, EdgeLengthStats, Mesh};

@@ -594,9 +594,11 @@ pub(crate) struct Run<'a> {
 /// Per corner position `j` in a triangle, the positions of the corners after and before it.
 const AFTER_BEFORE: [(usize, usize); 3] = [(1, 2), (2, 0), (0, 1)];
 
+// Corner numbers are below u32::MAX - 3 (`CornerTable`'s bound): the 32-bit test for
+// multiples of 3 is one multiply (`whet_mesh::is_multiple_of_three`), a usize modulo more.
 #[inline]
 pub(crate) fn next(c: usize) -> usize {
-    if c % 3 == 2 {
+    if whet_mesh::is_multiple_of_three((c as u32).wrapping_add(1)) {
         c - 2
     } else {
         c + 1
@@ -605,7 +607,7 @@ pub(crate) fn next(c: usize) -> usize {
 
 #[inline]
 pub(crate) fn prev(c: usize) -> usize {
-    if c % 3 == 0 {
+    if whet_mesh::is_multiple_of_three(c as u32) {
         c + 2
     } else {
         c - 1
