@@ -461,6 +461,11 @@ fn prepare_with(
     })
 }
 
+/// [`morton_spread`] of every byte, as 24-bit values.
+fn morton_spread_bytes() -> [u32; 256] {
+    std::array::from_fn(|b| morton_spread(b as u64) as u32)
+}
+
 /// Meshes under this many triangles are left in their order: their arrays stay in the
 /// caches whatever the order.
 const REORDER_MIN_TRIANGLES: usize = 1 << 18;
@@ -536,13 +541,17 @@ fn spatial_order(
     let cells = 1usize << (3 * bits);
     let extent = (bbox.max - bbox.min).max_element().max(f64::MIN_POSITIVE);
     let scale = ((1u32 << bits) as f64 - 1e-6) / extent;
-    let top = (1u64 << bits) - 1;
+    let top = (1i64 << bits) - 1;
+    // At most 8 bits an axis: each axis spread by one lookup. The coordinates are finite
+    // and at least the box's minimum, so the scaled ones are in [0, 2^bits) and the signed
+    // conversion (one instruction; the unsigned one is a sequence on x86-64) is exact.
+    let spread = morton_spread_bytes();
     let mut cell: Vec<u32> = scratch.take_empty(nv);
     cell.extend(mesh.positions.iter().map(|p| {
         let q = ((*p - bbox.min) * scale)
             .to_array()
-            .map(|x| (x as u64).min(top));
-        (morton_spread(q[0]) | morton_spread(q[1]) << 1 | morton_spread(q[2]) << 2) as u32
+            .map(|x| (x as i64).clamp(0, top) as usize);
+        spread[q[0]] | spread[q[1]] << 1 | spread[q[2]] << 2
     }));
     let mut start = bucket_starts(cell.iter().map(|&c| c as usize), cells, scratch);
     // Each written once below (a permutation).
