@@ -29,6 +29,12 @@ pub struct SharpenArgs {
     /// untouched; a vertex that stays welded keeps its index, used by no triangle.
     #[arg(long)]
     no_weld: bool,
+    /// extended: sharpen every part, also those whose creases are already sharp (most of
+    /// their strong creases on edges between smooth regions: a CAD original, or a mesh
+    /// sharpened before), which are otherwise left alone; their narrow real faces and coarse
+    /// facets then get taken for chamfers.
+    #[arg(long)]
+    no_sharp_parts: bool,
     /// extended and papers: where two rings of triangles lie outside every smooth region, an
     /// edge turning by under this factor times the smooth threshold counts as smooth, so a
     /// face curved at the sampling's scale (a small hole's wall) gets its chamfers found.
@@ -149,6 +155,7 @@ pub fn run(args: &SharpenArgs) -> CliResult {
         .with_eta(args.eta)
         .with_lambda(args.lambda)
         .with_weld_clusters(!args.no_weld)
+        .with_keep_sharp_parts(!args.no_sharp_parts)
         .with_passes(args.passes);
     let opts = match args.curved_walls {
         Some(w) => opts.with_curved_wall_factor(w),
@@ -190,6 +197,14 @@ pub fn run(args: &SharpenArgs) -> CliResult {
              clusters); they stay in the output at their index, used by no triangle \
              (--no-weld keeps them)",
             out.report.welded_vertices
+        );
+    }
+    if out.report.already_sharp_components > 0 {
+        // An unchanged output is otherwise a puzzle: say why.
+        eprintln!(
+            "whet: left {} already sharp part(s) unchanged (their creases run along edges, \
+             not across chamfers; --no-sharp-parts sharpens them anyway)",
+            out.report.already_sharp_components
         );
     }
     if args.json {

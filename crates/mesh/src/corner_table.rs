@@ -865,6 +865,19 @@ impl CornerTable {
     pub fn opposites(&self) -> &[u32] {
         &self.opposite
     }
+    /// The connected component of each triangle (through the table's interior edges), named
+    /// by its lowest triangle: triangles `a` and `b` are joined exactly when
+    /// `components[a] == components[b]`, and `components[t] <= t`.
+    pub fn triangle_components(&self) -> Vec<u32> {
+        let nt = self.triangles.len();
+        let mut uf = crate::topology::UnionFind::new(nt);
+        for (c, &o) in self.opposite.iter().enumerate() {
+            if o != NONE && o as usize > c {
+                uf.union((c / 3) as u32, o / 3);
+            }
+        }
+        (0..nt as u32).map(|t| uf.find(t)).collect()
+    }
 
     /// Mean length of the mesh's edges, each counted once (the table pairs them), for the
     /// `positions` of its vertices; 0 without triangles. The same figure as
@@ -1096,6 +1109,25 @@ fn prev_raw(c: usize) -> usize {
 mod tests {
     use super::*;
     use glam::DVec3;
+
+    #[test]
+    fn triangle_components_name_each_part_by_its_lowest_triangle() {
+        // Two tetrahedra, the second's triangles interleaved with the first's.
+        let t = |o: u32| {
+            [
+                [o, o + 1, o + 2],
+                [o, o + 3, o + 1],
+                [o + 1, o + 3, o + 2],
+                [o, o + 2, o + 3],
+            ]
+        };
+        let (a, b) = (t(0), t(4));
+        let triangles = vec![a[0], b[0], a[1], b[1], a[2], b[2], a[3], b[3]];
+        let table = CornerTable::from_triangles(&triangles, 8).unwrap();
+        assert_eq!(table.triangle_components(), vec![0, 1, 0, 1, 0, 1, 0, 1]);
+        let empty = CornerTable::from_triangles(&[], 0).unwrap();
+        assert!(empty.triangle_components().is_empty());
+    }
 
     fn tetrahedron() -> Mesh {
         Mesh::new(

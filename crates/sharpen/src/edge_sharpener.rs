@@ -235,6 +235,10 @@ pub struct EdgeSharpener {
     scratch: Scratch,
     weld_scratch: crate::weld::WeldScratch,
     pool: Pool,
+    /// Whether the pass running is a later one (`SharpenOptions::passes`): its input is the
+    /// previous pass's output, whose sharpened creases must not read as an already sharp
+    /// input.
+    later_pass: bool,
 }
 
 /// Vectors kept between runs for the tables and the welded mesh ([`whet_mesh::Scratch`]); a
@@ -267,6 +271,7 @@ impl EdgeSharpener {
             scratch: Scratch::default(),
             weld_scratch: crate::weld::WeldScratch::default(),
             pool: Pool::default(),
+            later_pass: false,
         }
     }
 
@@ -302,6 +307,7 @@ impl EdgeSharpener {
         }
         let start = Instant::now();
         self.options.validate()?;
+        self.later_pass = false;
         let mut out = self.sharpen_once(mesh, judge.as_deref_mut())?;
         out.report.passes = 1;
         // A pass that gives its input back would do so again.
@@ -319,7 +325,10 @@ impl EdgeSharpener {
             {
                 break;
             }
-            let Ok(next) = self.sharpen_once(&out.mesh, judge.as_deref_mut()) else {
+            self.later_pass = true;
+            let next = self.sharpen_once(&out.mesh, judge.as_deref_mut());
+            self.later_pass = false;
+            let Ok(next) = next else {
                 break;
             };
             unchanged = next.mesh == out.mesh;
@@ -414,6 +423,7 @@ impl EdgeSharpener {
             }
         }
         let mut run = Run::new(mesh, table, &self.options, &mut self.scratch, report);
+        run.input_may_be_sharp = self.options.keep_sharp_parts && !self.later_pass;
         let (out, parents, tagged) = run.run(judge);
         let mut report = run.report;
         let tags = sharp_tags(&mut report, &out, &tagged);
@@ -451,6 +461,7 @@ impl EdgeSharpener {
             input: mesh,
             welded: w,
         });
+        run.input_may_be_sharp = self.options.keep_sharp_parts && !self.later_pass;
         // Parents come out named by their input triangles (the output pass maps them).
         let (mut out, mut parents, mut tagged) = run.run(judge.as_deref_mut());
         let mut report = run.report;
@@ -528,6 +539,7 @@ fn compose_passes(first: Sharpened, next: Sharpened) -> Sharpened {
         chamfer_edges: a.chamfer_edges + b.chamfer_edges,
         corner_triangles: a.corner_triangles + b.corner_triangles,
         twin_corners: a.twin_corners + b.twin_corners,
+        already_sharp_components: a.already_sharp_components + b.already_sharp_components,
         chamfer_vertices: a.chamfer_vertices + b.chamfer_vertices,
         inserted_vertices: a.inserted_vertices + b.inserted_vertices,
         new_vertices: a.new_vertices + b.new_vertices,
@@ -571,6 +583,9 @@ pub(crate) struct Run<'a> {
     /// On a welded input: the input and its welding, so that the smooth threshold is the
     /// input's (see [`crate::weld::WeldPatch`]).
     pub weld_patch: Option<crate::weld::WeldPatch<'a>>,
+    /// Whether the extended method looks for already sharp parts (the first pass only:
+    /// `crate::extended::already_sharp_parts`).
+    pub input_may_be_sharp: bool,
     pub limits: SnapLimits,
     /// The smooth threshold, radians (`smooth_factor` times the mean normal angle).
     pub smooth_threshold: f64,
@@ -633,6 +648,7 @@ impl<'a> Run<'a> {
             max_edge: 0.0,
             mean_edge: 0.0,
             weld_patch: None,
+            input_may_be_sharp: true,
             limits: SnapLimits::new(0.0),
             smooth_threshold: 0.0,
             ref_normals: Vec::new(),

@@ -100,6 +100,13 @@ pub struct SharpenOptions {
     /// (docs/sharpen.md, "What we extend", step 10); vertices that stay welded keep their
     /// indices, used by no triangle. Default on.
     pub weld_clusters: bool,
+    /// Extended method: leave alone the connected parts whose creases are already sharp
+    /// (most of their strong creases run along edges between smooth regions, where a
+    /// sampling would have cut them into chamfers: a CAD original, or a mesh this sharpener
+    /// already sharpened; docs/sharpen.md, "What we extend", step 17). Default on; off, every
+    /// part is taken for a chamfered sampling, as before. Later passes never look (their
+    /// input is the previous pass's output).
+    pub keep_sharp_parts: bool,
     /// Curved walls (docs/sharpen.md): where two rings of triangles lie outside every smooth
     /// region, an edge turning by under this factor times the smooth threshold counts as
     /// smooth too, so that a face curved at the sampling's scale (a hole's cylinder a few
@@ -128,6 +135,7 @@ impl SharpenOptions {
         eta: 0.1,
         lambda: 0.0,
         weld_clusters: true,
+        keep_sharp_parts: true,
         curved_wall_factor: None,
         passes: 1,
         pass_budget_triangles: None,
@@ -175,6 +183,12 @@ impl SharpenOptions {
     /// Sets whether the extended method welds the vertex clusters that block chamfers.
     pub const fn with_weld_clusters(mut self, weld: bool) -> Self {
         self.weld_clusters = weld;
+        self
+    }
+
+    /// Sets whether the extended method leaves already sharp parts alone.
+    pub const fn with_keep_sharp_parts(mut self, keep: bool) -> Self {
+        self.keep_sharp_parts = keep;
         self
     }
 

@@ -128,6 +128,10 @@ pub struct SharpenReport {
     /// Subdivided triangles the sliver pass restored to their input triangles (docs/sharpen.md,
     /// "The sliver pass").
     pub restored_triangles: usize,
+    /// Extended method: connected parts left alone because their creases are already sharp
+    /// (most of their strong creases run along edges between smooth regions instead of
+    /// bordering a chamfer; docs/sharpen.md, "What we extend", step 17).
+    pub already_sharp_components: usize,
     /// Vertices tagged sharp (filter 3bis plus the new vertices).
     pub tagged_vertices: usize,
     /// Edges tagged sharp.
@@ -191,7 +195,8 @@ impl SharpenReport {
     /// `absolute_feature_vertices`, `presmooth_iterations`, `filtered_normals`,
     /// `rectified_normals`, `update_iterations`, `flips_avoided`, `swaps`, `collapses`,
     /// `detection_ms`, `filtering_ms` and `updating_ms` (zeros for the other methods), then
-    /// `curved_wall_factor`, `curved_wall_edges`, `passes` and `twin_corners`.
+    /// `curved_wall_factor`, `curved_wall_edges`, `passes`, `twin_corners` and
+    /// `already_sharp_components`.
     pub fn to_json(&self) -> String {
         let mut s = String::with_capacity(768);
         // Writing to a String cannot fail.
@@ -243,7 +248,7 @@ impl SharpenReport {
              \"rectified_normals\":{},\"update_iterations\":{},\"flips_avoided\":{},\"swaps\":{},\
              \"collapses\":{},\"detection_ms\":{},\"filtering_ms\":{},\"updating_ms\":{},\
              \"curved_wall_factor\":{},\"curved_wall_edges\":{},\"passes\":{},\
-             \"twin_corners\":{}}}",
+             \"twin_corners\":{},\"already_sharp_components\":{}}}",
             json_num(self.rho),
             json_num(self.eta),
             json_num(self.lambda),
@@ -264,6 +269,7 @@ impl SharpenReport {
             self.curved_wall_edges,
             self.passes,
             self.twin_corners,
+            self.already_sharp_components,
         );
         s
     }
@@ -310,6 +316,7 @@ mod tests {
             "curved_wall_edges",
             "passes",
             "twin_corners",
+            "already_sharp_components",
         ] {
             assert_eq!(j.matches(&format!("\"{key}\":")).count(), 1, "{key} in {j}");
         }

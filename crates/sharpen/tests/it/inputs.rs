@@ -137,11 +137,71 @@ fn already_sharp_meshes_come_back_unchanged() {
         // to sharpen: the input comes back unwelded).
         "cad_bracket.off",
         "block.off",
+        // Unchanged since already sharp parts are left alone (2026-12-06; before, the
+        // extended method snapped narrow real faces and facets taken for chamfers: 5, 30,
+        // 128 and 175 new vertices, max error 0.12-0.48 % of the diagonal).
+        "fandisk.off",
+        "partLp.off",
+        "joint.off",
+        "cad_cyl_fillet.off",
     ] {
         let m = whet_io::read_path(&whet_testkit::shared_fixture(name), None).unwrap();
         let out = sharpen(&m, &SharpenOptions::DEFAULT).unwrap();
         assert!(out.mesh == m, "{name}: {}", out.report.to_json());
     }
+}
+
+#[test]
+fn exactly_decoded_cad_originals_come_back_unchanged() {
+    // The exact mode at 12 bits keeps a CAD original's creases on its edges; the sharpener
+    // must see that through the quantization's noise (fandisk's max error went from 0.012 to
+    // 0.127 % of the diagonal before already sharp parts were left alone, joint's to 0.16 %).
+    for name in ["fandisk.off", "joint.off"] {
+        let m = whet_io::read_path(&whet_testkit::shared_fixture(name), None).unwrap();
+        let opts = whet_codec::EncodeOptions::DEFAULT.with_quant_bits(12);
+        let bytes = whet_codec::encode(&m, &opts).unwrap().bytes;
+        let decoded = whet_codec::decode(&bytes, &whet_codec::DecodeOptions::DEFAULT).unwrap();
+        let out = sharpen(&decoded, &SharpenOptions::DEFAULT).unwrap();
+        assert_eq!(out.report.already_sharp_components, 1, "{name}");
+        assert!(out.mesh == decoded, "{name}: {}", out.report.to_json());
+        // The papers' method (kept as the floor) still takes its narrow faces for chamfers.
+        let papers = sharpen(&decoded, &SharpenOptions::PAPERS).unwrap();
+        assert!(papers.report.new_vertices > 0, "{name}");
+    }
+}
+
+#[test]
+fn an_already_sharp_part_is_left_alone_beside_a_chamfered_one() {
+    // One mesh of two parts: a CAD original (already sharp) and a marching-cubes sampling
+    // of the cube (chamfered). The decision is per part: the sampling is sharpened, the
+    // original's vertices and triangles come out as they were.
+    let sharp = whet_io::read_path(&whet_testkit::shared_fixture("fandisk.off"), None).unwrap();
+    let cube = chamfered(ShapeKind::Cube, 20);
+    let both = meshes::union(sharp.clone(), &cube, 100.0);
+    let out = sharpen(&both, &SharpenOptions::DEFAULT).unwrap();
+    assert_eq!(out.report.already_sharp_components, 1);
+    // Every new vertex is the cube's (the smooth threshold is the whole mesh's, so the
+    // counts differ from the cube's alone).
+    let nv = sharp.positions.len();
+    assert!(out.report.new_vertices > 0);
+    let new = &out.mesh.positions[both.positions.len()..];
+    assert!(new.iter().all(|p| p.x > 50.0), "a new vertex off the cube");
+    assert_eq!(out.mesh.positions[..nv], sharp.positions[..]);
+    let kept: Vec<[u32; 3]> = out
+        .mesh
+        .triangles
+        .iter()
+        .filter(|t| t.iter().all(|&v| (v as usize) < nv))
+        .copied()
+        .collect();
+    assert_eq!(kept, sharp.triangles);
+    // Alone, the original is one already sharp part; a later pass, whose input is the
+    // previous pass's output, does not look for sharp parts (its creases are the ones the
+    // first pass sharpened).
+    let out = sharpen(&sharp, &SharpenOptions::DEFAULT).unwrap();
+    assert_eq!(out.report.already_sharp_components, 1);
+    let two = sharpen(&cube, &SharpenOptions::DEFAULT.with_passes(2)).unwrap();
+    assert_eq!(two.report.already_sharp_components, 0);
 }
 
 #[test]
