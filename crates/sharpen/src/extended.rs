@@ -109,9 +109,10 @@ pub(crate) fn classify(run: &mut Run) {
             }
         }
     }
-    if run.surface_samples {
-        region_turns(run);
-    } else {
+    // Both kinds of input measure their regions' typical turns: surface samplings for
+    // `distinct_crease`, marching cubes for `flat_sided_crease`.
+    region_turns(run, !run.surface_samples);
+    if !run.surface_samples {
         gray_vertices(run);
     }
     crease_vertices(run);
@@ -406,6 +407,9 @@ fn snap_chamfer_vertices(run: &mut Run) {
                 .any(|y| is_blend(run, x.label, y.label))
         });
         if blend {
+            continue;
+        }
+        if !run.surface_samples && !flat_sided_crease(run, &kept) {
             continue;
         }
         surfaces.clear();
@@ -902,39 +906,53 @@ fn neighbour_plane_distance(run: &Run, v: u32, r: u32) -> f64 {
     best / (len / k.max(1) as f64)
 }
 
-/// Surface samplings: the *typical turn* of each smooth region, the median normal angle of
-/// the edges inside it (both triangles in the region), into `run.s.region_turn` (radians;
-/// 0 for a region without inner edges). Linear: the angles are bucketed by region with prefix
-/// sums, and each bucket's median is a selection, not a sort. The median, not the mean: a CAD
-/// region often joins flat faces and the tangent blends between them, whose larger angles would
-/// pull a mean up; the median is the turn of most of the region.
+/// The *typical turn* of each smooth region, the median normal angle of the edges inside it
+/// (both triangles in the region), into `run.s.region_turn` (radians; 0 for a region without
+/// inner edges). Linear: the angles are bucketed by region with prefix sums, and each bucket's
+/// median is a selection, not a sort. The median, not the mean: a CAD region often joins flat
+/// faces and the tangent blends between them, whose larger angles would pull a mean up; the
+/// median is the turn of most of the region.
+///
+/// Surface samplings take every inner edge. Marching cubes (`sampled`) takes the inner edges
+/// of about [`REGION_SAMPLE`] triangles, evenly spread over the triangle order (every one
+/// under twice that): a face of a million-triangle sampling has hundreds of thousands, whose
+/// bucketing and selection took 22 ms of a 320 ms run (every eighth triangle still 9.5 ms:
+/// the passes read every cache line of the corner arrays), and a sample places its median as
+/// well. A region the sample misses has typical turn 0, which refuses nothing.
 #[inline(never)] // one call per run; kept out of line so profiles show it
-pub(crate) fn region_turns(run: &mut Run) {
+pub(crate) fn region_turns(run: &mut Run, sampled: bool) {
     let nregions = region_count(run);
+    let stride = if sampled {
+        (run.mesh.triangles.len() / REGION_SAMPLE).max(1)
+    } else {
+        1
+    };
     let s = &mut *run.s;
     s.region_turn.clear();
     s.region_turn.resize(nregions, 0.0);
     if nregions == 0 {
         return;
     }
-    // The inner edges: a corner holding an angle (the lower corner of an interior edge) whose
-    // triangle and opposite triangle are in the same region.
-    let inner = |c: usize, s: &crate::edge_sharpener::Scratch| -> Option<u32> {
-        if s.angles[c] < 0.0 {
-            return None;
+    let opposite = run.table.opposites();
+    // The inner edges of triangle `t` in region `r`: a corner holding an angle (the lower
+    // corner of an interior edge) whose opposite triangle is in the same region.
+    let inner = |t: usize, r: u32, s: &crate::edge_sharpener::Scratch| {
+        let (mut corners, mut n) = ([0usize; 3], 0);
+        for c in 3 * t..3 * t + 3 {
+            let o = opposite[c];
+            if s.angles[c] >= 0.0 && o != NONE && s.region[o as usize / 3] == r {
+                corners[n] = c;
+                n += 1;
+            }
         }
-        let r = s.region[c / 3];
-        if r == NONE {
-            return None;
-        }
-        let o = run.table.opposite(CornerId(c as u32))?;
-        (s.region[o.index() / 3] == r).then_some(r)
+        (corners, n)
     };
     s.region_start.clear();
     s.region_start.resize(nregions + 1, 0);
-    for c in 0..s.angles.len() {
-        if let Some(r) = inner(c, s) {
-            s.region_start[r as usize + 1] += 1;
+    for t in (0..s.region.len()).step_by(stride) {
+        let r = s.region[t];
+        if r != NONE {
+            s.region_start[r as usize + 1] += inner(t, r, s).1 as u32;
         }
     }
     for r in 0..nregions {
@@ -944,8 +962,13 @@ pub(crate) fn region_turns(run: &mut Run) {
     s.region_angles
         .resize(s.region_start[nregions] as usize, 0.0);
     // Fill, advancing each region's start: afterwards region_start[r] is where r ends.
-    for c in 0..s.angles.len() {
-        if let Some(r) = inner(c, s) {
+    for t in (0..s.region.len()).step_by(stride) {
+        let r = s.region[t];
+        if r == NONE {
+            continue;
+        }
+        let (corners, n) = inner(t, r, s);
+        for &c in &corners[..n] {
             let k = s.region_start[r as usize] as usize;
             s.region_angles[k] = s.angles[c];
             s.region_start[r as usize] += 1;
@@ -967,6 +990,10 @@ pub(crate) fn region_turns(run: &mut Run) {
         };
     }
 }
+
+/// Marching cubes: about how many triangles measure the regions' typical turns
+/// ([`region_turns`]).
+const REGION_SAMPLE: usize = 1 << 12;
 
 /// Label planes of the red vertices that touch a non-red triangle or two regions.
 #[inline(never)] // one call per run; kept out of line so profiles show it
@@ -1380,6 +1407,7 @@ pub(crate) fn edge_snap(
                 Ok(p) => {
                     // Cheap tests first (the result does not depend on the order).
                     if !consistent(run, p, &[(a, x.label), (b, y.label)], scale)
+                        || (!run.surface_samples && !flat_sided_crease(run, &[*x, *y]))
                         || (run.surface_samples
                             && (p.distance(anchor) > SURFACE_DISPLACEMENT * scale
                                 || !distinct_crease(run, &[(a, x), (b, y)])
@@ -1586,21 +1614,57 @@ pub(crate) const SAME_REGION_CONTRAST: f64 = 1.75;
 /// samplings.
 pub(crate) const MAX_SURFACE_TURN_DEGREES: f64 = 100.0;
 
+/// The typical turn ([`region_turns`]) of the region of `lp`, in radians.
+fn typical_turn(run: &Run, lp: &LabelPlane) -> f64 {
+    f64::from(
+        run.s
+            .region_turn
+            .get(lp.label as usize)
+            .copied()
+            .unwrap_or(0.0),
+    )
+}
+
+/// Marching cubes: whether planes `planes` (of a snap, or of a vertex's move onto a crease or
+/// corner) meet at a crease of a part rather than a bend of a smooth one: every pair turns by
+/// at least [`CREASE_CONTRAST`] times the *typical turn* ([`region_turns`]) of the flatter of
+/// its two regions. A sampled CAD crease has a flat or gently curved face on at least one
+/// side (the synth shapes' planes turn by about 0 inside their regions, fandisk's cone and
+/// cylinder at 32 cells by a few degrees); an organic mesh bends everywhere, and its thin
+/// parts (ears, limbs, rims) give strips turning by 30-60 degrees between regions that turn
+/// by 3-6 degrees per edge, which the filters take for chamfers. The flatter side, not the
+/// mean of the two that surface samplings use ([`distinct_crease`]): with the mean, a crease
+/// between a flat face and fandisk's coarse cone failed (synth fandisk 48 r1 RMS 3.05x ->
+/// 2.90x). Measured (docs/results.md, "Creases with a flat side"): the organic originals
+/// fertility and screwdriver come out unchanged, rocker_arm's max 0.396 -> 0.259 %; on the
+/// marching-cubes table nine fandisk rows gain up to 2.5 % in RMS and 32 r1 loses 2 %, every
+/// max gain as it was.
+fn flat_sided_crease(run: &Run, planes: &[LabelPlane]) -> bool {
+    let typical = |lp: &LabelPlane| typical_turn(run, lp);
+    for (i, x) in planes.iter().enumerate() {
+        for y in &planes[i + 1..] {
+            let least = CREASE_CONTRAST * typical(x).min(typical(y));
+            // A flat side passes at once (no trigonometry: the common case).
+            if least == 0.0 {
+                continue;
+            }
+            if least >= std::f64::consts::PI
+                || x.plane.normal.dot(y.plane.normal).clamp(-1.0, 1.0).acos() < least
+            {
+                return false;
+            }
+        }
+    }
+    true
+}
+
 /// Whether the planes of a snap (`(vertex, label plane)` pairs) meet at a crease distinct
 /// from the regions' own curvature: every pair turns by at most
 /// [`MAX_SURFACE_TURN_DEGREES`] and by at least [`CREASE_CONTRAST`] times the mean typical turn
 /// of its two regions ([`SAME_REGION_CONTRAST`] times more for sides joined smoothly).
-/// Surface samplings only (on marching cubes the consistency test plays this part).
+/// Surface samplings only (marching cubes has the consistency test and [`flat_sided_crease`]).
 fn distinct_crease(run: &Run, planes: &[(u32, &LabelPlane)]) -> bool {
-    let typical = |lp: &LabelPlane| {
-        f64::from(
-            run.s
-                .region_turn
-                .get(lp.label as usize)
-                .copied()
-                .unwrap_or(0.0),
-        )
-    };
+    let typical = |lp: &LabelPlane| typical_turn(run, lp);
     let max_cos = MAX_SURFACE_TURN_DEGREES.to_radians().cos();
     for (i, &(a, x)) in planes.iter().enumerate() {
         for &(b, y) in &planes[i + 1..] {
@@ -1706,8 +1770,9 @@ pub(crate) fn corner_snap(
                             q,
                             &[(tri[0], x.label), (tri[1], y.label), (tri[2], z.label)],
                             2.0 * scale,
-                        ) || (run.surface_samples
-                            && !distinct_crease(run, &[(tri[0], x), (tri[1], y), (tri[2], z)]))
+                        ) || (!run.surface_samples && !flat_sided_crease(run, &[*x, *y, *z]))
+                            || (run.surface_samples
+                                && !distinct_crease(run, &[(tri[0], x), (tri[1], y), (tri[2], z)]))
                             || !supported_within(
                                 run,
                                 q,
@@ -1936,7 +2001,7 @@ fn unlabelled_corner_vertices(run: &mut Run, placed: &mut Vec<DVec3>, moved: &mu
                     let small = |lp: &LabelPlane| {
                         region_size.get(lp.label as usize).copied().unwrap_or(0) < MIN_CORNER_REGION
                     };
-                    if small(x) || small(y) || small(z) {
+                    if small(x) || small(y) || small(z) || !flat_sided_crease(run, &[*x, *y, *z]) {
                         continue;
                     }
                     let Ok(q) = snap::corner_point(&x.plane, &y.plane, &z.plane, p, &run.limits)
