@@ -823,3 +823,35 @@ fn decode_sharpen_replays_the_encoders_snap_vetoes() {
     }
     assert!(old_worse > 0, "the case the vetoes are for was not made");
 }
+
+#[test]
+fn sharpen_leaves_an_already_sharp_original_alone_unless_told() {
+    // A CAD original: its creases run along edges, so the default run leaves it as it is and
+    // says so on stderr and in the JSON; `--no-sharp-parts` takes it for a sampling (its
+    // narrow faces then read as chamfers and get split).
+    let dir = scratch_dir("cli-sharpen-sharp-parts");
+    let input = shared_fixture("fandisk.off");
+    let (kept, forced) = (dir.join("kept.off"), dir.join("forced.off"));
+    let o = whet(&["sharpen", s(&input), "-o", s(&kept), "--json"]);
+    assert!(o.status.success());
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("already sharp"),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(j["already_sharp_components"], 1);
+    assert_eq!(j["new_vertices"], 0);
+    let (max, _) = rms_pct(&input, &kept);
+    assert!(max < 1e-9, "{max}");
+    let j = whet_json(&[
+        "sharpen",
+        s(&input),
+        "-o",
+        s(&forced),
+        "--no-sharp-parts",
+        "--json",
+    ]);
+    assert_eq!(j["already_sharp_components"], 0);
+    assert!(j["new_vertices"].as_u64().unwrap() > 0);
+}
