@@ -540,6 +540,7 @@ fn compose_passes(first: Sharpened, next: Sharpened) -> Sharpened {
         corner_triangles: a.corner_triangles + b.corner_triangles,
         twin_corners: a.twin_corners + b.twin_corners,
         already_sharp_components: a.already_sharp_components + b.already_sharp_components,
+        direct_crease_fraction: a.direct_crease_fraction,
         chamfer_vertices: a.chamfer_vertices + b.chamfer_vertices,
         inserted_vertices: a.inserted_vertices + b.inserted_vertices,
         new_vertices: a.new_vertices + b.new_vertices,

@@ -91,7 +91,9 @@ pub(crate) fn classify(run: &mut Run) {
     // The red set is final from here on.
     run.list_gray_triangles();
     let sharp_parts = if run.input_may_be_sharp {
-        already_sharp_parts(run)
+        let (fraction, parts) = already_sharp_parts(run);
+        run.report.direct_crease_fraction = fraction;
+        parts
     } else {
         None
     };
@@ -1640,10 +1642,9 @@ fn typical_turn(run: &Run, lp: &LabelPlane) -> f64 {
 /// marching-cubes table nine fandisk rows gain up to 2.5 % in RMS and 32 r1 loses 2 %, every
 /// max gain as it was.
 fn flat_sided_crease(run: &Run, planes: &[LabelPlane]) -> bool {
-    let typical = |lp: &LabelPlane| typical_turn(run, lp);
     for (i, x) in planes.iter().enumerate() {
         for y in &planes[i + 1..] {
-            let least = CREASE_CONTRAST * typical(x).min(typical(y));
+            let least = CREASE_CONTRAST * typical_turn(run, x).min(typical_turn(run, y));
             // A flat side passes at once (no trigonometry: the common case).
             if least == 0.0 {
                 continue;
@@ -2115,12 +2116,14 @@ pub(crate) const STRONG_CREASE_DEGREES: f64 = 20.0;
 
 /// A part (connected component) is already sharp when at least this fraction of the length
 /// of its strong creases runs along *direct* edges, between red triangles of two smooth
-/// regions. Measured (2026-12-06, `whet sharpen` with a temporary print, the whole mesh as one
-/// part): the CAD originals fandisk, partLp, joint, block, cad_bracket, cad_box_hole,
-/// cad_cyl_fillet and sharp_sphere 0.68-1.0; every chamfered input at most 0.10 (the 48
-/// swing-decoded fixture meshes of `sharpen_figures -- swing` 0.00-0.09, marching cubes of
-/// cube, pyramid, fandisk, cylinder and blend at 32-128 cells, generic, grid-aligned and
-/// near-axis rotations, 0.00-0.10); the organic fixtures and rocker_arm 0.00-0.03.
+/// regions. Measured (2026-12-06, the whole mesh as one part: `whet sharpen <in> -o out.off
+/// --json`, key `direct_crease_fraction`): the CAD originals fandisk, partLp, joint, block,
+/// cad_bracket, cad_box_hole, cad_cyl_fillet and sharp_sphere 0.68-1.0; the 48 swing-decoded
+/// fixture meshes of `sharpen_figures -- swing` 0.00-0.09; marching cubes of cube, pyramid,
+/// fandisk, cylinder and blend at 32-128 cells (generic, grid-aligned and near-axis
+/// rotations) 0.00-0.12, of nine synth shapes at 20-28 cells at most 0.14, at 12-16 cells up
+/// to 0.28 (creases barely resolved: the margin is thin there, and a part taken for sharp is
+/// only left unchanged); the organic fixtures and rocker_arm 0.00-0.03.
 pub(crate) const ALREADY_SHARP_FRACTION: f64 = 0.3;
 
 /// The whole mesh's fraction under which no part is looked at on its own (a mesh of
@@ -2131,9 +2134,10 @@ const PART_SCAN_FRACTION: f64 = 0.1;
 /// Fewer strong creases than this in a part say nothing either way: the part is sharpened.
 pub(crate) const MIN_STRONG_CREASES: usize = 8;
 
-/// The parts of the mesh whose creases are already sharp ([`ALREADY_SHARP_FRACTION`]): per
-/// part, whether it is, and the part of each triangle; `None` when none is (or the whole
-/// mesh's fraction is under [`PART_SCAN_FRACTION`]).
+/// The whole mesh's fraction of strong-crease length on direct edges (0 without strong
+/// creases), and the parts of the mesh whose creases are already sharp
+/// ([`ALREADY_SHARP_FRACTION`]): per part, whether it is, and the part of each triangle;
+/// `None` when none is (or the whole mesh's fraction is under [`PART_SCAN_FRACTION`]).
 ///
 /// The papers' filters assume every crease was cut by the sampling, and a chamfer, locally,
 /// looks like a narrow real face (a 45-degree chamfer one triangle wide, a facet of a coarsely
@@ -2142,7 +2146,8 @@ pub(crate) const MIN_STRONG_CREASES: usize = 8;
 /// the two inputs apart is how the *other* creases look: a sampling cuts nearly every crease
 /// into a chamfer, so its strong creases border a gray triangle; a CAD tessellation has its
 /// creases on its edges, between the faces' own triangles.
-fn already_sharp_parts(run: &Run) -> Option<(Vec<bool>, Vec<u32>)> {
+#[allow(clippy::type_complexity)] // (fraction, (sharp per part, part per triangle))
+fn already_sharp_parts(run: &Run) -> (f64, Option<(Vec<bool>, Vec<u32>)>) {
     let min_turn = run.smooth_threshold.max(STRONG_CREASE_DEGREES.to_radians());
     let opposite = run.table.opposites();
     let s = &run.s;
@@ -2166,8 +2171,12 @@ fn already_sharp_parts(run: &Run) -> Option<(Vec<bool>, Vec<u32>)> {
             direct += len;
         }
     }
-    if all == 0.0 || direct < PART_SCAN_FRACTION * all {
-        return None;
+    if all == 0.0 {
+        return (0.0, None);
+    }
+    let fraction = direct / all;
+    if fraction < PART_SCAN_FRACTION {
+        return (fraction, None);
     }
     let part = run.table.triangle_components();
     let nt = part.len();
@@ -2184,7 +2193,7 @@ fn already_sharp_parts(run: &Run) -> Option<(Vec<bool>, Vec<u32>)> {
         .iter()
         .map(|&(d, a, n)| n >= MIN_STRONG_CREASES && d >= ALREADY_SHARP_FRACTION * a)
         .collect();
-    sharp.contains(&true).then_some((sharp, part))
+    (fraction, sharp.contains(&true).then_some((sharp, part)))
 }
 
 #[cfg(test)]

@@ -132,6 +132,10 @@ pub struct SharpenReport {
     /// (most of their strong creases run along edges between smooth regions instead of
     /// bordering a chamfer; docs/sharpen.md, "What we extend", step 17).
     pub already_sharp_components: usize,
+    /// Extended method, first pass: the fraction of the whole mesh's strong-crease length that
+    /// runs along edges between smooth regions (`already_sharp_components`' measure; 0 without
+    /// strong creases or in later passes).
+    pub direct_crease_fraction: f64,
     /// Vertices tagged sharp (filter 3bis plus the new vertices).
     pub tagged_vertices: usize,
     /// Edges tagged sharp.
@@ -195,8 +199,8 @@ impl SharpenReport {
     /// `absolute_feature_vertices`, `presmooth_iterations`, `filtered_normals`,
     /// `rectified_normals`, `update_iterations`, `flips_avoided`, `swaps`, `collapses`,
     /// `detection_ms`, `filtering_ms` and `updating_ms` (zeros for the other methods), then
-    /// `curved_wall_factor`, `curved_wall_edges`, `passes`, `twin_corners` and
-    /// `already_sharp_components`.
+    /// `curved_wall_factor`, `curved_wall_edges`, `passes`, `twin_corners`,
+    /// `already_sharp_components` and `direct_crease_fraction`.
     pub fn to_json(&self) -> String {
         let mut s = String::with_capacity(768);
         // Writing to a String cannot fail.
@@ -248,7 +252,7 @@ impl SharpenReport {
              \"rectified_normals\":{},\"update_iterations\":{},\"flips_avoided\":{},\"swaps\":{},\
              \"collapses\":{},\"detection_ms\":{},\"filtering_ms\":{},\"updating_ms\":{},\
              \"curved_wall_factor\":{},\"curved_wall_edges\":{},\"passes\":{},\
-             \"twin_corners\":{},\"already_sharp_components\":{}}}",
+             \"twin_corners\":{},\"already_sharp_components\":{},\"direct_crease_fraction\":{}}}",
             json_num(self.rho),
             json_num(self.eta),
             json_num(self.lambda),
@@ -270,6 +274,7 @@ impl SharpenReport {
             self.passes,
             self.twin_corners,
             self.already_sharp_components,
+            json_num(self.direct_crease_fraction),
         );
         s
     }
@@ -317,6 +322,7 @@ mod tests {
             "passes",
             "twin_corners",
             "already_sharp_components",
+            "direct_crease_fraction",
         ] {
             assert_eq!(j.matches(&format!("\"{key}\":")).count(), 1, "{key} in {j}");
         }
