@@ -170,8 +170,9 @@ pub fn run(args: &DecodeArgs) -> CliResult {
             if let Some(h) = &header {
                 whet_codec::SurfaceFilter::after_sharpening_of(h)
                     .apply_after_sharpening(&mesh, &mut s.mesh);
-                // Then the flat faces onto their planes and the curved ones onto local
-                // quadrics, when the stream says so.
+                // Then the flat faces onto their planes, the curved ones onto local
+                // quadrics and the crease vertices onto their sides' intersection, when the
+                // stream says so.
                 super::sharpen::project_as_stated(h, &mut s.mesh);
             }
         }

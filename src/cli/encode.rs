@@ -377,6 +377,26 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh, skipped: &whet::io::ReadRepor
     // The retiling bridges features thinner than L; far past that, part of the surface is
     // missing from the decoded mesh, which the user should hear about rather than find.
     let gap_pct = 100.0 * out.coverage_gap * out.edge_length_fraction;
+    // Built apart from the object below, which is near serde_json's macro recursion limit
+    // (raised in main.rs).
+    let sharpen_trials: Vec<_> = out
+        .sharpen_trials
+        .iter()
+        .map(|t| {
+            json!({
+                "method": t.hint.name(),
+                "smooth_factor": t.smooth_factor,
+                "curved_walls": t.curved_walls,
+                "passes": t.passes,
+                "rms_error_pct": t.rms_pct,
+                "max_error_pct": t.max_pct,
+                "planar": t.planar,
+                "quadric": t.quadric,
+                "crease": t.crease,
+                "sharpened_filter": t.sharpened_filter,
+            })
+        })
+        .collect();
     if !out.coverage_gap.is_finite() {
         // A distance that could not be computed, which the encoder counts as uncovered
         // (JSON: null).
@@ -442,19 +462,10 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh, skipped: &whet::io::ReadRepor
             "sharpen_smooth_factor": out.sharpen_hint.and(out.sharpen_smooth_factor),
             "sharpen_curved_walls": out.sharpen_hint.and(out.sharpen_curved_walls),
             "sharpen_passes": out.sharpen_hint.map(|_| out.sharpen_passes.unwrap_or(1)),
-            "sharpen_trials": out.sharpen_trials.iter().map(|t| json!({
-                "method": t.hint.name(),
-                "smooth_factor": t.smooth_factor,
-                "curved_walls": t.curved_walls,
-                "passes": t.passes,
-                "rms_error_pct": t.rms_pct,
-                "max_error_pct": t.max_pct,
-                "planar": t.planar,
-                "quadric": t.quadric,
-                "sharpened_filter": t.sharpened_filter,
-            })).collect::<Vec<_>>(),
+            "sharpen_trials": sharpen_trials,
             "planar_tolerance": out.planar_factor,
             "quadric_projection": out.quadric_factor,
+            "crease_projection": out.crease_factor,
             "sharpen_input_max_error_pct": out.sharpen_input_max_pct,
             "search": out.search.iter().map(|&(f, b)| json!([f, b])).collect::<Vec<_>>(),
             "angle_trials": out.angle_trials.iter().map(|t| json!({

@@ -130,7 +130,7 @@ pub fn stated_vetoes(header: &whet_format::Header) -> CliResult<Option<whet_shar
 /// A swing stream's projections after sharpening, applied to `sharpened`: the output of the
 /// sharpening and of the stream's filter for after sharpening (docs/swing.md section 2).
 /// First the planar-region projection (optional header field 25), then the local quadric
-/// projection (field 31). A mesh a projection refuses (it needs an oriented manifold, which
+/// projection (field 31), then the crease projection (field 35). A mesh a projection refuses (it needs an oriented manifold, which
 /// sharpening gives) is kept as it is with a warning, as the encoder's measurement keeps
 /// it: the fields are optional refinements, not part of the decoded mesh.
 pub fn project_as_stated(header: &whet_format::Header, sharpened: &mut Mesh) {
@@ -144,6 +144,12 @@ pub fn project_as_stated(header: &whet_format::Header, sharpened: &mut Mesh) {
         let opts = whet_sharpen::QuadricOptions::for_swing(bits, factor);
         if let Err(e) = whet_sharpen::project_onto_local_quadrics(sharpened, &opts) {
             eprintln!("whet: the local quadric projection was skipped: {e}");
+        }
+    }
+    if let Some(max_move) = whet_codec::SharpenHint::crease_of(header) {
+        let opts = whet_sharpen::CreaseOptions::DEFAULT.with_max_move(max_move);
+        if let Err(e) = whet_sharpen::project_creases_onto_local_quadrics(sharpened, &opts) {
+            eprintln!("whet: the crease projection was skipped: {e}");
         }
     }
 }

@@ -336,12 +336,8 @@ fn bend_and_subdivide_repair_non_manifold_input() {
     }
 }
 
-/// `whet decode --sharpen` follows the sharpening a swing stream names (header field 21,
-/// written by `--optimize-for sharpened`) unless `--method` is given; a stream that names
-/// no sharpening decodes as plain `whet decode` does.
-#[test]
-fn decode_sharpen_follows_the_streams_hint() {
-    let dir = scratch_dir("cli-decode-sharpen-hint");
+/// A marching-cubes cube at 20 cells, turned so that every edge is chamfered, in `dir`.
+fn chamfered_cube(dir: &std::path::Path) -> std::path::PathBuf {
     let mc = dir.join("cube.off");
     let o = whet(&[
         "synth",
@@ -354,6 +350,16 @@ fn decode_sharpen_follows_the_streams_hint() {
         "0,1,1,30",
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    mc
+}
+
+/// `whet decode --sharpen` follows the sharpening a swing stream names (header field 21,
+/// written by `--optimize-for sharpened`) unless `--method` is given; a stream that names
+/// no sharpening decodes as plain `whet decode` does.
+#[test]
+fn decode_sharpen_follows_the_streams_hint() {
+    let dir = scratch_dir("cli-decode-sharpen-hint");
+    let mc = chamfered_cube(&dir);
     let stream = dir.join("c.whet");
     let j = whet_json(&[
         "encode",
@@ -371,16 +377,19 @@ fn decode_sharpen_follows_the_streams_hint() {
     // refined (its smooth factor a quarter up and down, with curved walls each also with
     // the wall factor one up and one down: 2 or 8 more), and none, and kept the lowest
     // error; then the chosen sharpening once more with the planar-region projection, kept
-    // when it beat it, and once more with the local quadric projection on top; then, when
-    // its stream carried a filter for after sharpening, the same three without that filter.
+    // when it beat it, once more with the local quadric projection on top, and once more
+    // with the crease projection on top of what was kept; then, when its stream carried a
+    // filter for after sharpening, the same four without that filter.
     let all = j["sharpen_trials"].as_array().unwrap();
     let with_filter = |t: &&serde_json::Value| t["sharpened_filter"] == true;
     let trials: Vec<_> = all
         .iter()
-        .filter(|t| t["planar"] == false && t["quadric"] == false && with_filter(t))
+        .filter(|t| {
+            t["planar"] == false && t["quadric"] == false && t["crease"] == false && with_filter(t)
+        })
         .collect();
     let bare: Vec<_> = all.iter().filter(|t| !with_filter(t)).collect();
-    assert!(bare.is_empty() || bare.len() == 3, "{j}");
+    assert!(bare.is_empty() || bare.len() == 4, "{j}");
     // The stream states no filter for after sharpening when the path without it won.
     let stated_filter =
         j["sharpened_filter"]["normal"] != 0.0 || j["sharpened_filter"]["smoothed"] != 0.0;
@@ -388,12 +397,17 @@ fn decode_sharpen_follows_the_streams_hint() {
     let on_path = |t: &&&serde_json::Value| with_filter(t) != bare_won;
     let planar: Vec<_> = all
         .iter()
-        .filter(|t| t["planar"] == true && t["quadric"] == false)
+        .filter(|t| t["planar"] == true && t["quadric"] == false && t["crease"] == false)
         .filter(|t| on_path(&t))
         .collect();
     let quadric: Vec<_> = all
         .iter()
-        .filter(|t| t["quadric"] == true)
+        .filter(|t| t["quadric"] == true && t["crease"] == false)
+        .filter(|t| on_path(&t))
+        .collect();
+    let crease: Vec<_> = all
+        .iter()
+        .filter(|t| t["crease"] == true)
         .filter(|t| on_path(&t))
         .collect();
     // The refined candidates: 2 around a grid best without curved walls, 8 with, none
@@ -424,6 +438,12 @@ fn decode_sharpen_follows_the_streams_hint() {
     let chosen = j["sharpen_method"].as_str().unwrap();
     assert_eq!(planar.len(), usize::from(chosen != "none"), "{j}");
     assert_eq!(quadric.len(), planar.len(), "{j}");
+    assert_eq!(crease.len(), planar.len(), "{j}");
+    // The crease trial refines what the planar and quadric decisions kept.
+    if let Some(c) = crease.first() {
+        assert_eq!(c["planar"], !j["planar_tolerance"].is_null(), "{j}");
+        assert_eq!(c["quadric"], !j["quadric_projection"].is_null(), "{j}");
+    }
     // The stream states curved walls only where they are on.
     let chosen_walls = j["sharpen_curved_walls"].as_f64().unwrap_or(0.0);
     let candidate_error = trials
@@ -446,6 +466,20 @@ fn decode_sharpen_follows_the_streams_hint() {
         candidate_error
     };
     let mut reported = j["rms_error_pct"].as_f64().unwrap();
+    if !j["crease_projection"].is_null() {
+        // The reported error is the crease trial's, under the margin of what it refined.
+        assert_eq!(j["crease_projection"].as_f64(), Some(0.5), "{j}");
+        let c = crease[0]["rms_error_pct"].as_f64().unwrap();
+        assert_eq!(Some(reported), Some(c), "{j}");
+        reported = match quadric.first() {
+            Some(q) if !j["quadric_projection"].is_null() => q["rms_error_pct"].as_f64().unwrap(),
+            _ => match planar.first() {
+                Some(p) if !j["planar_tolerance"].is_null() => p["rms_error_pct"].as_f64().unwrap(),
+                _ => chosen_error,
+            },
+        };
+        assert!(c < 0.995 * reported, "{j}");
+    }
     if !j["quadric_projection"].is_null() {
         // The reported error is the quadric trial's; what it refined is checked below.
         assert_eq!(j["quadric_projection"].as_f64(), Some(0.25), "{j}");
@@ -854,4 +888,53 @@ fn sharpen_leaves_an_already_sharp_original_alone_unless_told() {
     ]);
     assert_eq!(j["already_sharp_components"], 0);
     assert!(j["new_vertices"].as_u64().unwrap() > 0);
+}
+
+/// `whet decode --sharpen` applies the crease projection a swing stream states (optional
+/// header field 35, in hundredths of the mean edge length) after the sharpening and the
+/// other projections: its output is the projection of what the same stream decodes to
+/// without the field.
+#[test]
+fn decode_sharpen_applies_a_stated_crease_projection() {
+    let dir = scratch_dir("cli-crease-projection");
+    let mc = chamfered_cube(&dir);
+    let stream = dir.join("c.whet");
+    let o = whet(&["encode", s(&mc), "-o", s(&stream), "--bpv", "3"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let container = whet_format::parse(
+        &std::fs::read(&stream).unwrap(),
+        &whet_format::Limits::DEFAULT,
+    )
+    .unwrap();
+    assert!(whet_codec::SharpenHint::crease_of(&container.header).is_none());
+    let decode = |input: &std::path::Path, name: &str| {
+        let out = dir.join(name);
+        let o = whet(&["decode", s(input), "-o", s(&out), "--sharpen"]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        whet_io::read_path(&out, None).unwrap()
+    };
+    let plain = decode(&stream, "plain.off");
+    let mut stating = container.clone();
+    stating.header = stating
+        .header
+        .clone()
+        .with(whet_format::tag::CREASE_PROJECTION, 50u64);
+    let stated = dir.join("stated.whet");
+    std::fs::write(&stated, stating.to_bytes().unwrap()).unwrap();
+    let projected = decode(&stated, "projected.off");
+    let mut expected = plain.clone();
+    let opts = whet_sharpen::CreaseOptions::DEFAULT.with_max_move(0.5);
+    let report = whet_sharpen::project_creases_onto_local_quadrics(&mut expected, &opts).unwrap();
+    // The cube's twelve edges come out of the sharpening as crease lines.
+    assert!(report.moved_vertices > 12, "{report:?}");
+    assert_eq!(projected.triangles, expected.triangles);
+    let moved = expected
+        .positions
+        .iter()
+        .zip(&plain.positions)
+        .filter(|(a, b)| a != b)
+        .count();
+    assert_eq!(moved, report.moved_vertices);
+    // The OFF writer prints shortest round-trip digits: the files agree to the bit.
+    assert_eq!(projected.positions, expected.positions);
 }

@@ -144,6 +144,21 @@ impl SharpenHint {
         Self::angle_step_factor(header, whet_format::tag::QUADRIC_PROJECTION)
     }
 
+    /// The crease projection a swing stream's header states for after sharpening and the
+    /// two other projections (field 35): its move limit in mean edge lengths (the field's
+    /// hundredths over 100), for `whet_sharpen::CreaseOptions::with_max_move`. `None`
+    /// without the field, for other modes, or with a value outside
+    /// [`Self::SMOOTH_FACTOR_HUNDREDTHS`].
+    pub fn crease_of(header: &whet_format::Header) -> Option<f64> {
+        if header.mode != whet_format::Mode::Swing {
+            return None;
+        }
+        header
+            .get_u64(whet_format::tag::CREASE_PROJECTION)
+            .filter(|h| Self::SMOOTH_FACTOR_HUNDREDTHS.contains(h))
+            .map(|h| h as f64 / 100.0)
+    }
+
     /// A swing header's field `tag` as a factor in hundredths of the angle step, with the
     /// stream's angle bits.
     fn angle_step_factor(header: &whet_format::Header, tag: u64) -> Option<(f64, u32)> {
@@ -192,6 +207,24 @@ mod tests {
             .with(whet_format::tag::ANGLE_BITS, 6u64)
             .with(whet_format::tag::PLANAR_TOLERANCE, 100u64);
         assert_eq!(SharpenHint::planar_of(&exact), None);
+    }
+
+    #[test]
+    fn crease_projection_is_read_from_swing_headers_only_and_in_range() {
+        let swing = whet_format::Header::new(whet_format::Mode::Swing, 3, 1)
+            .with(whet_format::tag::ANGLE_BITS, 6u64);
+        assert_eq!(SharpenHint::crease_of(&swing), None);
+        let on = swing
+            .clone()
+            .with(whet_format::tag::CREASE_PROJECTION, 25u64);
+        assert_eq!(SharpenHint::crease_of(&on), Some(0.25));
+        for bad in [0u64, 1001] {
+            let h = swing.clone().with(whet_format::tag::CREASE_PROJECTION, bad);
+            assert_eq!(SharpenHint::crease_of(&h), None);
+        }
+        let exact = whet_format::Header::new(whet_format::Mode::Exact, 3, 1)
+            .with(whet_format::tag::CREASE_PROJECTION, 25u64);
+        assert_eq!(SharpenHint::crease_of(&exact), None);
     }
 
     #[test]

@@ -187,6 +187,10 @@ pub mod tag {
     /// measured farther from the original than their rest positions, and vetoed, for the
     /// sharpening the stream states (swing; absent: none). Layout in docs/format.md section 3.
     pub const SNAP_VETOES: u64 = 33;
+    /// u64 (optional, added 2026-12-06): the crease projection a decoder applies after
+    /// sharpening and the planar and quadric projections, its move limit in hundredths of the
+    /// mean edge length (swing; absent, or outside 1..=1000: none).
+    pub const CREASE_PROJECTION: u64 = 35;
     /// i64 (format 1.4): factor of `s2`, the one-ring mean of the filter's smoothed field,
     /// in the swing decoder's extended surface filter, in units of 1/1024 (swing; absent:
     /// 0). Required: a stream with it decodes to another mesh.
@@ -205,7 +209,7 @@ pub mod tag {
     pub const EXACT_PREDICTION: u64 = 40;
 
     /// Every tag this crate knows, with its name and value type.
-    pub const KNOWN: [(u64, &str, ValueType); 23] = [
+    pub const KNOWN: [(u64, &str, ValueType); 24] = [
         (ENCODER, "encoder", ValueType::Bytes),
         (COMPONENT_COUNT, "component_count", ValueType::U64),
         (QUANT_BITS, "quant_bits", ValueType::U64),
@@ -237,6 +241,7 @@ pub mod tag {
         (QUADRIC_PROJECTION, "quadric_projection", ValueType::U64),
         (BBOX_F32, "bbox_f32", ValueType::Bytes),
         (SNAP_VETOES, "snap_vetoes", ValueType::Bytes),
+        (CREASE_PROJECTION, "crease_projection", ValueType::U64),
         (FILTER_SMOOTHED2, "filter_smoothed2", ValueType::I64),
         (FILTER_QUADRATIC, "filter_quadratic", ValueType::I64),
         (FILTER_TANGENTIAL, "filter_tangential", ValueType::I64),

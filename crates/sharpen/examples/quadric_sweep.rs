@@ -12,7 +12,7 @@ mod support;
 mod swing_inputs;
 
 use whet_metro::{metro, MetroOptions};
-use whet_sharpen::{flatten_planar_regions, project_onto_local_quadrics, QuadricOptions};
+use whet_sharpen::{project_onto_local_quadrics, QuadricOptions};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -36,14 +36,7 @@ fn main() {
                 if s.sharpen_hint == Some(whet_codec::SharpenHint::Unsharpened) {
                     continue;
                 }
-                let mut base = s.decode_sharpen_unprojected();
-                let header = whet_format::parse(&s.bytes, &whet_format::Limits::UNLIMITED)
-                    .unwrap_or_else(|e| panic!("{e}"))
-                    .header;
-                if let Some((f, bits)) = whet_codec::SharpenHint::planar_of(&header) {
-                    let opts = whet_sharpen::PlanarOptions::for_swing(bits, f);
-                    flatten_planar_regions(&mut base, &opts).unwrap_or_else(|e| panic!("{e}"));
-                }
+                let base = s.decode_sharpen_through(swing_inputs::Projections::Planar);
                 let mut fitted = base.clone();
                 let opts = QuadricOptions::for_swing(s.angle_bits, factor)
                     .with_rings(rings)

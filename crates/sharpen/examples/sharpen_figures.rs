@@ -169,7 +169,7 @@ fn swing(only: Option<String>) {
                 let name = match s.sharpen_hint {
                     Some(SharpenHint::Unsharpened) => "none".to_string(),
                     h => format!(
-                        "{} {}{}{}{}{}{}",
+                        "{} {}{}{}{}{}{}{}",
                         h.map_or("extended", SharpenHint::name),
                         s.smooth_factor,
                         match s.curved_walls {
@@ -183,6 +183,7 @@ fn swing(only: Option<String>) {
                         },
                         if s.planar { " + planes" } else { "" },
                         if s.quadric { " + quadrics" } else { "" },
+                        if s.crease { " + creases" } else { "" },
                         if s.after_filter { "" } else { " − filter" }
                     ),
                 };

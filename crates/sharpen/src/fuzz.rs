@@ -8,8 +8,8 @@
 //! coincidences and exact coplanarity are common.
 
 use crate::{
-    flatten_planar_regions, project_onto_local_quadrics, sharpen, Error, Method, PlanarOptions,
-    QuadricOptions, SharpenOptions,
+    flatten_planar_regions, project_creases_onto_local_quadrics, project_onto_local_quadrics,
+    sharpen, CreaseOptions, Error, Method, PlanarOptions, QuadricOptions, SharpenOptions,
 };
 use whet_mesh::{CornerTable, DVec3, Mesh, MeshError, VertexId};
 
@@ -73,7 +73,7 @@ pub fn fuzz_input(data: &[u8]) -> Option<(Mesh, SharpenOptions, PlanarOptions, Q
 }
 
 /// Sharpens the mesh `data` describes ([`fuzz_input`]) as `whet sharpen` does (cut to a
-/// manifold first when it is not one), then runs the two projections after sharpening; the
+/// manifold first when it is not one), then runs the three projections after sharpening; the
 /// EdgeSharpener methods run once more with a pseudo-random half of their snaps vetoed, as
 /// a stream's field 33 may ask.
 /// Panics only on a bug: a panic inside, an internal error, or an output that breaks the
@@ -132,7 +132,7 @@ pub fn fuzz_sharpen(data: &[u8]) -> Option<(Mesh, Vec<[u32; 2]>)> {
             "the papers' method moved an input vertex"
         );
     }
-    // Both projections take every sharpened mesh (an oriented manifold, finite), move only
+    // The projections take every sharpened mesh (an oriented manifold, finite), move only
     // interior vertices and by at most their limits in mean edge lengths: the planar
     // projection half an edge, the quadric one its option.
     let before = sharp.clone();
@@ -145,6 +145,14 @@ pub fn fuzz_sharpen(data: &[u8]) -> Option<(Mesh, Vec<[u32; 2]>)> {
         panic!("quadric projection refused a sharpened mesh: {e}");
     }
     check_moves(&before, &sharp, quadric.max_move, "quadric projection");
+    // The crease projection, at the quadric one's limit (a stream states its own in mean
+    // edge lengths, 0.01 to 10): the same promises.
+    let crease = CreaseOptions::DEFAULT.with_max_move(quadric.max_move);
+    let before = sharp.clone();
+    if let Err(e) = project_creases_onto_local_quadrics(&mut sharp, &crease) {
+        panic!("crease projection refused a sharpened mesh: {e}");
+    }
+    check_moves(&before, &sharp, crease.max_move, "crease projection");
     let edges = out.tags.edges.iter().map(|e| [e[0].0, e[1].0]).collect();
     Some((sharp, edges))
 }

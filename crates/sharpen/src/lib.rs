@@ -10,7 +10,9 @@
 //! with samples, noisy creases; [`sharpen_region`] limits it to a [`VertexSelection`]).
 //! [`flatten_planar_regions`] moves the vertices inside a decoded mesh's flat faces onto
 //! their fitted planes (the swing decoder's quantization noise, which sharpening leaves);
-//! [`project_onto_local_quadrics`] does the same for curved faces, vertex by vertex.
+//! [`project_onto_local_quadrics`] does the same for curved faces, vertex by vertex, and
+//! [`project_creases_onto_local_quadrics`] moves the vertices on crease lines onto the
+//! intersection of the quadrics fitted to their two sides.
 //! See `docs/sharpen.md` for the rules and the degenerate cases.
 //!
 //! ```
@@ -30,6 +32,7 @@
 //! ```
 #![forbid(unsafe_code)]
 
+mod crease;
 mod edge_sharpener;
 mod extended;
 mod fuzz;
@@ -44,6 +47,7 @@ mod snap;
 mod tags;
 mod weld;
 
+pub use crease::{project_creases_onto_local_quadrics, CreaseOptions, CreaseReport};
 pub use edge_sharpener::EdgeSharpener;
 
 /// What sharpening holds at its peak per input triangle, with the input mesh and the

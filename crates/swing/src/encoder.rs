@@ -76,6 +76,9 @@ pub struct SharpenTrial {
     /// [`QUADRIC_FACTOR`]): tried on the best sharpening, with the planar projection when
     /// that was kept.
     pub quadric: bool,
+    /// With the crease projection after those (optional header field 35, at
+    /// [`CREASE_MOVE`]): tried last, with the projections kept before it.
+    pub crease: bool,
     /// With the stream's surface filter for after sharpening (header fields 17 and 19)
     /// applied: true but for the chosen sharpening tried without it (a stream whose filter
     /// the encoder fitted to zero counts as with it).
@@ -117,6 +120,15 @@ pub const PLANAR_FACTOR: f64 = 2.0;
 /// whet-sharpen), 0.25 gained the most where it was kept (docs/results.md, "Local quadric
 /// projection").
 pub const QUADRIC_FACTOR: f64 = 0.25;
+
+/// The crease projection's move limit, in mean edge lengths, that the encoder tries after
+/// the other projections (`whet_sharpen::CreaseOptions`; docs/swing.md section 2): the
+/// crease vertices' errors come from the sharpener's plane intersections as much as from
+/// the angle quantization, so the limit is not in angle steps. Of 0.1, 0.25, 0.35, 0.5,
+/// 0.75 and 1 on the 42 sharpened swing rows of the sharpening figures (`crease_sweep` in
+/// whet-sharpen), 0.5 gained the most and raised no row's max (docs/results.md, "Crease
+/// projection").
+pub const CREASE_MOVE: f64 = 0.5;
 
 /// Options of [`SwingEncoder`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -311,6 +323,9 @@ pub struct SwingOutput {
     /// The local quadric projection after those the stream states (optional header field
     /// 31: its move limit in angle steps), when the encoder measured it better.
     pub quadric_factor: Option<f64>,
+    /// The crease projection after those the stream states (optional header field 35: its
+    /// move limit in mean edge lengths), when the encoder measured it better.
+    pub crease_factor: Option<f64>,
     /// The candidates of that choice with their measured symmetric RMS error (% of the
     /// diagonal; empty when no choice was made).
     pub sharpen_trials: Vec<SharpenTrial>,
@@ -640,6 +655,7 @@ impl SwingEncoder {
             max_pct: decoded_max,
             planar: false,
             quadric: false,
+            crease: false,
             sharpened_filter: true,
         };
         // Candidates whose output is the same mesh (curved walls that turn no edge smooth, a
@@ -853,9 +869,10 @@ impl SwingEncoder {
         trials: &mut Vec<SharpenTrial>,
     ) -> Result<(SwingOutput, SharpenTrial), Error> {
         let (mut chosen, mut current) = start;
-        let restated: [fn(SwingOutput) -> Result<SwingOutput, Error>; 2] = [
+        let restated: [fn(SwingOutput) -> Result<SwingOutput, Error>; 3] = [
             |o| restate_planar(o, PLANAR_FACTOR),
             |o| restate_quadric(o, QUADRIC_FACTOR),
+            |o| restate_crease(o, CREASE_MOVE),
         ];
         for (k, restate) in restated.iter().enumerate() {
             let projected = restate(chosen.clone())?;
@@ -865,7 +882,8 @@ impl SwingEncoder {
                 rms_pct: rms,
                 max_pct: max,
                 planar: current.planar || k == 0,
-                quadric: k == 1,
+                quadric: current.quadric || k == 1,
+                crease: k == 2,
                 ..current
             };
             trials.push(trial);
@@ -1159,6 +1177,7 @@ impl SwingEncoder {
                 sharpen_passes: info.sharpen_passes,
                 planar_factor: None,
                 quadric_factor: None,
+                crease_factor: None,
                 sharpen_trials: Vec::new(),
                 sharpen_input_max_pct: None,
                 snap_vetoes: None,
@@ -1408,6 +1427,11 @@ impl SwingEncoder {
                     let opts = whet_sharpen::QuadricOptions::for_swing(out.angle_bits, f);
                     // As above: a refused mesh is kept as it is, by the decoder too.
                     let _ = whet_sharpen::project_onto_local_quadrics(&mut m, &opts);
+                }
+                if let Some(max_move) = out.crease_factor {
+                    let opts = whet_sharpen::CreaseOptions::DEFAULT.with_max_move(max_move);
+                    // As above.
+                    let _ = whet_sharpen::project_creases_onto_local_quadrics(&mut m, &opts);
                 }
                 Some(m)
             }
@@ -1719,6 +1743,7 @@ impl Candidate {
             max_pct,
             planar: false,
             quadric: false,
+            crease: false,
             sharpened_filter: true,
         }
     }
@@ -1792,6 +1817,18 @@ fn restate_quadric(mut out: SwingOutput, factor: f64) -> Result<SwingOutput, Err
     out.bytes = with_header_field(&out.bytes, whet_format::tag::QUADRIC_PROJECTION, code)?;
     out.report.bytes = out.bytes.len();
     out.quadric_factor = Some(code as f64 / 100.0);
+    Ok(out)
+}
+
+/// `out` with header field 35 stating the crease projection at a move limit of `max_move`
+/// mean edge lengths (rounded to the field's hundredths). Like field 25, its bytes come
+/// after the size search.
+fn restate_crease(mut out: SwingOutput, max_move: f64) -> Result<SwingOutput, Error> {
+    let code = SharpenHint::smooth_factor_code(max_move)
+        .ok_or_else(|| Error::Internal(format!("crease move {max_move} out of range")))?;
+    out.bytes = with_header_field(&out.bytes, whet_format::tag::CREASE_PROJECTION, code)?;
+    out.report.bytes = out.bytes.len();
+    out.crease_factor = Some(code as f64 / 100.0);
     Ok(out)
 }
 

@@ -74,18 +74,35 @@ pub struct SwingInput {
     pub planar: bool,
     /// The stream states the local quadric projection after sharpening (field 31).
     pub quadric: bool,
+    pub crease: bool,
     /// The stream carries a filter for after sharpening (fields 17 and 19).
     pub after_filter: bool,
     /// The stream.
     pub bytes: Vec<u8>,
 }
 
+/// How far along the projections after sharpening [`SwingInput::decode_sharpen_through`]
+/// goes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Projections {
+    None,
+    Planar,
+    Quadric,
+    All,
+}
+
 impl SwingInput {
     /// What `whet decode --sharpen` writes for this stream (src/cli/decode.rs): the
     /// sharpening the stream names, then its filter for after sharpening on the vertices the
     /// sharpener left alone; for a stream naming none, the plain decoded mesh with its
-    /// surface filter; and the planar-region projection when the stream states it.
+    /// surface filter; and the projections the stream states (planar, quadric, crease).
     pub fn decode_sharpen(&self) -> Mesh {
+        self.decode_sharpen_through(Projections::All)
+    }
+
+    /// [`Self::decode_sharpen`] with the stream's projections up to and including `last`
+    /// (the sweeps of one projection measure it on what the ones before it left).
+    pub fn decode_sharpen_through(&self, last: Projections) -> Mesh {
         let mut m = self.decode_sharpen_unprojected();
         if self.sharpen_hint == Some(whet_codec::SharpenHint::Unsharpened) {
             return m;
@@ -93,13 +110,27 @@ impl SwingInput {
         let header = whet_format::parse(&self.bytes, &whet_format::Limits::UNLIMITED)
             .unwrap_or_else(|e| panic!("{e}"))
             .header;
+        if last == Projections::None {
+            return m;
+        }
         if let Some((factor, bits)) = whet_codec::SharpenHint::planar_of(&header) {
             let opts = whet_sharpen::PlanarOptions::for_swing(bits, factor);
             whet_sharpen::flatten_planar_regions(&mut m, &opts).unwrap_or_else(|e| panic!("{e}"));
         }
+        if last == Projections::Planar {
+            return m;
+        }
         if let Some((factor, bits)) = whet_codec::SharpenHint::quadric_of(&header) {
             let opts = whet_sharpen::QuadricOptions::for_swing(bits, factor);
             whet_sharpen::project_onto_local_quadrics(&mut m, &opts)
+                .unwrap_or_else(|e| panic!("{e}"));
+        }
+        if last == Projections::Quadric {
+            return m;
+        }
+        if let Some(max_move) = whet_codec::SharpenHint::crease_of(&header) {
+            let opts = whet_sharpen::CreaseOptions::DEFAULT.with_max_move(max_move);
+            whet_sharpen::project_creases_onto_local_quadrics(&mut m, &opts)
                 .unwrap_or_else(|e| panic!("{e}"));
         }
         m
@@ -134,13 +165,26 @@ impl SwingInput {
     }
 }
 
+/// Every input of the swing table, in its order: each fixture of [`SWING_FIXTURES`] at each
+/// of its rates, with 6 angle bits and with automatic ones, as (fixture, rate, angles,
+/// input).
+pub fn every_swing_input() -> impl Iterator<Item = (&'static str, f64, Angles, SwingInput)> {
+    SWING_FIXTURES.into_iter().flat_map(|(name, rates)| {
+        rates.into_iter().flat_map(move |bpv| {
+            [Angles::Fixed(6), Angles::AutoSharpened]
+                .into_iter()
+                .map(move |angles| (name, bpv, angles, swing_input(name, bpv, angles)))
+        })
+    })
+}
+
 /// Encodes the shared fixture `name` at `bpv` bits per original vertex and decodes it.
 pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
     let original = whet_io::read_path(&whet_testkit::shared_fixture(name), None)
         .unwrap_or_else(|e| panic!("{name}: {e}"));
     let dir = whet_testkit::workspace_root().join("target/sharpen-swing");
     let _ = std::fs::create_dir_all(&dir);
-    let path = dir.join(format!("v32-{name}-{bpv}-{}.whet", angles.tag()));
+    let path = dir.join(format!("v33-{name}-{bpv}-{}.whet", angles.tag()));
     let bytes = match std::fs::read(&path) {
         Ok(b) => b,
         Err(_) => {
@@ -177,6 +221,7 @@ pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
         after_filter: !whet_codec::SurfaceFilter::after_sharpening_of(&header).is_none(),
         planar: whet_codec::SharpenHint::planar_of(&header).is_some(),
         quadric: whet_codec::SharpenHint::quadric_of(&header).is_some(),
+        crease: whet_codec::SharpenHint::crease_of(&header).is_some(),
         original,
         decoded,
         bytes,

@@ -227,22 +227,22 @@ fn automatic_angle_bits_climb_on_flat_parts_and_stay_low_on_smooth_ones() {
     // The sharpening choice retiled its candidates at the chosen bits (twelve methods,
     // factors and curved walls, in one pass and in two, each the same retiling, the best of
     // them refined: 2 neighbours without curved walls, 8 with; and none), then tried the
-    // chosen one with the planar-region projection and the local quadric one, and without
-    // its filter for after sharpening.
+    // chosen one with the planar-region projection, the local quadric one and the crease
+    // one, and without its filter for after sharpening.
     let unprojected = out
         .sharpen_trials
         .iter()
-        .filter(|t| !t.planar && !t.quadric && t.sharpened_filter)
+        .filter(|t| !t.planar && !t.quadric && !t.crease && t.sharpened_filter)
         .count();
     assert!(
         [25, 27, 33].contains(&unprojected),
         "{:?}",
         out.sharpen_trials
     );
-    // (Plus two projections, and the chosen sharpening without its filter for after
-    // sharpening with its two.)
+    // (Plus three projections, and the chosen sharpening without its filter for after
+    // sharpening with its three.)
     assert!(
-        out.sharpen_trials.len() <= unprojected + 5,
+        out.sharpen_trials.len() <= unprojected + 7,
         "{:?}",
         out.sharpen_trials
     );
@@ -321,15 +321,15 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
         assert_eq!(SharpenHint::of(&header(&out.bytes)), Some(hint));
         // 24 candidates of the grid (each with the filter for after sharpening fitted for
         // it), the grid's best refined (its neighbours in smooth factor and curved walls),
-        // no sharpening; then the chosen sharpening refined by the planar-region projection
-        // and by the local quadric one (on top of the planar one when that was kept); then,
-        // when its stream carried a filter for after sharpening, the same without that
-        // filter, and its two projections.
+        // no sharpening; then the chosen sharpening refined by the planar-region projection,
+        // by the local quadric one and by the crease one (each on top of those kept before
+        // it); then, when its stream carried a filter for after sharpening, the same without
+        // that filter, and its three projections.
         use whet_swing::SharpenTrial;
         let (trials, refined): (Vec<&SharpenTrial>, Vec<_>) = out
             .sharpen_trials
             .iter()
-            .partition(|t| t.sharpened_filter && !t.planar && !t.quadric);
+            .partition(|t| t.sharpened_filter && !t.planar && !t.quadric && !t.crease);
         let input_max = out.sharpen_input_max_pct.unwrap();
         assert_eq!(
             trials.last().map(|t| t.hint),
@@ -366,13 +366,14 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
         let (with, bare): (Vec<&SharpenTrial>, Vec<_>) =
             refined.into_iter().partition(|t| t.sharpened_filter);
         let sharpened = hint != SharpenHint::Unsharpened;
-        assert_eq!(with.len(), if sharpened { 2 } else { 0 }, "{name}");
-        assert!(bare.is_empty() || (sharpened && bare.len() == 3), "{name}");
+        assert_eq!(with.len(), if sharpened { 3 } else { 0 }, "{name}");
+        assert!(bare.is_empty() || (sharpened && bare.len() == 4), "{name}");
         let h = header(&out.bytes);
         let stated = SharpenHint::planar_of(&h);
         assert_eq!(stated.map(|s| s.0), out.planar_factor, "{name}");
         let stated = SharpenHint::quadric_of(&h);
         assert_eq!(stated.map(|s| s.0), out.quadric_factor, "{name}");
+        assert_eq!(SharpenHint::crease_of(&h), out.crease_factor, "{name}");
         let (unprojected, chosen) = if sharpened {
             // The candidate the refinements start from: the same sharpening unprojected.
             let base = **trials
@@ -395,7 +396,8 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
                 let mut current = start;
                 for (k, s) in steps.iter().enumerate() {
                     assert_eq!(s.planar, current.planar || k == 0, "{name}: {s:?}");
-                    assert_eq!(s.quadric, k == 1, "{name}: {s:?}");
+                    assert_eq!(s.quadric, current.quadric || k == 1, "{name}: {s:?}");
+                    assert_eq!(s.crease, k == 2, "{name}: {s:?}");
                     assert_eq!(s.sharpened_filter, start.sharpened_filter, "{name}");
                     if s.score() < 0.995 * current.score() && admit(s) {
                         current = **s;
@@ -405,7 +407,7 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
             };
             let mut end = path_end(base, &with);
             if let Some((first, steps)) = bare.split_first() {
-                assert!(!first.planar && !first.quadric, "{name}");
+                assert!(!first.planar && !first.quadric && !first.crease, "{name}");
                 let without = path_end(**first, steps);
                 if without.score() < 0.995 * end.score() && admit(&without) {
                     end = without;
@@ -414,11 +416,15 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
             assert_eq!(out.rms_pct, Some(end.rms_pct), "{name}");
             assert_eq!(out.planar_factor.is_some(), end.planar, "{name}");
             assert_eq!(out.quadric_factor.is_some(), end.quadric, "{name}");
+            assert_eq!(out.crease_factor.is_some(), end.crease, "{name}");
             if let Some(f) = out.planar_factor {
                 assert_eq!(f, whet_swing::PLANAR_FACTOR);
             }
             if let Some(f) = out.quadric_factor {
                 assert_eq!(f, whet_swing::QUADRIC_FACTOR);
+            }
+            if let Some(f) = out.crease_factor {
+                assert_eq!(f, whet_swing::CREASE_MOVE);
             }
             if !end.sharpened_filter {
                 assert!(out.sharpened_filter.is_none(), "{name}");
