@@ -196,8 +196,8 @@ pub fn project_creases_onto_local_quadrics(
             continue;
         }
         report.crease_vertices += 1;
-        // Each arc: from a cut's corner on to the corner before the other cut (the swing
-        // order runs across the edge towards the next vertex).
+        // A cut at i lies between fan[i] and fan[i + 1] (cyclically); each side is the arc
+        // from the corner after one cut up to and including the corner at the other.
         for (s, side) in sides.iter_mut().enumerate() {
             side.clear();
             let (from, to) = (cuts[s], cuts[1 - s]);
