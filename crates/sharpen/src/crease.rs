@@ -11,7 +11,7 @@
 use glam::DVec3;
 use whet_mesh::{CornerId, Mesh, VertexId};
 
-use crate::planar::{checked_table, solve6};
+use crate::planar::{add_height_sample, checked_table, solve6};
 use crate::Error;
 
 /// Most triangles one side's gathering takes, per square of the ring count (144 for three
@@ -275,13 +275,7 @@ pub fn project_creases_onto_local_quadrics(
                     points += 1;
                     let d = (p[w] - p[v]) / reach;
                     let (a, b, h) = (d.dot(eu), d.dot(ev), d.dot(n));
-                    let basis = [a * a, a * b, b * b, a, b, 1.0];
-                    for i in 0..6 {
-                        for j in 0..6 {
-                            m[i][j] += basis[i] * basis[j];
-                        }
-                        m[i][6] += basis[i] * h;
-                    }
+                    add_height_sample(&mut m, [a * a, a * b, b * b, a, b, 1.0], h);
                 }
             }
             // Six unknowns: at least twice as many points.

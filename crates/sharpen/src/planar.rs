@@ -299,13 +299,7 @@ fn fit_plane(pts: &[DVec3], normal: DVec3) -> Option<PlaneFit> {
     };
     let mut m = [[0.0f64; 7]; 6];
     for &(u, v, h) in &local {
-        let b = basis(u, v);
-        for i in 0..6 {
-            for j in 0..6 {
-                m[i][j] += b[i] * b[j];
-            }
-            m[i][6] += b[i] * h;
-        }
+        add_height_sample(&mut m, basis(u, v), h);
     }
     let coef = solve6(m)?;
     // The plane: the same system with the quadratic terms pinned to zero.
@@ -343,6 +337,19 @@ fn fit_plane(pts: &[DVec3], normal: DVec3) -> Option<PlaneFit> {
             quadric_rms,
         },
     )
+}
+
+/// Adds one sample of height `h` with quadratic basis `b` (`[u^2, uv, v^2, u, v, 1]`) to
+/// the least-squares normal equations `m` of a quadratic height field (augmented: the right
+/// side in column 6), as the planar, quadric and crease fits all build them.
+#[inline]
+pub(crate) fn add_height_sample(m: &mut [[f64; 7]; 6], b: [f64; 6], h: f64) {
+    for i in 0..6 {
+        for j in 0..6 {
+            m[i][j] += b[i] * b[j];
+        }
+        m[i][6] += b[i] * h;
+    }
 }
 
 /// Solves the 6x6 system of augmented matrix `m` by Gaussian elimination with partial

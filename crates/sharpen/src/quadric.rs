@@ -10,7 +10,7 @@
 use glam::DVec3;
 use whet_mesh::{Mesh, VertexId};
 
-use crate::planar::{checked_table, solve6};
+use crate::planar::{add_height_sample, checked_table, solve6};
 use crate::Error;
 
 /// Most points a fit gathers, per square of its ring count: 144 for three rings, about four
@@ -183,13 +183,7 @@ pub fn project_onto_local_quadrics(
         for &w in &ring {
             let d = (p[w as usize] - p[v]) / scale;
             let (u, s, h) = (d.dot(eu), d.dot(ev), d.dot(n));
-            let b = [u * u, u * s, s * s, u, s, 1.0];
-            for i in 0..6 {
-                for j in 0..6 {
-                    m[i][j] += b[i] * b[j];
-                }
-                m[i][6] += b[i] * h;
-            }
+            add_height_sample(&mut m, [u * u, u * s, s * s, u, s, 1.0], h);
         }
         let Some(coef) = solve6(m) else {
             continue;
