@@ -244,84 +244,35 @@ impl Codec for SubdivCodec {
     }
 }
 
-fn sharpened(
-    mesh: &Mesh,
-    method: whet_sharpen::Method,
-    smooth_factor: f64,
-    curved_walls: Option<f64>,
-    passes: u32,
-    mut replay: Option<&mut whet_sharpen::VetoReplay>,
-) -> Result<whet_sharpen::Sharpened, String> {
-    let mut opts = whet_sharpen::SharpenOptions::DEFAULT
-        .with_method(method)
-        .with_smooth_factor(smooth_factor)
-        .with_passes(passes);
-    if let Some(w) = curved_walls {
-        opts = opts.with_curved_wall_factor(w);
-    }
-    // With the stream's snap vetoes (field 33) when it states any, as `whet decode --sharpen`.
-    let mut run = |m: &Mesh| match replay.as_deref_mut() {
-        Some(r) => whet_sharpen::sharpen_judged(m, &opts, r),
-        None => whet_sharpen::sharpen(m, &opts),
-    };
-    match run(mesh) {
-        Ok(s) => Ok(s),
-        Err(whet_sharpen::Error::InvalidInput(_)) => {
-            let mut m = mesh.clone();
-            m.make_manifold();
-            run(&m).map_err(|e| e.to_string())
-        }
-        Err(e) => Err(e.to_string()),
-    }
-}
-
 /// What `whet decode --sharpen` makes of a stream, with the sharp-edge tags for Bender: the
-/// sharpening its header names (`SharpenHint`; extended without one), then its filter for
-/// after sharpening (swing streams that carry one) on the vertices the sharpener left
-/// alone; for a stream whose encoder measured no sharpening best, the plain decoded mesh
-/// (its surface filter included) and no tags.
+/// sharpening its header states (`whet_swing::StatedSharpening`: the extended method
+/// without a hint; its snap vetoes replayed), then its filter for after sharpening and its
+/// projections; for a stream whose encoder measured no sharpening best, the plain decoded
+/// mesh (its surface filter included) and filter 3bis's tags.
 fn sharpened_from_stream(mesh: &Mesh, bytes: &[u8]) -> Result<(Mesh, Vec<[u32; 2]>), String> {
     let header = whet_format::parse(bytes, &whet_format::Limits::UNLIMITED)
         .ok()
         .map(|c| c.header);
-    let stated = header.as_ref().and_then(whet_codec::SharpenHint::stated);
-    let (hint, smooth_factor) = stated.map_or((None, 2.0), |(h, f)| (Some(h), f));
-    let method = match hint {
-        Some(whet_codec::SharpenHint::Unsharpened) => {
+    let stated = match &header {
+        Some(h) => whet_swing::StatedSharpening::of(h).map_err(|e| e.to_string())?,
+        None => whet_swing::StatedSharpening::default(),
+    };
+    match stated.apply(mesh).map_err(|e| e.to_string())? {
+        Some(out) => {
+            for (p, e) in &out.skipped {
+                eprintln!("whet: the {} projection was skipped: {e}", p.name());
+            }
+            let tags = super::sharpen::tag_edges(&out.sharpened.tags);
+            Ok((out.sharpened.mesh, tags))
+        }
+        None => {
             // As `whet decode --sharpen --bend`: filter 3bis's tags for Bender.
             let plain = whet::decode(bytes, &own_streams()).map_err(|e| e.to_string())?;
             let tags =
                 super::sharpen::fallback_tags(&plain).map_err(|e| format!("{:#}", e.error))?;
-            return Ok((plain, tags));
+            Ok((plain, tags))
         }
-        Some(whet_codec::SharpenHint::Papers) => whet_sharpen::Method::Papers,
-        _ => whet_sharpen::Method::Extended,
-    };
-    let curved_walls = header
-        .as_ref()
-        .and_then(whet_codec::SharpenHint::curved_walls_of);
-    let passes = header
-        .as_ref()
-        .and_then(whet_codec::SharpenHint::passes_of)
-        .unwrap_or(1);
-    let mut replay = match &header {
-        Some(h) => super::sharpen::stated_vetoes(h).map_err(|f| format!("{:#}", f.error))?,
-        None => None,
-    };
-    let mut s = sharpened(
-        mesh,
-        method,
-        smooth_factor,
-        curved_walls,
-        passes,
-        replay.as_mut(),
-    )?;
-    if let Some(h) = &header {
-        whet_codec::SurfaceFilter::after_sharpening_of(h).apply_after_sharpening(mesh, &mut s.mesh);
-        super::sharpen::project_as_stated(h, &mut s.mesh);
     }
-    let tags = super::sharpen::tag_edges(&s.tags);
-    Ok((s.mesh, tags))
 }
 
 fn stage_by_name(name: &str) -> Result<Stage, Failure> {

@@ -134,22 +134,9 @@ pub fn stated_vetoes(header: &whet_format::Header) -> CliResult<Option<whet_shar
 /// sharpening gives) is kept as it is with a warning, as the encoder's measurement keeps
 /// it: the fields are optional refinements, not part of the decoded mesh.
 pub fn project_as_stated(header: &whet_format::Header, sharpened: &mut Mesh) {
-    if let Some((factor, bits)) = whet_codec::SharpenHint::planar_of(header) {
-        let opts = whet_sharpen::PlanarOptions::for_swing(bits, factor);
-        if let Err(e) = whet_sharpen::flatten_planar_regions(sharpened, &opts) {
-            eprintln!("whet: the planar-region projection was skipped: {e}");
-        }
-    }
-    if let Some((factor, bits)) = whet_codec::SharpenHint::quadric_of(header) {
-        let opts = whet_sharpen::QuadricOptions::for_swing(bits, factor);
-        if let Err(e) = whet_sharpen::project_onto_local_quadrics(sharpened, &opts) {
-            eprintln!("whet: the local quadric projection was skipped: {e}");
-        }
-    }
-    if let Some(max_move) = whet_codec::SharpenHint::crease_of(header) {
-        let opts = whet_sharpen::CreaseOptions::DEFAULT.with_max_move(max_move);
-        if let Err(e) = whet_sharpen::project_creases_onto_local_quadrics(sharpened, &opts) {
-            eprintln!("whet: the crease projection was skipped: {e}");
+    for p in whet_swing::StatedProjection::all_of(header) {
+        if let Err(e) = p.apply(sharpened) {
+            eprintln!("whet: the {} projection was skipped: {e}", p.name());
         }
     }
 }

@@ -4,6 +4,7 @@
 //! steps; the error goes roughly as `L^2`).
 
 use crate::retiler::{retile_fitted, FilterFits, RetileStats, RetileTuning};
+use crate::stated::StatedProjection;
 use crate::Error;
 use whet_codec::{
     encode_retiled, prepare_mesh, EncodeReport, SharpenHint, SnapVetoes, SurfaceFilter,
@@ -1417,21 +1418,24 @@ impl SwingEncoder {
             Some(s) => {
                 let mut m = s.mesh;
                 out.sharpened_filter.apply_after_sharpening(input, &mut m);
-                if let Some(f) = out.planar_factor {
-                    let opts = whet_sharpen::PlanarOptions::for_swing(out.angle_bits, f);
+                // The projections as the decoder reads them from the header
+                // (`StatedSharpening`), in its order.
+                let projections = [
+                    out.planar_factor.map(|factor| StatedProjection::Planar {
+                        factor,
+                        angle_bits: out.angle_bits,
+                    }),
+                    out.quadric_factor.map(|factor| StatedProjection::Quadric {
+                        factor,
+                        angle_bits: out.angle_bits,
+                    }),
+                    out.crease_factor
+                        .map(|max_move| StatedProjection::Crease { max_move }),
+                ];
+                for p in projections.into_iter().flatten() {
                     // The sharpened mesh is a manifold; were it refused, the decoder keeps it
                     // unprojected too (with a warning).
-                    let _ = whet_sharpen::flatten_planar_regions(&mut m, &opts);
-                }
-                if let Some(f) = out.quadric_factor {
-                    let opts = whet_sharpen::QuadricOptions::for_swing(out.angle_bits, f);
-                    // As above: a refused mesh is kept as it is, by the decoder too.
-                    let _ = whet_sharpen::project_onto_local_quadrics(&mut m, &opts);
-                }
-                if let Some(max_move) = out.crease_factor {
-                    let opts = whet_sharpen::CreaseOptions::DEFAULT.with_max_move(max_move);
-                    // As above.
-                    let _ = whet_sharpen::project_creases_onto_local_quadrics(&mut m, &opts);
+                    let _ = p.apply(&mut m);
                 }
                 Some(m)
             }

@@ -25,6 +25,7 @@ mod grid;
 mod holes;
 mod retiler;
 pub mod snap_judge;
+mod stated;
 mod surface;
 
 pub use encoder::{
@@ -35,6 +36,7 @@ pub use encoder::{
 pub use filter_fit::{fit_displacements, fit_filters, fit_surface_filter, FilterFit};
 pub use fuzz::fuzz_encode;
 pub use retiler::{retile, RetileStats, RetileTuning, Retiled};
+pub use stated::{StatedOutput, StatedProjection, StatedSharpening};
 
 /// Why a mesh could not be encoded in the swing mode.
 #[derive(Debug, thiserror::Error)]

@@ -83,7 +83,7 @@ pub struct SwingInput {
 
 /// How far along the projections after sharpening [`SwingInput::decode_sharpen_through`]
 /// goes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Projections {
     None,
     Planar,
@@ -92,76 +92,78 @@ pub enum Projections {
 }
 
 impl SwingInput {
-    /// What `whet decode --sharpen` writes for this stream (src/cli/decode.rs): the
-    /// sharpening the stream names, then its filter for after sharpening on the vertices the
-    /// sharpener left alone; for a stream naming none, the plain decoded mesh with its
-    /// surface filter; and the projections the stream states (planar, quadric, crease).
+    /// What `whet decode --sharpen` writes for this stream: `whet_swing::StatedSharpening`,
+    /// the code the CLI runs (the sharpening the stream states with its snap vetoes
+    /// replayed, then its filter for after sharpening on the vertices the sharpener left
+    /// alone, then the projections it states); for a stream stating no sharpening, the plain
+    /// decoded mesh with its surface filter.
     pub fn decode_sharpen(&self) -> Mesh {
-        self.decode_sharpen_through(Projections::All)
+        match self.stated().apply(&self.decoded) {
+            Ok(Some(out)) => {
+                assert_eq!(out.mismatched_veto_passes, 0, "vetoes out of step");
+                assert!(out.skipped.is_empty(), "{:?}", out.skipped);
+                out.sharpened.mesh
+            }
+            Ok(None) => self.plain(),
+            Err(e) => panic!("{e}"),
+        }
     }
 
     /// [`Self::decode_sharpen`] with the stream's projections up to and including `last`
     /// (the sweeps of one projection measure it on what the ones before it left).
     pub fn decode_sharpen_through(&self, last: Projections) -> Mesh {
+        let stated = self.stated();
+        if stated.is_unsharpened() {
+            return self.plain();
+        }
         let mut m = self.decode_sharpen_unprojected();
-        if self.sharpen_hint == Some(whet_codec::SharpenHint::Unsharpened) {
-            return m;
-        }
-        let header = whet_format::parse(&self.bytes, &whet_format::Limits::UNLIMITED)
-            .unwrap_or_else(|e| panic!("{e}"))
-            .header;
-        if last == Projections::None {
-            return m;
-        }
-        if let Some((factor, bits)) = whet_codec::SharpenHint::planar_of(&header) {
-            let opts = whet_sharpen::PlanarOptions::for_swing(bits, factor);
-            whet_sharpen::flatten_planar_regions(&mut m, &opts).unwrap_or_else(|e| panic!("{e}"));
-        }
-        if last == Projections::Planar {
-            return m;
-        }
-        if let Some((factor, bits)) = whet_codec::SharpenHint::quadric_of(&header) {
-            let opts = whet_sharpen::QuadricOptions::for_swing(bits, factor);
-            whet_sharpen::project_onto_local_quadrics(&mut m, &opts)
-                .unwrap_or_else(|e| panic!("{e}"));
-        }
-        if last == Projections::Quadric {
-            return m;
-        }
-        if let Some(max_move) = whet_codec::SharpenHint::crease_of(&header) {
-            let opts = whet_sharpen::CreaseOptions::DEFAULT.with_max_move(max_move);
-            whet_sharpen::project_creases_onto_local_quadrics(&mut m, &opts)
-                .unwrap_or_else(|e| panic!("{e}"));
+        let rank = |p: &whet_swing::StatedProjection| match p {
+            whet_swing::StatedProjection::Planar { .. } => Projections::Planar,
+            whet_swing::StatedProjection::Quadric { .. } => Projections::Quadric,
+            whet_swing::StatedProjection::Crease { .. } => Projections::All,
+        };
+        for p in stated.projections.iter().filter(|p| rank(p) <= last) {
+            p.apply(&mut m).unwrap_or_else(|e| panic!("{e}"));
         }
         m
     }
 
-    /// [`Self::decode_sharpen`] without the planar-region projection.
+    /// [`Self::decode_sharpen`] without the projections.
     pub fn decode_sharpen_unprojected(&self) -> Mesh {
+        let stated = self.stated();
+        if stated.is_unsharpened() {
+            return self.plain();
+        }
+        let mut replay = stated.veto_replay();
+        let opts = stated.options();
+        let mut s = match replay.as_mut() {
+            Some(r) => whet_sharpen::sharpen_judged(&self.decoded, &opts, r),
+            None => whet_sharpen::sharpen(&self.decoded, &opts),
+        }
+        .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(
+            replay.map_or(0, |r| r.mismatched_passes()),
+            0,
+            "vetoes out of step"
+        );
+        stated
+            .after_filter
+            .apply_after_sharpening(&self.decoded, &mut s.mesh);
+        s.mesh
+    }
+
+    /// What the stream's header states about sharpening.
+    fn stated(&self) -> whet_swing::StatedSharpening {
         let header = whet_format::parse(&self.bytes, &whet_format::Limits::UNLIMITED)
             .unwrap_or_else(|e| panic!("{e}"))
             .header;
-        let method = match self.sharpen_hint {
-            Some(whet_codec::SharpenHint::Unsharpened) => {
-                return whet_codec::decode(&self.bytes, &whet_codec::DecodeOptions::DEFAULT)
-                    .unwrap_or_else(|e| panic!("{e}"));
-            }
-            Some(whet_codec::SharpenHint::Papers) => whet_sharpen::Method::Papers,
-            _ => whet_sharpen::Method::Extended,
-        };
-        let factor = self.smooth_factor;
-        let opts = whet_sharpen::SharpenOptions::DEFAULT
-            .with_method(method)
-            .with_smooth_factor(factor)
-            .with_passes(self.passes);
-        let opts = match self.curved_walls {
-            Some(w) => opts.with_curved_wall_factor(w),
-            None => opts,
-        };
-        let mut s = whet_sharpen::sharpen(&self.decoded, &opts).unwrap_or_else(|e| panic!("{e}"));
-        whet_codec::SurfaceFilter::after_sharpening_of(&header)
-            .apply_after_sharpening(&self.decoded, &mut s.mesh);
-        s.mesh
+        whet_swing::StatedSharpening::of(&header).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// The plain decoded mesh, its surface filter included.
+    fn plain(&self) -> Mesh {
+        whet_codec::decode(&self.bytes, &whet_codec::DecodeOptions::DEFAULT)
+            .unwrap_or_else(|e| panic!("{e}"))
     }
 }
 

@@ -62,6 +62,20 @@ fn the_decoder_replays_exactly_what_the_encoder_judged() {
     assert_eq!(decoder_side.mesh.triangles, encoder_side.mesh.triangles);
     let plain = whet_sharpen::sharpen(&input, &opts).unwrap();
     assert_ne!(plain.mesh, decoder_side.mesh);
+    // `StatedSharpening::apply`, which `whet decode --sharpen`, `whet rd` and the figures
+    // run, replays the flags too: the judged mesh, then the stream's filter and projections.
+    let stated = whet_swing::StatedSharpening::of(&header).unwrap();
+    assert!(stated.vetoes.is_some());
+    let applied = stated
+        .apply(&input)
+        .unwrap()
+        .expect("the stream states a sharpening");
+    assert_eq!(applied.mismatched_veto_passes, 0);
+    assert!(applied.skipped.is_empty());
+    let mut expected = encoder_side.mesh.clone();
+    assert!(stated.finish(&input, &mut expected).is_empty());
+    assert_eq!(crate::bits(&applied.sharpened.mesh), crate::bits(&expected));
+    assert_eq!(applied.sharpened.mesh.triangles, expected.triangles);
 }
 
 #[test]
