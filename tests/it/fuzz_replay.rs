@@ -27,7 +27,7 @@ fn decode_regressions_and_seeds() {
     let f = files("decode");
     assert!(!f.is_empty(), "fuzz/corpus/decode has the seed streams");
     for p in f {
-        whet_codec::fuzz_decode(&std::fs::read(&p).unwrap());
+        whet_swing::fuzz_decode_sharpen(&std::fs::read(&p).unwrap());
     }
 }
 

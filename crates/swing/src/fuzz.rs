@@ -1,10 +1,57 @@
-//! The entry point of the `swing_encode` cargo-fuzz target (`fuzz/`), shared with the stable
-//! replay test of its corpus: the retiler and the swing encoder on arbitrary small meshes
-//! (the mesh layout of `whet_sharpen::fuzz_input`: coincident vertices, zero-area and folded
-//! triangles, exact coplanarity, several components), at an edge length and angle bits the
-//! input picks.
+//! The entry points of the `swing_encode` and `decode` cargo-fuzz targets (`fuzz/`), shared
+//! with the stable replay tests of their corpora: the retiler and the swing encoder on
+//! arbitrary small meshes (the mesh layout of `whet_sharpen::fuzz_input`: coincident
+//! vertices, zero-area and folded triangles, exact coplanarity, several components), at an
+//! edge length and angle bits the input picks; and `whet decode --sharpen` on arbitrary
+//! bytes.
 
-use crate::{encode, Error, Rate, RetileTuning, SwingOptions};
+use crate::{encode, Error, Rate, RetileTuning, StatedSharpening, SwingOptions};
+
+/// Most triangles a decoded stream may have for [`fuzz_decode_sharpen`] to sharpen it (the
+/// decoder's fuzzing runs to a million; sharpening that many per input would starve the
+/// fuzzer).
+const MAX_SHARPENED_TRIANGLES: u64 = 1 << 14;
+
+/// `whet decode --sharpen` on arbitrary bytes: `whet_codec::fuzz_decode`, then, for a
+/// stream that decodes to a small mesh, the sharpening its header states
+/// ([`StatedSharpening::apply`]: hostile hints, smooth factors, passes, vetoes and
+/// projections included). Panics only on a bug: a panic inside, or an output with an index
+/// out of range or a non-finite position.
+pub fn fuzz_decode_sharpen(data: &[u8]) {
+    whet_codec::fuzz_decode(data);
+    let limits = whet_format::Limits::DEFAULT
+        .with_max_faces(MAX_SHARPENED_TRIANGLES)
+        .with_max_vertices(MAX_SHARPENED_TRIANGLES);
+    let Ok(container) = whet_format::parse(data, &limits) else {
+        return;
+    };
+    // A malformed veto field is bad input, refused as `whet decode --sharpen` refuses it.
+    let Ok(stated) = StatedSharpening::of(&container.header) else {
+        return;
+    };
+    let opts = whet_codec::DecodeOptions::DEFAULT
+        .with_limits(limits)
+        .with_surface_filter(false);
+    let Ok(mesh) = whet_codec::decode(data, &opts) else {
+        return;
+    };
+    if let Ok(Some(out)) = stated.apply(&mesh) {
+        check_mesh(&out.sharpened.mesh, "the stated sharpening");
+    }
+}
+
+/// Panics when `mesh` has an index out of range or a non-finite position.
+fn check_mesh(mesh: &whet_mesh::Mesh, what: &str) {
+    let n = mesh.positions.len() as u32;
+    assert!(
+        mesh.triangles.iter().flatten().all(|&v| v < n),
+        "{what}: index out of range"
+    );
+    assert!(
+        mesh.positions.iter().all(|p| p.is_finite()),
+        "{what}: non-finite position"
+    );
+}
 
 /// Encodes the mesh `data` describes (`whet_sharpen::fuzz_input`'s layout; byte 1 also
 /// picks the angle bits, byte 2 the edge length: 2 % to 50 % of the diagonal) and, when the
@@ -30,15 +77,7 @@ pub fn fuzz_encode(data: &[u8]) {
     };
     let decoded = whet_codec::decode(&out.bytes, &whet_codec::DecodeOptions::DEFAULT)
         .unwrap_or_else(|e| panic!("the encoder's own stream does not decode: {e}"));
-    let n = decoded.positions.len() as u32;
-    assert!(
-        decoded.triangles.iter().flatten().all(|&v| v < n),
-        "index out of range"
-    );
-    assert!(
-        decoded.positions.iter().all(|p| p.is_finite()),
-        "non-finite position"
-    );
+    check_mesh(&decoded, "the decoded stream");
     assert_eq!(
         decoded.triangles, out.retiled.triangles,
         "the decoder rebuilt other triangles than the encoder's"
@@ -52,4 +91,23 @@ pub fn fuzz_encode(data: &[u8]) {
         same && decoded.positions.len() == out.retiled.positions.len(),
         "the decoder rebuilt other positions than the encoder's"
     );
+    // What `whet decode --sharpen` makes of the stream: the encoder's snap vetoes must fit
+    // the decoder's run pass for pass (they were judged on that very run).
+    let header = whet_format::parse(&out.bytes, &whet_format::Limits::DEFAULT)
+        .unwrap_or_else(|e| panic!("the encoder's own stream does not parse: {e}"))
+        .header;
+    let stated = StatedSharpening::of(&header)
+        .unwrap_or_else(|e| panic!("the encoder's own veto field is refused: {e}"));
+    let raw = whet_codec::decode(
+        &out.bytes,
+        &whet_codec::DecodeOptions::DEFAULT.with_surface_filter(false),
+    )
+    .unwrap_or_else(|e| panic!("the encoder's own stream does not decode: {e}"));
+    if let Ok(Some(sharpened)) = stated.apply(&raw) {
+        assert_eq!(
+            sharpened.mismatched_veto_passes, 0,
+            "the encoder's snap vetoes do not fit the decoder's sharpening"
+        );
+        check_mesh(&sharpened.sharpened.mesh, "the stated sharpening");
+    }
 }

@@ -34,7 +34,7 @@ pub use encoder::{
     PLANAR_FACTOR, QUADRIC_FACTOR, TWO_PASSES,
 };
 pub use filter_fit::{fit_displacements, fit_filters, fit_surface_filter, FilterFit};
-pub use fuzz::fuzz_encode;
+pub use fuzz::{fuzz_decode_sharpen, fuzz_encode};
 pub use retiler::{retile, RetileStats, RetileTuning, Retiled};
 pub use stated::{StatedOutput, StatedProjection, StatedSharpening};
 
