@@ -33,6 +33,14 @@ pub mod codec {
     pub use whet_codec::*;
 }
 
+/// EdgeSharpener: options, reports, sharp-edge tags and the projections after it.
+pub mod sharpen {
+    pub use whet_sharpen::*;
+}
+
+/// What a swing stream states about sharpening its decoded mesh ([`decode_sharpened`]).
+pub use whet_swing::{StatedOutput, StatedProjection, StatedSharpening};
+
 pub use whet_codec::{
     encode, DecodeBuffers, DecodeOptions, Decoder, EncodeBuffers, EncodeOptions, Encoder,
     StreamingDecoder,
@@ -48,6 +56,9 @@ pub enum Error {
     /// A subdiv stream is bad.
     #[error(transparent)]
     Subdiv(#[from] whet_subdiv::Error),
+    /// The decoded mesh could not be sharpened ([`decode_sharpened`]).
+    #[error(transparent)]
+    Sharpen(#[from] whet_sharpen::Error),
 }
 
 impl Error {
@@ -56,6 +67,7 @@ impl Error {
         match self {
             Error::Codec(e) => e.is_input_error(),
             Error::Subdiv(e) => !matches!(e, whet_subdiv::Error::Parameter(_)),
+            Error::Sharpen(e) => !matches!(e, whet_sharpen::Error::Parameter(_)),
         }
     }
 }
@@ -103,6 +115,65 @@ pub fn decode_with_levels(
 /// Decodes a `.whet` stream of any mode (see [`decode_with_levels`]).
 pub fn decode(bytes: &[u8], opts: &DecodeOptions) -> Result<Mesh, Error> {
     decode_with_levels(bytes, opts, None)
+}
+
+/// A stream decoded and sharpened as it states ([`decode_sharpened`]).
+#[derive(Debug)]
+pub enum DecodedSharpened {
+    /// The sharpening run: the output mesh with its sharp-edge tags (for Bender), its
+    /// report, and the projections skipped.
+    Sharpened(Box<StatedOutput>),
+    /// The stream's encoder measured no sharpening best: the plain decoded mesh, its surface
+    /// filter included.
+    Unsharpened(Mesh),
+}
+
+impl DecodedSharpened {
+    /// The output: what `whet decode --sharpen` writes.
+    pub fn mesh(&self) -> &Mesh {
+        match self {
+            DecodedSharpened::Sharpened(s) => &s.sharpened.mesh,
+            DecodedSharpened::Unsharpened(m) => m,
+        }
+    }
+
+    /// [`Self::mesh`], taken.
+    pub fn into_mesh(self) -> Mesh {
+        match self {
+            DecodedSharpened::Sharpened(s) => s.sharpened.mesh,
+            DecodedSharpened::Unsharpened(m) => m,
+        }
+    }
+}
+
+/// Decodes a stream and sharpens it as its header states, exactly as `whet decode --sharpen`
+/// with no option changed (docs/swing.md section 2): the sharpening its encoder measured
+/// best with its snap vetoes replayed, the filter for after sharpening, then the planar,
+/// quadric and crease projections it states (a projection the mesh does not admit is
+/// skipped and listed in [`StatedOutput::skipped`]). A stream without sharpening fields (an
+/// exact or subdiv stream, an older swing stream) gets the extended method at smooth
+/// factor 2. `opts`'s surface filter applies only to a stream that states no sharpening.
+///
+/// ```
+/// let mesh = whet::io::read_path(&whet_testkit::shared_fixture("fandisk.off"), None)?;
+/// let opts = whet_swing::SwingOptions::DEFAULT.with_rate(whet_swing::Rate::BitsPerVertex(2.0));
+/// let stream = whet_swing::encode(&mesh, &opts)?.bytes;
+/// let out = whet::decode_sharpened(&stream, &whet::DecodeOptions::DEFAULT)?;
+/// assert!(out.mesh().triangles.len() > 1000);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn decode_sharpened(bytes: &[u8], opts: &DecodeOptions) -> Result<DecodedSharpened, Error> {
+    let container = whet_format::parse(bytes, &opts.limits).map_err(whet_codec::Error::from)?;
+    let stated = StatedSharpening::of(&container.header)?;
+    if stated.is_unsharpened() {
+        return Ok(DecodedSharpened::Unsharpened(decode(bytes, opts)?));
+    }
+    let raw = decode(bytes, &opts.with_surface_filter(false))?;
+    Ok(match stated.apply(&raw)? {
+        Some(out) => DecodedSharpened::Sharpened(Box::new(out)),
+        // `apply` sharpens every stream that does not state "none" (handled above).
+        None => DecodedSharpened::Unsharpened(raw),
+    })
 }
 
 /// [`decode`] in the memory of `buffers`, for a caller that decodes stream after stream

@@ -938,3 +938,66 @@ fn decode_sharpen_applies_a_stated_crease_projection() {
     // The OFF writer prints shortest round-trip digits: the files agree to the bit.
     assert_eq!(projected.positions, expected.positions);
 }
+
+/// The library's `whet::decode_sharpened` writes what `whet decode --sharpen` writes, on a
+/// stream that states a sharpening and projections (and its snap vetoes, where it carries
+/// them), and on one that
+/// states none.
+#[test]
+fn the_library_decodes_and_sharpens_as_the_cli_does() {
+    let dir = scratch_dir("cli-decode-sharpened-library");
+    let mc = chamfered_cube(&dir);
+    let stream = dir.join("c.whet");
+    let o = whet(&[
+        "encode",
+        s(&mc),
+        "-o",
+        s(&stream),
+        "--bpv",
+        "3",
+        "--optimize-for",
+        "sharpened",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let bytes = std::fs::read(&stream).unwrap();
+    let header = whet_format::parse(&bytes, &whet_format::Limits::DEFAULT)
+        .unwrap()
+        .header;
+    let stated = whet::StatedSharpening::of(&header).unwrap();
+    assert!(
+        !stated.is_unsharpened() && !stated.projections.is_empty(),
+        "{stated:?}"
+    );
+    let cli = |input: &std::path::Path, name: &str| {
+        let out = dir.join(name);
+        let o = whet(&["decode", s(input), "-o", s(&out), "--sharpen"]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        whet_io::read_path(&out, None).unwrap()
+    };
+    let from_cli = cli(&stream, "cli.off");
+    let lib = whet::decode_sharpened(&bytes, &whet::DecodeOptions::DEFAULT).unwrap();
+    let whet::DecodedSharpened::Sharpened(run) = &lib else {
+        panic!("the stream states a sharpening");
+    };
+    assert!(run.skipped.is_empty() && run.mismatched_veto_passes == 0);
+    // The OFF writer prints shortest round-trip digits: the two agree to the bit.
+    assert_eq!(lib.mesh().triangles, from_cli.triangles);
+    assert_eq!(lib.mesh().positions, from_cli.positions);
+    // A stream stating no sharpening decodes as without --sharpen.
+    let mut none = whet_format::parse(&bytes, &whet_format::Limits::DEFAULT).unwrap();
+    none.header = none.header.clone().with(
+        whet_format::tag::SHARPEN_METHOD,
+        whet_codec::SharpenHint::Unsharpened.code(),
+    );
+    let none_path = dir.join("none.whet");
+    let none_bytes = none.to_bytes().unwrap();
+    std::fs::write(&none_path, &none_bytes).unwrap();
+    let plain_cli = cli(&none_path, "none.off");
+    let plain = whet::decode_sharpened(&none_bytes, &whet::DecodeOptions::DEFAULT).unwrap();
+    assert!(matches!(plain, whet::DecodedSharpened::Unsharpened(_)));
+    assert_eq!(plain.mesh().positions, plain_cli.positions);
+    assert_eq!(
+        plain.into_mesh(),
+        whet::decode(&none_bytes, &whet::DecodeOptions::DEFAULT).unwrap()
+    );
+}
