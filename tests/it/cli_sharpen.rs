@@ -941,8 +941,7 @@ fn decode_sharpen_applies_a_stated_crease_projection() {
 
 /// The library's `whet::decode_sharpened` writes what `whet decode --sharpen` writes, on a
 /// stream that states a sharpening and projections (and its snap vetoes, where it carries
-/// them), and on one that
-/// states none.
+/// them), and on one that states none.
 #[test]
 fn the_library_decodes_and_sharpens_as_the_cli_does() {
     let dir = scratch_dir("cli-decode-sharpened-library");
