@@ -375,7 +375,8 @@ fn decode_sharpen_follows_the_streams_hint() {
     // The encoder measured 24 candidates (both methods at three factors without and with
     // curved walls, every sharpening in one pass and in two), then the best of them
     // refined (its smooth factor a quarter up and down, with curved walls each also with
-    // the wall factor one up and one down: 2 or 8 more), and none, and kept the lowest
+    // the wall factor one up and one down, then itself in one more pass: 3 or 9 more), and
+    // none, and kept the lowest
     // error; then the chosen sharpening once more with the planar-region projection, kept
     // when it beat it, once more with the local quadric projection on top, and once more
     // with the crease projection on top of what was kept; then, when its stream carried a
@@ -410,8 +411,8 @@ fn decode_sharpen_follows_the_streams_hint() {
         .filter(|t| t["crease"] == true)
         .filter(|t| on_path(&t))
         .collect();
-    // The refined candidates: 2 around a grid best without curved walls, 8 with, none
-    // without a grid best (the encoder's rule: among those within the input's max and no
+    // The refined candidates: 2 around a grid best without curved walls, 8 with, and the
+    // grid best in one more pass; none without a grid best (the encoder's rule: among those within the input's max and no
     // sharpening's RMS, each later one kept only 0.5 % lower in score).
     let input_max = j["sharpen_input_max_error_pct"].as_f64().unwrap();
     let none_rms = trials.last().unwrap()["rms_error_pct"].as_f64().unwrap();
@@ -431,8 +432,8 @@ fn decode_sharpen_follows_the_streams_hint() {
         });
     let refined = match grid_best {
         None => 0,
-        Some(b) if b["curved_walls"].as_f64() == Some(0.0) => 2,
-        Some(_) => 8,
+        Some(b) if b["curved_walls"].as_f64() == Some(0.0) => 3,
+        Some(_) => 9,
     };
     assert_eq!(trials.len(), 25 + refined, "{j}");
     let chosen = j["sharpen_method"].as_str().unwrap();

@@ -1763,7 +1763,8 @@ const CURVED_WALL_STEP: f64 = 1.0;
 /// The sharpenings around `centre`, the best of the candidates' grid: the same method and
 /// passes, the smooth factor `SMOOTH_FACTOR_STEP` up and down, and with curved walls each of
 /// those with the wall factor `CURVED_WALL_STEP` up and down too (8 around a sharpening with
-/// curved walls, 2 around one without).
+/// curved walls, 2 around one without); then `centre` in one more pass (the grid's are 1
+/// or 2, so always one more candidate).
 fn refinements(centre: &SharpenTrial) -> Vec<Candidate> {
     let s = centre.smooth_factor;
     let smooth = [s - SMOOTH_FACTOR_STEP, s, s + SMOOTH_FACTOR_STEP];
@@ -1791,6 +1792,17 @@ fn refinements(centre: &SharpenTrial) -> Vec<Candidate> {
                 });
             }
         }
+    }
+    // And the centre itself in one more pass: the sharpener run again on its own output
+    // finds the chamfers its splits left (docs/results.md, "One more pass").
+    let more = centre.passes + 1;
+    if SharpenHint::PASSES.contains(&u64::from(more)) {
+        out.push(Candidate {
+            hint: Some(centre.hint),
+            smooth_factor: s,
+            curved_walls: (centre.curved_walls > 0.0).then_some(centre.curved_walls),
+            passes: more,
+        });
     }
     out
 }

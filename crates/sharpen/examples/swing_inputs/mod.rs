@@ -186,7 +186,7 @@ pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
         .unwrap_or_else(|e| panic!("{name}: {e}"));
     let dir = whet_testkit::workspace_root().join("target/sharpen-swing");
     let _ = std::fs::create_dir_all(&dir);
-    let path = dir.join(format!("v33-{name}-{bpv}-{}.whet", angles.tag()));
+    let path = dir.join(format!("v34-{name}-{bpv}-{}.whet", angles.tag()));
     let bytes = match std::fs::read(&path) {
         Ok(b) => b,
         Err(_) => {
