@@ -7,7 +7,7 @@
 //! was inserted between (the ends of its chamfer edge, the corners of its corner triangle):
 //! the new edges it makes, not the vertex alone (which vetoed 2-3 times more snaps on the
 //! CAD fixtures and raised cad_cyl_fillet's max). Snaps are judged by strip, with a bound
-//! for new maxima ([`rule`]).
+//! for new maxima (`rule`).
 
 use std::collections::{HashMap, HashSet};
 use std::sync::OnceLock;

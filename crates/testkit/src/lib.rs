@@ -99,7 +99,7 @@ pub fn resolve_shared_reference(path: &str) -> PathBuf {
 /// A scratch folder unique to one test (under the system's temporary folder, named after the
 /// test and the process), emptied on creation and removed when the value is dropped — kept
 /// when the test fails (the thread is panicking), or when `WHET_KEEP_SCRATCH` is set, so the
-/// files can be looked at. Dereferences to its [`Path`](std::path::Path).
+/// files can be looked at. Dereferences to its [`std::path::Path`].
 pub fn scratch_dir(test_name: &str) -> ScratchDir {
     let dir = std::env::temp_dir().join(format!("whet-{}-{}", test_name, std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
