@@ -353,13 +353,12 @@ fn chamfered_cube(dir: &std::path::Path) -> std::path::PathBuf {
     mc
 }
 
-/// `whet decode --sharpen` follows the sharpening a swing stream names (header field 21,
-/// written by `--optimize-for sharpened`) unless `--method` is given; a stream that names
-/// no sharpening decodes as plain `whet decode` does.
-#[test]
-fn decode_sharpen_follows_the_streams_hint() {
-    let dir = scratch_dir("cli-decode-sharpen-hint");
-    let mc = chamfered_cube(&dir);
+/// The chamfered cube of [`chamfered_cube`] in `dir`, encoded at 3 bits per vertex with
+/// `--optimize-for sharpened`: the mesh, the stream and the encoder's JSON report.
+fn cube_encoded_for_sharpening(
+    dir: &std::path::Path,
+) -> (std::path::PathBuf, std::path::PathBuf, serde_json::Value) {
+    let mc = chamfered_cube(dir);
     let stream = dir.join("c.whet");
     let j = whet_json(&[
         "encode",
@@ -372,6 +371,16 @@ fn decode_sharpen_follows_the_streams_hint() {
         "sharpened",
         "--json",
     ]);
+    (mc, stream, j)
+}
+
+/// `whet decode --sharpen` follows the sharpening a swing stream names (header field 21,
+/// written by `--optimize-for sharpened`) unless `--method` is given; a stream that names
+/// no sharpening decodes as plain `whet decode` does.
+#[test]
+fn decode_sharpen_follows_the_streams_hint() {
+    let dir = scratch_dir("cli-decode-sharpen-hint");
+    let (mc, stream, j) = cube_encoded_for_sharpening(&dir);
     // The encoder measured 24 candidates (both methods at three factors without and with
     // curved walls, every sharpening in one pass and in two), then the best of them
     // refined (its smooth factor a quarter up and down, with curved walls each also with
@@ -946,19 +955,7 @@ fn decode_sharpen_applies_a_stated_crease_projection() {
 #[test]
 fn the_library_decodes_and_sharpens_as_the_cli_does() {
     let dir = scratch_dir("cli-decode-sharpened-library");
-    let mc = chamfered_cube(&dir);
-    let stream = dir.join("c.whet");
-    let o = whet(&[
-        "encode",
-        s(&mc),
-        "-o",
-        s(&stream),
-        "--bpv",
-        "3",
-        "--optimize-for",
-        "sharpened",
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (_, stream, _) = cube_encoded_for_sharpening(&dir);
     let bytes = std::fs::read(&stream).unwrap();
     let header = whet_format::parse(&bytes, &whet_format::Limits::DEFAULT)
         .unwrap()
