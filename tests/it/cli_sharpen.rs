@@ -998,3 +998,22 @@ fn the_library_decodes_and_sharpens_as_the_cli_does() {
         whet::decode(&none_bytes, &whet::DecodeOptions::DEFAULT).unwrap()
     );
 }
+
+/// `whet::decode_sharpened` on bad streams: a truncated stream and a malformed snap-veto
+/// field (header field 33) are input errors, never a panic or a mesh.
+#[test]
+fn the_library_refuses_bad_streams_to_sharpen() {
+    let dir = scratch_dir("cli-decode-sharpened-bad");
+    let (_, stream, _) = cube_encoded_for_sharpening(&dir);
+    let bytes = std::fs::read(&stream).unwrap();
+    let opts = whet::DecodeOptions::DEFAULT;
+    for cut in [0, 4, bytes.len() / 2, bytes.len() - 1] {
+        let e = whet::decode_sharpened(&bytes[..cut], &opts).expect_err("truncated");
+        assert!(e.is_input_error(), "cut at {cut}: {e}");
+    }
+    let mut c = whet_format::parse(&bytes, &whet_format::Limits::DEFAULT).unwrap();
+    c.header.set(whet_format::tag::SNAP_VETOES, vec![0xffu8; 7]);
+    let bad = c.to_bytes().unwrap();
+    let e = whet::decode_sharpened(&bad, &opts).expect_err("a malformed veto field");
+    assert!(e.is_input_error(), "{e}");
+}
