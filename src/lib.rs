@@ -165,10 +165,19 @@ impl DecodedSharpened {
 pub fn decode_sharpened(bytes: &[u8], opts: &DecodeOptions) -> Result<DecodedSharpened, Error> {
     let container = whet_format::parse(bytes, &opts.limits).map_err(whet_codec::Error::from)?;
     let stated = StatedSharpening::of(&container.header)?;
+    // The container parsed above, decoded without parsing (and checking) it again; a subdiv
+    // stream goes through `decode`, which also subdivides.
+    let decode_parsed = |o: &DecodeOptions| -> Result<Mesh, Error> {
+        if container.header.mode == whet_format::Mode::Subdiv {
+            decode(bytes, o)
+        } else {
+            Ok(whet_codec::decode_container(&container, o)?)
+        }
+    };
     if stated.is_unsharpened() {
-        return Ok(DecodedSharpened::Unsharpened(decode(bytes, opts)?));
+        return Ok(DecodedSharpened::Unsharpened(decode_parsed(opts)?));
     }
-    let raw = decode(bytes, &opts.with_surface_filter(false))?;
+    let raw = decode_parsed(&opts.with_surface_filter(false))?;
     Ok(match stated.apply(&raw)? {
         Some(out) => DecodedSharpened::Sharpened(Box::new(out)),
         // `apply` sharpens every stream that does not state "none" (handled above).
