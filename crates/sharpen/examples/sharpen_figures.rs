@@ -9,6 +9,7 @@
 //! cargo run --release -p whet-sharpen --example sharpen_figures -- noise   # noise sweep
 //! cargo run --release -p whet-sharpen --example sharpen_figures -- swing   # swing-decoded
 //! cargo run --release -p whet-sharpen --example sharpen_figures -- swing rocker  # one fixture
+//! cargo run --release -p whet-sharpen --example sharpen_figures -- swing-synth  # synth CAD shapes
 //! ```
 //!
 //! `swing` encodes the CAD fixtures with whet-swing at three rates per fixture (about 0.5x, 1x
@@ -38,7 +39,7 @@ use whet_sharpen::{sharpen, Method, SharpenOptions};
 use whet_synth::{add_noise, marching_cubes, Shape, ShapeKind, ShapeParams};
 
 use support::{cached_stand_in, check, error, rotations};
-use swing_inputs::{swing_input, Angles};
+use swing_inputs::{swing_input, swing_input_of, Angles};
 
 /// Face samples per Metro direction: the default rule unless `SHARPEN_FIGURES_SAMPLES` is set
 /// (for quick iterations; the tables in docs/results.md use the default).
@@ -166,27 +167,7 @@ fn swing(only: Option<String>) {
                 );
                 // What `whet decode --sharpen` writes: the sharpening the stream names and
                 // the stream's filter for after sharpening, or the filtered decoded mesh.
-                let name = match s.sharpen_hint {
-                    Some(SharpenHint::Unsharpened) => "none".to_string(),
-                    h => format!(
-                        "{} {}{}{}{}{}{}{}",
-                        h.map_or("extended", SharpenHint::name),
-                        s.smooth_factor,
-                        match s.curved_walls {
-                            Some(w) => format!(" walls {w}"),
-                            None => String::new(),
-                        },
-                        if s.passes > 1 {
-                            format!(" x{}", s.passes)
-                        } else {
-                            String::new()
-                        },
-                        if s.planar { " + planes" } else { "" },
-                        if s.quadric { " + quadrics" } else { "" },
-                        if s.crease { " + creases" } else { "" },
-                        if s.after_filter { "" } else { " − filter" }
-                    ),
-                };
+                let name = stated_name(&s);
                 let d = error(&s.original, &s.decode_sharpen(), samples());
                 println!(
                     "{line} {name} | {:.4} | {:.3} | {:.2}x | {:.2}x |",
@@ -194,6 +175,110 @@ fn swing(only: Option<String>) {
                     d.max_pct,
                     e[0].0 / d.rms_pct,
                     e[0].1 / d.max_pct
+                );
+            }
+        }
+    }
+}
+
+/// The sharpening a swing stream states, as the swing tables print it.
+fn stated_name(s: &swing_inputs::SwingInput) -> String {
+    match s.sharpen_hint {
+        Some(SharpenHint::Unsharpened) => "none".to_string(),
+        h => format!(
+            "{} {}{}{}{}{}{}{}",
+            h.map_or("extended", SharpenHint::name),
+            s.smooth_factor,
+            match s.curved_walls {
+                Some(w) => format!(" walls {w}"),
+                None => String::new(),
+            },
+            if s.passes > 1 {
+                format!(" x{}", s.passes)
+            } else {
+                String::new()
+            },
+            if s.planar { " + planes" } else { "" },
+            if s.quadric { " + quadrics" } else { "" },
+            if s.crease { " + creases" } else { "" },
+            if s.after_filter { "" } else { " − filter" }
+        ),
+    }
+}
+
+/// Shapes no constant was tuned on: the synth truth meshes (exact planes, cylinders and
+/// cones; the blend's fillets and the sphere, which must not get worse; the r0 rotation of
+/// the marching-cubes table, so no face is axis-aligned), swing
+/// encoded at three edge lengths with 6 angle bits, and at those streams' sizes with
+/// automatic angle bits, `--optimize-for sharpened`. Columns: the mesh `whet decode --sharpen` sharpens (no surface filter), what
+/// `whet decode` writes (its surface filter applied), `whet sharpen` with the defaults on the
+/// former, and `whet decode --sharpen`; gains over both decoded meshes.
+fn swing_synth() {
+    println!("\n### Swing-decoded synth shapes (reference: the truth mesh)\n");
+    println!(
+        "| shape, L, angle bits | V | unfiltered RMS % | max % | `whet decode` RMS % | max % \
+         | `whet sharpen` RMS % | max % | `decode --sharpen`: method | RMS % | max % \
+         | gain over unfiltered, RMS / max | gain over `whet decode`, RMS / max |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let rotation = rotations()[0];
+    for kind in [
+        ShapeKind::Box,
+        ShapeKind::Pyramid,
+        ShapeKind::Octahedron,
+        ShapeKind::Cylinder,
+        ShapeKind::Cone,
+        ShapeKind::Fandisk,
+        ShapeKind::ThinFace,
+        ShapeKind::TorusBox,
+        ShapeKind::Blend,
+        ShapeKind::Sphere,
+    ] {
+        let shape = Shape::new(kind, &ShapeParams::default().with_rotation(rotation))
+            .unwrap_or_else(|e| panic!("{e}"));
+        // Automatic angle bits need a size target: the 6-bit stream's size at each length.
+        let mut sizes = Vec::new();
+        for angles in [Angles::Fixed(6), Angles::AutoSharpened] {
+            for (i, l) in [0.01, 0.015, 0.02].into_iter().enumerate() {
+                let rate = match angles {
+                    Angles::Fixed(_) => whet_swing::Rate::EdgeLength(l),
+                    Angles::AutoSharpened => whet_swing::Rate::TargetBytes(sizes[i]),
+                };
+                let s = swing_input_of(
+                    shape.truth_mesh_ref().clone(),
+                    &format!("synth-{}-r0-{l}", kind.name()),
+                    rate,
+                    angles,
+                );
+                sizes.push(s.bytes.len());
+                let bits = match angles {
+                    Angles::Fixed(b) => b.to_string(),
+                    Angles::AutoSharpened => format!("auto {}", s.angle_bits),
+                };
+                let u = error(&s.original, &s.decoded, samples());
+                let p = error(&s.original, &s.plain(), samples());
+                let extended =
+                    sharpen(&s.decoded, &SharpenOptions::DEFAULT).unwrap_or_else(|e| panic!("{e}"));
+                let x = error(&s.original, &extended.mesh, samples());
+                let d = error(&s.original, &s.decode_sharpen(), samples());
+                println!(
+                    "| {} {l} {bits} | {} | {:.4} | {:.3} | {:.4} | {:.3} | {:.4} | {:.3} | {} \
+                     | {:.4} | {:.3} | {:.2}x / {:.2}x | {:.2}x / {:.2}x |",
+                    kind.name(),
+                    s.decoded.positions.len(),
+                    u.rms_pct,
+                    u.max_pct,
+                    p.rms_pct,
+                    p.max_pct,
+                    x.rms_pct,
+                    x.max_pct,
+                    stated_name(&s),
+                    d.rms_pct,
+                    d.max_pct,
+                    u.rms_pct / d.rms_pct,
+                    u.max_pct / d.max_pct,
+                    p.rms_pct / d.rms_pct,
+                    p.max_pct / d.max_pct,
                 );
             }
         }
@@ -231,5 +316,8 @@ fn main() {
     }
     if what.is_empty() || what == "swing" {
         swing(std::env::args().nth(2));
+    }
+    if what.is_empty() || what == "swing-synth" {
+        swing_synth();
     }
 }

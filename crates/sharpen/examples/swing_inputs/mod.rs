@@ -160,8 +160,8 @@ impl SwingInput {
         whet_swing::StatedSharpening::of(&header).unwrap_or_else(|e| panic!("{e}"))
     }
 
-    /// The plain decoded mesh, its surface filter included.
-    fn plain(&self) -> Mesh {
+    /// The plain decoded mesh, its surface filter included (what `whet decode` writes).
+    pub fn plain(&self) -> Mesh {
         whet_codec::decode(&self.bytes, &whet_codec::DecodeOptions::DEFAULT)
             .unwrap_or_else(|e| panic!("{e}"))
     }
@@ -184,21 +184,32 @@ pub fn every_swing_input() -> impl Iterator<Item = (&'static str, f64, Angles, S
 pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
     let original = whet_io::read_path(&whet_testkit::shared_fixture(name), None)
         .unwrap_or_else(|e| panic!("{name}: {e}"));
+    swing_input_of(
+        original,
+        &format!("{name}-{bpv}"),
+        Rate::BitsPerVertex(bpv),
+        angles,
+    )
+}
+
+/// Encodes `original` at `rate` and decodes it; `key` names the stream in the cache
+/// (`target/sharpen-swing/v34-<key>-<angles>.whet`).
+pub fn swing_input_of(original: Mesh, key: &str, rate: Rate, angles: Angles) -> SwingInput {
     let dir = whet_testkit::workspace_root().join("target/sharpen-swing");
     let _ = std::fs::create_dir_all(&dir);
-    let path = dir.join(format!("v34-{name}-{bpv}-{}.whet", angles.tag()));
+    let path = dir.join(format!("v34-{key}-{}.whet", angles.tag()));
     let bytes = match std::fs::read(&path) {
         Ok(b) => b,
         Err(_) => {
             let mut opts = SwingOptions::DEFAULT
-                .with_rate(Rate::BitsPerVertex(bpv))
+                .with_rate(rate)
                 .with_error_of(ErrorOf::Sharpened);
             opts = match angles {
                 Angles::Fixed(b) => opts.with_angle_bits(b),
                 Angles::AutoSharpened => opts.with_auto_angle_bits(true),
             };
             let out = whet_swing::encode(&original, &opts)
-                .unwrap_or_else(|e| panic!("{name} at {bpv} bpv: encode: {e}"));
+                .unwrap_or_else(|e| panic!("{key}: encode: {e}"));
             let _ = std::fs::write(&path, &out.bytes);
             out.bytes
         }
@@ -207,9 +218,9 @@ pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
         &bytes,
         &whet_codec::DecodeOptions::DEFAULT.with_surface_filter(false),
     )
-    .unwrap_or_else(|e| panic!("{name} at {bpv} bpv: decode: {e}"));
+    .unwrap_or_else(|e| panic!("{key}: decode: {e}"));
     let header = whet_format::parse(&bytes, &whet_format::Limits::UNLIMITED)
-        .unwrap_or_else(|e| panic!("{name} at {bpv} bpv: {e}"))
+        .unwrap_or_else(|e| panic!("{key}: {e}"))
         .header;
     SwingInput {
         bpv: bytes.len() as f64 * 8.0 / original.positions.len() as f64,
