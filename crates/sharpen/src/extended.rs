@@ -1459,8 +1459,8 @@ fn supported(run: &Run, p: DVec3, around: &[u32]) -> bool {
 /// 1.6-1.8 mean edge lengths deep and their three-plane points refused by the support test
 /// (docs/results.md). It widens the support test of corner points and the move limit of
 /// [`unlabelled_corner_vertices`]. Marching-cubes input only: on surface samplings
-/// every sample is on the surface and acute wedges are left alone anyway
-/// ([`MAX_SURFACE_TURN_DEGREES`]), and widening the edge snaps' support too changed no row
+/// every sample is on the surface (and acute wedges were left alone when this was measured,
+/// before [`ACUTE_CONTRAST_FACTOR`]), and widening the edge snaps' support too changed no row
 /// of the synth or stand-in tables.
 fn acute_reach(run: &Run, planes: &[&Plane]) -> f64 {
     if run.surface_samples {
@@ -1612,9 +1612,23 @@ pub(crate) const SAME_REGION_CONTRAST: f64 = 1.75;
 /// without bound as the wedge closes (1.9x the rim radius at 130 degrees). The swing-decoded
 /// CAD fixtures have almost no snap above 100 degrees (2 of 10,000; 100 instead of 110 changes
 /// their RMS by under 0.3 %), while armadillo's ear rims at 8 bpv (auto angle bits) turn by
-/// 100-110 degrees (max +12 % at 110). The cost: acute CAD wedges stay chamfered on surface
-/// samplings.
+/// 100-110 degrees (max +12 % at 110). A wedge turning by more is still a crease when its
+/// faces are flat enough ([`ACUTE_CONTRAST_FACTOR`]).
 pub(crate) const MAX_SURFACE_TURN_DEGREES: f64 = 100.0;
+
+/// Surface samplings: a wedge turning by more than [`MAX_SURFACE_TURN_DEGREES`] is a crease
+/// when its turn is at least this many times [`CREASE_CONTRAST`] over the mean typical turn
+/// of its two regions: the faces of an acute CAD wedge are flat (a retiled pyramid's, with 6
+/// angle bits: contrasts of 80-220, 160-460 with its base on a coordinate plane), a thin
+/// organic part bends everywhere (contrasts mostly under 45). Measured (docs/results.md,
+/// "Acute wedges on surface samplings") on the swing-decoded organic fixtures and rocker_arm
+/// at 1-16 bpv with 6, 8 and 10 angle bits: of 3,573 such checks, 18 reach 3x (54), on
+/// screwdriver at 16 bpv (16; its output then improves, max 0.319 -> 0.262 % at 6 angle
+/// bits), screwdriver at 6 bpv and bunny_dense at 3 bpv (one each, figures unchanged); the
+/// synth pyramid retiled at 1.5 % of its diagonal went from 1.474 % to 0.419 % in max through
+/// `whet decode --sharpen`. Before it, acute CAD wedges stayed chamfered on surface
+/// samplings.
+pub(crate) const ACUTE_CONTRAST_FACTOR: f64 = 3.0;
 
 /// The typical turn ([`region_turns`]) of the region of `lp`, in radians.
 fn typical_turn(run: &Run, lp: &LabelPlane) -> f64 {
@@ -1660,9 +1674,10 @@ fn flat_sided_crease(run: &Run, planes: &[LabelPlane]) -> bool {
 }
 
 /// Whether the planes of a snap (`(vertex, label plane)` pairs) meet at a crease distinct
-/// from the regions' own curvature: every pair turns by at most
-/// [`MAX_SURFACE_TURN_DEGREES`] and by at least [`CREASE_CONTRAST`] times the mean typical turn
-/// of its two regions ([`SAME_REGION_CONTRAST`] times more for sides joined smoothly).
+/// from the regions' own curvature: every pair turns by at least [`CREASE_CONTRAST`] times
+/// the mean typical turn of its two regions ([`SAME_REGION_CONTRAST`] times more for sides
+/// joined smoothly, [`ACUTE_CONTRAST_FACTOR`] times more past
+/// [`MAX_SURFACE_TURN_DEGREES`]).
 /// Surface samplings only (marching cubes has the consistency test and [`flat_sided_crease`]).
 fn distinct_crease(run: &Run, planes: &[(u32, &LabelPlane)]) -> bool {
     let typical = |lp: &LabelPlane| typical_turn(run, lp);
@@ -1670,15 +1685,12 @@ fn distinct_crease(run: &Run, planes: &[(u32, &LabelPlane)]) -> bool {
     for (i, &(a, x)) in planes.iter().enumerate() {
         for &(b, y) in &planes[i + 1..] {
             let c = x.plane.normal.dot(y.plane.normal).clamp(-1.0, 1.0);
-            if c < max_cos {
-                return false;
-            }
             // Two sides that are smoothly connected near the chamfer (one region, or a region
             // that turns towards the other side within the two-ring of its end) need the higher
             // contrast; the two-ring is looked at only when the contrast is in between.
             let needed = CREASE_CONTRAST * 0.5 * (typical(x) + typical(y));
             let turn = c.acos();
-            if turn < needed {
+            if turn < needed || (c < max_cos && turn < ACUTE_CONTRAST_FACTOR * needed) {
                 return false;
             }
             if turn < SAME_REGION_CONTRAST * needed
