@@ -9,7 +9,7 @@
 //! cargo run --release -p whet-sharpen --example sharpen_figures -- noise   # noise sweep
 //! cargo run --release -p whet-sharpen --example sharpen_figures -- swing   # swing-decoded
 //! cargo run --release -p whet-sharpen --example sharpen_figures -- swing rocker  # one fixture
-//! cargo run --release -p whet-sharpen --example sharpen_figures -- swing-synth  # synth CAD shapes
+//! cargo run --release -p whet-sharpen --example sharpen_figures -- swing-synth  # synth shapes
 //! ```
 //!
 //! `swing` encodes the CAD fixtures with whet-swing at three rates per fixture (about 0.5x, 1x
@@ -19,7 +19,9 @@
 //! last columns are what `whet decode --sharpen` writes: the sharpening the stream names (the
 //! encoder's measured choice, docs/swing.md section 2) and the stream's filter for after
 //! sharpening, or the filtered decoded mesh for "none", against the same input error. `retile`
-//! is the marching-cubes stand-in measured before the swing codec existed.
+//! is the marching-cubes stand-in measured before the swing codec existed. `swing-synth`
+//! encodes the synth truth shapes the same way, at three edge lengths (shapes no constant was
+//! tuned on).
 //!
 //! Errors are symmetric Metro figures (whet-metro, default sampling: at least 10 samples per
 //! face and 1M per direction) in percent of the reference's bounding-box diagonal; the
@@ -208,11 +210,12 @@ fn stated_name(s: &swing_inputs::SwingInput) -> String {
 
 /// Shapes no constant was tuned on: the synth truth meshes (exact planes, cylinders and
 /// cones; the blend's fillets and the sphere, which must not get worse; the r0 rotation of
-/// the marching-cubes table, so no face is axis-aligned), swing
-/// encoded at three edge lengths with 6 angle bits, and at those streams' sizes with
-/// automatic angle bits, `--optimize-for sharpened`. Columns: the mesh `whet decode --sharpen` sharpens (no surface filter), what
-/// `whet decode` writes (its surface filter applied), `whet sharpen` with the defaults on the
-/// former, and `whet decode --sharpen`; gains over both decoded meshes.
+/// the marching-cubes table, so no face is axis-aligned), swing encoded at three edge
+/// lengths with 6 angle bits, and at those streams' sizes with automatic angle bits,
+/// `--optimize-for sharpened`. Columns: the mesh `whet decode --sharpen` sharpens (no
+/// surface filter), what `whet decode` writes (its surface filter applied), `whet sharpen`
+/// with the defaults on the former, and `whet decode --sharpen`; gains over both decoded
+/// meshes (docs/results.md, "Shapes no constant was tuned on").
 fn swing_synth() {
     println!("\n### Swing-decoded synth shapes (reference: the truth mesh)\n");
     println!(
