@@ -392,6 +392,7 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh, skipped: &whet::io::ReadRepor
                 "max_error_pct": t.max_pct,
                 "planar": t.planar,
                 "quadric": t.quadric,
+                "beside": t.beside,
                 "crease": t.crease,
                 "sharpened_filter": t.sharpened_filter,
             })
@@ -465,6 +466,7 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh, skipped: &whet::io::ReadRepor
             "sharpen_trials": sharpen_trials,
             "planar_tolerance": out.planar_factor,
             "quadric_projection": out.quadric_factor,
+            "beside_projection": out.beside_factor,
             "crease_projection": out.crease_factor,
             "sharpen_input_max_error_pct": out.sharpen_input_max_pct,
             "search": out.search.iter().map(|&(f, b)| json!([f, b])).collect::<Vec<_>>(),

@@ -387,19 +387,24 @@ fn decode_sharpen_follows_the_streams_hint() {
     // the wall factor one up and one down, then itself in one more pass: 3 or 9 more), and
     // none, and kept the lowest
     // error; then the chosen sharpening once more with the planar-region projection, kept
-    // when it beat it, once more with the local quadric projection on top, and once more
-    // with the crease projection on top of what was kept; then, when its stream carried a
-    // filter for after sharpening, the same four without that filter.
+    // when it beat it, once more with the local quadric projection on top, once more with
+    // the one-sided projection beside creases and once more with the crease projection on
+    // top of what was kept; then, when its stream carried a filter for after sharpening,
+    // the same five without that filter.
     let all = j["sharpen_trials"].as_array().unwrap();
     let with_filter = |t: &&serde_json::Value| t["sharpened_filter"] == true;
     let trials: Vec<_> = all
         .iter()
         .filter(|t| {
-            t["planar"] == false && t["quadric"] == false && t["crease"] == false && with_filter(t)
+            t["planar"] == false
+                && t["quadric"] == false
+                && t["beside"] == false
+                && t["crease"] == false
+                && with_filter(t)
         })
         .collect();
     let bare: Vec<_> = all.iter().filter(|t| !with_filter(t)).collect();
-    assert!(bare.is_empty() || bare.len() == 4, "{j}");
+    assert!(bare.is_empty() || bare.len() == 5, "{j}");
     // The stream states no filter for after sharpening when the path without it won.
     let stated_filter =
         j["sharpened_filter"]["normal"] != 0.0 || j["sharpened_filter"]["smoothed"] != 0.0;
@@ -407,12 +412,22 @@ fn decode_sharpen_follows_the_streams_hint() {
     let on_path = |t: &&&serde_json::Value| with_filter(t) != bare_won;
     let planar: Vec<_> = all
         .iter()
-        .filter(|t| t["planar"] == true && t["quadric"] == false && t["crease"] == false)
+        .filter(|t| {
+            t["planar"] == true
+                && t["quadric"] == false
+                && t["beside"] == false
+                && t["crease"] == false
+        })
         .filter(|t| on_path(&t))
         .collect();
     let quadric: Vec<_> = all
         .iter()
-        .filter(|t| t["quadric"] == true && t["crease"] == false)
+        .filter(|t| t["quadric"] == true && t["beside"] == false && t["crease"] == false)
+        .filter(|t| on_path(&t))
+        .collect();
+    let beside: Vec<_> = all
+        .iter()
+        .filter(|t| t["beside"] == true && t["crease"] == false)
         .filter(|t| on_path(&t))
         .collect();
     let crease: Vec<_> = all
@@ -448,11 +463,13 @@ fn decode_sharpen_follows_the_streams_hint() {
     let chosen = j["sharpen_method"].as_str().unwrap();
     assert_eq!(planar.len(), usize::from(chosen != "none"), "{j}");
     assert_eq!(quadric.len(), planar.len(), "{j}");
+    assert_eq!(beside.len(), planar.len(), "{j}");
     assert_eq!(crease.len(), planar.len(), "{j}");
-    // The crease trial refines what the planar and quadric decisions kept.
+    // The crease trial refines what the planar, quadric and one-sided decisions kept.
     if let Some(c) = crease.first() {
         assert_eq!(c["planar"], !j["planar_tolerance"].is_null(), "{j}");
         assert_eq!(c["quadric"], !j["quadric_projection"].is_null(), "{j}");
+        assert_eq!(c["beside"], !j["beside_projection"].is_null(), "{j}");
     }
     // The stream states curved walls only where they are on.
     let chosen_walls = j["sharpen_curved_walls"].as_f64().unwrap_or(0.0);
@@ -476,19 +493,33 @@ fn decode_sharpen_follows_the_streams_hint() {
         candidate_error
     };
     let mut reported = j["rms_error_pct"].as_f64().unwrap();
+    // The error of what the one-sided trial refined: the last projection kept before it.
+    let before_beside = match quadric.first() {
+        Some(q) if !j["quadric_projection"].is_null() => q["rms_error_pct"].as_f64().unwrap(),
+        _ => match planar.first() {
+            Some(p) if !j["planar_tolerance"].is_null() => p["rms_error_pct"].as_f64().unwrap(),
+            _ => chosen_error,
+        },
+    };
     if !j["crease_projection"].is_null() {
         // The reported error is the crease trial's, under the margin of what it refined.
         assert_eq!(j["crease_projection"].as_f64(), Some(0.5), "{j}");
         let c = crease[0]["rms_error_pct"].as_f64().unwrap();
         assert_eq!(Some(reported), Some(c), "{j}");
-        reported = match quadric.first() {
-            Some(q) if !j["quadric_projection"].is_null() => q["rms_error_pct"].as_f64().unwrap(),
-            _ => match planar.first() {
-                Some(p) if !j["planar_tolerance"].is_null() => p["rms_error_pct"].as_f64().unwrap(),
-                _ => chosen_error,
-            },
+        reported = match beside.first() {
+            Some(b) if !j["beside_projection"].is_null() => b["rms_error_pct"].as_f64().unwrap(),
+            _ => before_beside,
         };
         assert!(c < 0.995 * reported, "{j}");
+    }
+    if !j["beside_projection"].is_null() {
+        // The reported error (or what the crease trial refined) is the one-sided trial's,
+        // under the margin of what it refined.
+        assert_eq!(j["beside_projection"].as_f64(), Some(0.25), "{j}");
+        let b = beside[0]["rms_error_pct"].as_f64().unwrap();
+        assert_eq!(Some(reported), Some(b), "{j}");
+        reported = before_beside;
+        assert!(b < 0.995 * reported, "{j}");
     }
     if !j["quadric_projection"].is_null() {
         // The reported error is the quadric trial's; what it refined is checked below.

@@ -144,6 +144,14 @@ impl SharpenHint {
         Self::angle_step_factor(header, whet_format::tag::QUADRIC_PROJECTION)
     }
 
+    /// The one-sided quadric projection of the vertices beside creases a swing stream's
+    /// header states (field 37): its move limit (the field's hundredths over 100, in angle
+    /// steps) and the stream's angle bits, for `whet_sharpen::BesideOptions::for_swing`;
+    /// `None` as for [`Self::planar_of`].
+    pub fn beside_of(header: &whet_format::Header) -> Option<(f64, u32)> {
+        Self::angle_step_factor(header, whet_format::tag::BESIDE_PROJECTION)
+    }
+
     /// The crease projection a swing stream's header states for after sharpening and the
     /// two other projections (field 35): its move limit in mean edge lengths (the field's
     /// hundredths over 100), for `whet_sharpen::CreaseOptions::with_max_move`. `None`
@@ -248,6 +256,27 @@ mod tests {
             .with(whet_format::tag::ANGLE_BITS, 6u64)
             .with(whet_format::tag::QUADRIC_PROJECTION, 50u64);
         assert_eq!(SharpenHint::quadric_of(&exact), None);
+    }
+
+    #[test]
+    fn beside_projection_is_read_from_swing_headers_only_and_in_range() {
+        let swing = whet_format::Header::new(whet_format::Mode::Swing, 3, 1)
+            .with(whet_format::tag::ANGLE_BITS, 6u64);
+        assert_eq!(SharpenHint::beside_of(&swing), None);
+        let on = swing
+            .clone()
+            .with(whet_format::tag::BESIDE_PROJECTION, 25u64);
+        assert_eq!(SharpenHint::beside_of(&on), Some((0.25, 6)));
+        // Field 37 is read apart from field 31.
+        assert_eq!(SharpenHint::quadric_of(&on), None);
+        for bad in [0u64, 1001] {
+            let h = swing.clone().with(whet_format::tag::BESIDE_PROJECTION, bad);
+            assert_eq!(SharpenHint::beside_of(&h), None);
+        }
+        let exact = whet_format::Header::new(whet_format::Mode::Exact, 3, 1)
+            .with(whet_format::tag::ANGLE_BITS, 6u64)
+            .with(whet_format::tag::BESIDE_PROJECTION, 25u64);
+        assert_eq!(SharpenHint::beside_of(&exact), None);
     }
 
     #[test]

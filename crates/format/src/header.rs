@@ -191,6 +191,11 @@ pub mod tag {
     /// sharpening and the planar and quadric projections, its move limit in hundredths of the
     /// mean edge length (swing; absent, or outside 1..=1000: none).
     pub const CREASE_PROJECTION: u64 = 35;
+    /// u64 (optional, added 2026-12-06, later session): the one-sided quadric projection of
+    /// the vertices beside creases a decoder applies after the planar and quadric
+    /// projections and before the crease projection, its move limit in hundredths of the
+    /// angle step (swing; absent, or outside 1..=1000: none).
+    pub const BESIDE_PROJECTION: u64 = 37;
     /// i64 (format 1.4): factor of `s2`, the one-ring mean of the filter's smoothed field,
     /// in the swing decoder's extended surface filter, in units of 1/1024 (swing; absent:
     /// 0). Required: a stream with it decodes to another mesh.
@@ -209,7 +214,7 @@ pub mod tag {
     pub const EXACT_PREDICTION: u64 = 40;
 
     /// Every tag this crate knows, with its name and value type.
-    pub const KNOWN: [(u64, &str, ValueType); 24] = [
+    pub const KNOWN: [(u64, &str, ValueType); 25] = [
         (ENCODER, "encoder", ValueType::Bytes),
         (COMPONENT_COUNT, "component_count", ValueType::U64),
         (QUANT_BITS, "quant_bits", ValueType::U64),
@@ -244,6 +249,7 @@ pub mod tag {
         (CREASE_PROJECTION, "crease_projection", ValueType::U64),
         (FILTER_SMOOTHED2, "filter_smoothed2", ValueType::I64),
         (FILTER_QUADRATIC, "filter_quadratic", ValueType::I64),
+        (BESIDE_PROJECTION, "beside_projection", ValueType::U64),
         (FILTER_TANGENTIAL, "filter_tangential", ValueType::I64),
         (EXACT_PREDICTION, "exact_prediction", ValueType::U64),
     ];

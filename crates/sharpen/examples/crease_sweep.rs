@@ -1,9 +1,10 @@
 //! The crease projection's move limit, reach and crease angle on the swing-decoded CAD
 //! fixtures of `sharpen_figures`: for each stream that names a sharpening, `whet decode
-//! --sharpen`'s output without the crease projection (the planar and quadric ones as the
-//! stream states them), then with `project_creases_onto_local_quadrics` at the given move
-//! limit (mean edge lengths), reach (mean edge lengths) and crease angle, both measured with
-//! Metro against the original (symmetric RMS and max, 300 000 samples a direction).
+//! --sharpen`'s output without the crease projection (the planar, quadric and one-sided
+//! ones as the stream states them), then with `project_creases_onto_local_quadrics` at the
+//! given move limit (mean edge lengths), reach (mean edge lengths) and crease angle, both
+//! measured with Metro against the original (symmetric RMS and max, 300 000 samples a
+//! direction).
 //!
 //! ```text
 //! cargo run --release -p whet-sharpen --example crease_sweep -- [max move 0.5] [rings 3] [degrees 30]
@@ -32,7 +33,7 @@ fn main() {
         if s.sharpen_hint == Some(whet_codec::SharpenHint::Unsharpened) {
             continue;
         }
-        let base = s.decode_sharpen_through(swing_inputs::Projections::Quadric);
+        let base = s.decode_sharpen_through(swing_inputs::Projections::Beside);
         let mut fitted = base.clone();
         let report = project_creases_onto_local_quadrics(&mut fitted, &opts)
             .unwrap_or_else(|e| panic!("{name}: {e}"));

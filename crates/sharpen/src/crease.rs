@@ -129,6 +129,45 @@ impl SideFit {
     }
 }
 
+/// Per corner, whether the edge it faces is a crease (its two triangles' normals differ by
+/// more than `degrees`; a degenerate triangle, without a normal, makes all its edges
+/// creases), and per vertex, whether it is on a crease edge.
+pub(crate) fn crease_edges(
+    mesh: &Mesh,
+    table: &whet_mesh::CornerTable,
+    degrees: f64,
+) -> (Vec<bool>, Vec<bool>) {
+    let normals: Vec<DVec3> = (0..mesh.triangles.len())
+        .map(|t| mesh.face_cross(t).normalize_or_zero())
+        .collect();
+    crease_edges_of(mesh, table, &normals, degrees)
+}
+
+/// [`crease_edges`] from the triangles' unit `normals`.
+fn crease_edges_of(
+    mesh: &Mesh,
+    table: &whet_mesh::CornerTable,
+    normals: &[DVec3],
+    degrees: f64,
+) -> (Vec<bool>, Vec<bool>) {
+    let cos_crease = degrees.to_radians().cos();
+    let crease: Vec<bool> = (0..3 * mesh.triangles.len())
+        .map(|c| {
+            table.opposite(CornerId(c as u32)).is_some_and(|o| {
+                let (a, b) = (normals[c / 3], normals[o.index() / 3]);
+                a == DVec3::ZERO || b == DVec3::ZERO || a.dot(b) < cos_crease
+            })
+        })
+        .collect();
+    let mut on_crease = vec![false; mesh.positions.len()];
+    for (c, _) in crease.iter().enumerate().filter(|(_, &k)| k) {
+        let c = CornerId(c as u32);
+        on_crease[table.vertex(table.next(c)).index()] = true;
+        on_crease[table.vertex(table.prev(c)).index()] = true;
+    }
+    (crease, on_crease)
+}
+
 /// Moves every interior vertex that lies on a crease line (exactly two of its edges are
 /// creases) onto the intersection of the quadratic height fields fitted to its two sides,
 /// when the two sides turn by at least 20 degrees and the move is at most `max_move` mean
@@ -152,23 +191,7 @@ pub fn project_creases_onto_local_quadrics(
     let normals: Vec<DVec3> = (0..nt)
         .map(|t| mesh.face_cross(t).normalize_or_zero())
         .collect();
-    let cos_crease = opts.crease_angle_degrees.to_radians().cos();
-    // A corner's opposite edge is a crease when its two triangles turn by more than the
-    // crease angle (a degenerate triangle, without a normal, makes all its edges creases).
-    let crease: Vec<bool> = (0..3 * nt)
-        .map(|c| {
-            table.opposite(CornerId(c as u32)).is_some_and(|o| {
-                let (a, b) = (normals[c / 3], normals[o.index() / 3]);
-                a == DVec3::ZERO || b == DVec3::ZERO || a.dot(b) < cos_crease
-            })
-        })
-        .collect();
-    let mut on_crease = vec![false; nv];
-    for (c, _) in crease.iter().enumerate().filter(|(_, &k)| k) {
-        let c = CornerId(c as u32);
-        on_crease[table.vertex(table.next(c)).index()] = true;
-        on_crease[table.vertex(table.prev(c)).index()] = true;
-    }
+    let (crease, on_crease) = crease_edges_of(mesh, &table, &normals, opts.crease_angle_degrees);
     let max_triangles = MAX_TRIANGLES_PER_SQUARED_RING * opts.rings * opts.rings;
     let min_sin = MIN_SIDE_TURN_DEGREES.to_radians().sin();
     let max_move = opts.max_move * edge;

@@ -8,8 +8,9 @@
 //! coincidences and exact coplanarity are common.
 
 use crate::{
-    flatten_planar_regions, project_creases_onto_local_quadrics, project_onto_local_quadrics,
-    sharpen, CreaseOptions, Error, Method, PlanarOptions, QuadricOptions, SharpenOptions,
+    flatten_planar_regions, project_beside_creases_onto_local_quadrics,
+    project_creases_onto_local_quadrics, project_onto_local_quadrics, sharpen, BesideOptions,
+    CreaseOptions, Error, Method, PlanarOptions, QuadricOptions, SharpenOptions,
 };
 use whet_mesh::{CornerTable, DVec3, Mesh, MeshError, VertexId};
 
@@ -145,6 +146,14 @@ pub fn fuzz_sharpen(data: &[u8]) -> Option<(Mesh, Vec<[u32; 2]>)> {
         panic!("quadric projection refused a sharpened mesh: {e}");
     }
     check_moves(&before, &sharp, quadric.max_move, "quadric projection");
+    // The one-sided projection beside creases, at the quadric one's limit: the same
+    // promises.
+    let beside = BesideOptions::DEFAULT.with_max_move(quadric.max_move);
+    let before = sharp.clone();
+    if let Err(e) = project_beside_creases_onto_local_quadrics(&mut sharp, &beside) {
+        panic!("one-sided projection refused a sharpened mesh: {e}");
+    }
+    check_moves(&before, &sharp, beside.max_move, "one-sided projection");
     // The crease projection, at the quadric one's limit (a stream states its own in mean
     // edge lengths, 0.01 to 10): the same promises.
     let crease = CreaseOptions::DEFAULT.with_max_move(quadric.max_move);

@@ -10,8 +10,9 @@
 //! with samples, noisy creases; [`sharpen_region`] limits it to a [`VertexSelection`]).
 //! [`flatten_planar_regions`] moves the vertices inside a decoded mesh's flat faces onto
 //! their fitted planes (the swing decoder's quantization noise, which sharpening leaves);
-//! [`project_onto_local_quadrics`] does the same for curved faces, vertex by vertex, and
-//! [`project_creases_onto_local_quadrics`] moves the vertices on crease lines onto the
+//! [`project_onto_local_quadrics`] does the same for curved faces, vertex by vertex,
+//! [`project_beside_creases_onto_local_quadrics`] for the face vertices beside a crease
+//! (from their own side only), and [`project_creases_onto_local_quadrics`] moves the vertices on crease lines onto the
 //! intersection of the quadrics fitted to their two sides.
 //! See `docs/sharpen.md` for the rules and the degenerate cases.
 //!
@@ -32,6 +33,7 @@
 //! ```
 #![forbid(unsafe_code)]
 
+mod beside;
 mod crease;
 mod edge_sharpener;
 mod extended;
@@ -47,6 +49,7 @@ mod snap;
 mod tags;
 mod weld;
 
+pub use beside::{project_beside_creases_onto_local_quadrics, BesideOptions, BesideReport};
 pub use crease::{project_creases_onto_local_quadrics, CreaseOptions, CreaseReport};
 pub use edge_sharpener::EdgeSharpener;
 

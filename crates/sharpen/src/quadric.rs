@@ -207,13 +207,13 @@ pub fn project_onto_local_quadrics(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// A closed cylinder of radius `r` and height `h` wrapped by `around` x `up` quads
     /// (capped by fans), its side vertices pushed along their radius by a deterministic
     /// pseudo-random `noise` (absolute).
-    fn cylinder(r: f64, h: f64, around: usize, up: usize, noise: f64) -> Mesh {
+    pub(crate) fn cylinder(r: f64, h: f64, around: usize, up: usize, noise: f64) -> Mesh {
         let mut state = 0x9e37_79b9_7f4a_7c15u64;
         let mut rand = || {
             state ^= state << 13;

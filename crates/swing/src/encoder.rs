@@ -77,6 +77,10 @@ pub struct SharpenTrial {
     /// [`QUADRIC_FACTOR`]): tried on the best sharpening, with the planar projection when
     /// that was kept.
     pub quadric: bool,
+    /// With the one-sided quadric projection of the vertices beside creases after those
+    /// (optional header field 37, at [`BESIDE_FACTOR`]): tried with the projections kept
+    /// before it.
+    pub beside: bool,
     /// With the crease projection after those (optional header field 35, at
     /// [`CREASE_MOVE`]): tried last, with the projections kept before it.
     pub crease: bool,
@@ -121,6 +125,14 @@ pub const PLANAR_FACTOR: f64 = 2.0;
 /// whet-sharpen), 0.25 gained the most where it was kept (docs/results.md, "Local quadric
 /// projection").
 pub const QUADRIC_FACTOR: f64 = 0.25;
+
+/// The one-sided quadric projection's move limit, in angle steps, that the encoder tries
+/// after the local quadric projection (`whet_sharpen::BesideOptions::for_swing`;
+/// docs/swing.md section 2): a quarter step, as the local quadric projection's. Of 0.1,
+/// 0.15, 0.25, 0.5, 1 and 2 steps on the fandisk rows of the sharpening figures
+/// (`beside_sweep` in whet-sharpen), 0.25 gained the most (docs/results.md, "One-sided
+/// quadric projection").
+pub const BESIDE_FACTOR: f64 = 0.25;
 
 /// The crease projection's move limit, in mean edge lengths, that the encoder tries after
 /// the other projections (`whet_sharpen::CreaseOptions`; docs/swing.md section 2): the
@@ -324,6 +336,10 @@ pub struct SwingOutput {
     /// The local quadric projection after those the stream states (optional header field
     /// 31: its move limit in angle steps), when the encoder measured it better.
     pub quadric_factor: Option<f64>,
+    /// The one-sided quadric projection of the vertices beside creases after those the
+    /// stream states (optional header field 37: its move limit in angle steps), when the
+    /// encoder measured it better.
+    pub beside_factor: Option<f64>,
     /// The crease projection after those the stream states (optional header field 35: its
     /// move limit in mean edge lengths), when the encoder measured it better.
     pub crease_factor: Option<f64>,
@@ -656,6 +672,7 @@ impl SwingEncoder {
             max_pct: decoded_max,
             planar: false,
             quadric: false,
+            beside: false,
             crease: false,
             sharpened_filter: true,
         };
@@ -856,7 +873,8 @@ impl SwingEncoder {
     /// The projections after sharpening tried on `start` (a stream stating a sharpening and
     /// its measured trial), each kept when it beats what it refines by the margin within
     /// `bounds`: first the planar one (the flat faces' quantization noise, which the
-    /// sharpener leaves), then the local quadric one (that of the curved faces; docs/swing.md
+    /// sharpener leaves), then the local quadric one (that of the curved faces), the
+    /// one-sided one (that of the faces beside creases) and the crease one (docs/swing.md
     /// section 2). Every trial goes to `trials`; returns the stream and trial that stand.
     #[allow(clippy::too_many_arguments)]
     fn project_after_sharpening(
@@ -870,9 +888,10 @@ impl SwingEncoder {
         trials: &mut Vec<SharpenTrial>,
     ) -> Result<(SwingOutput, SharpenTrial), Error> {
         let (mut chosen, mut current) = start;
-        let restated: [fn(SwingOutput) -> Result<SwingOutput, Error>; 3] = [
+        let restated: [fn(SwingOutput) -> Result<SwingOutput, Error>; 4] = [
             |o| restate_planar(o, PLANAR_FACTOR),
             |o| restate_quadric(o, QUADRIC_FACTOR),
+            |o| restate_beside(o, BESIDE_FACTOR),
             |o| restate_crease(o, CREASE_MOVE),
         ];
         for (k, restate) in restated.iter().enumerate() {
@@ -884,7 +903,8 @@ impl SwingEncoder {
                 max_pct: max,
                 planar: current.planar || k == 0,
                 quadric: current.quadric || k == 1,
-                crease: k == 2,
+                beside: current.beside || k == 2,
+                crease: k == 3,
                 ..current
             };
             trials.push(trial);
@@ -1178,6 +1198,7 @@ impl SwingEncoder {
                 sharpen_passes: info.sharpen_passes,
                 planar_factor: None,
                 quadric_factor: None,
+                beside_factor: None,
                 crease_factor: None,
                 sharpen_trials: Vec::new(),
                 sharpen_input_max_pct: None,
@@ -1426,6 +1447,10 @@ impl SwingEncoder {
                         angle_bits: out.angle_bits,
                     }),
                     out.quadric_factor.map(|factor| StatedProjection::Quadric {
+                        factor,
+                        angle_bits: out.angle_bits,
+                    }),
+                    out.beside_factor.map(|factor| StatedProjection::Beside {
                         factor,
                         angle_bits: out.angle_bits,
                     }),
@@ -1747,6 +1772,7 @@ impl Candidate {
             max_pct,
             planar: false,
             quadric: false,
+            beside: false,
             crease: false,
             sharpened_filter: true,
         }
@@ -1833,6 +1859,18 @@ fn restate_quadric(mut out: SwingOutput, factor: f64) -> Result<SwingOutput, Err
     out.bytes = with_header_field(&out.bytes, whet_format::tag::QUADRIC_PROJECTION, code)?;
     out.report.bytes = out.bytes.len();
     out.quadric_factor = Some(code as f64 / 100.0);
+    Ok(out)
+}
+
+/// `out` with header field 37 stating the one-sided quadric projection beside creases at a
+/// move limit of `factor` angle steps (rounded to the field's hundredths). Like field 25,
+/// its bytes come after the size search.
+fn restate_beside(mut out: SwingOutput, factor: f64) -> Result<SwingOutput, Error> {
+    let code = SharpenHint::smooth_factor_code(factor)
+        .ok_or_else(|| Error::Internal(format!("beside factor {factor} out of range")))?;
+    out.bytes = with_header_field(&out.bytes, whet_format::tag::BESIDE_PROJECTION, code)?;
+    out.report.bytes = out.bytes.len();
+    out.beside_factor = Some(code as f64 / 100.0);
     Ok(out)
 }
 

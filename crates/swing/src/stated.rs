@@ -1,7 +1,7 @@
 //! The decoder's side of what a swing stream states about its sharpening (docs/swing.md
 //! section 2): the method, smooth factor, curved walls and passes its encoder measured best
 //! (`SharpenHint`), the snaps it vetoed (field 33), its filter for after sharpening, and the
-//! projections after that (fields 25, 31 and 35). `whet decode --sharpen`, `whet rd` and the
+//! projections after that (fields 25, 31, 37 and 35, in that order). `whet decode --sharpen`, `whet rd` and the
 //! sharpening figures all read a header through [`StatedSharpening`], and the encoder
 //! measures its projections through [`StatedProjection`], so what the encoder measured is
 //! what every decoder writes.
@@ -19,6 +19,10 @@ pub enum StatedProjection {
     /// Field 31: curved parts onto local quadrics (`whet_sharpen::project_onto_local_quadrics`),
     /// moves of at most `factor` angle steps.
     Quadric { factor: f64, angle_bits: u32 },
+    /// Field 37: the vertices beside creases onto their own side's local quadric
+    /// (`whet_sharpen::project_beside_creases_onto_local_quadrics`), moves of at most
+    /// `factor` angle steps; runs before the crease projection.
+    Beside { factor: f64, angle_bits: u32 },
     /// Field 35: crease vertices onto their sides' intersection
     /// (`whet_sharpen::project_creases_onto_local_quadrics`), moves of at most `max_move`
     /// mean edge lengths.
@@ -36,6 +40,9 @@ impl StatedProjection {
         if let Some((factor, angle_bits)) = SharpenHint::quadric_of(header) {
             projections.push(StatedProjection::Quadric { factor, angle_bits });
         }
+        if let Some((factor, angle_bits)) = SharpenHint::beside_of(header) {
+            projections.push(StatedProjection::Beside { factor, angle_bits });
+        }
         if let Some(max_move) = SharpenHint::crease_of(header) {
             projections.push(StatedProjection::Crease { max_move });
         }
@@ -47,6 +54,7 @@ impl StatedProjection {
         match self {
             StatedProjection::Planar { .. } => "planar-region",
             StatedProjection::Quadric { .. } => "local quadric",
+            StatedProjection::Beside { .. } => "beside-crease quadric",
             StatedProjection::Crease { .. } => "crease",
         }
     }
@@ -62,6 +70,10 @@ impl StatedProjection {
             StatedProjection::Quadric { factor, angle_bits } => {
                 let opts = whet_sharpen::QuadricOptions::for_swing(angle_bits, factor);
                 whet_sharpen::project_onto_local_quadrics(mesh, &opts).map(|_| ())
+            }
+            StatedProjection::Beside { factor, angle_bits } => {
+                let opts = whet_sharpen::BesideOptions::for_swing(angle_bits, factor);
+                whet_sharpen::project_beside_creases_onto_local_quadrics(mesh, &opts).map(|_| ())
             }
             StatedProjection::Crease { max_move } => {
                 let opts = whet_sharpen::CreaseOptions::DEFAULT.with_max_move(max_move);
@@ -224,9 +236,10 @@ mod tests {
     use whet_format::{tag, Header, Mode};
 
     #[test]
-    fn projections_run_planar_then_quadric_then_crease_whatever_the_field_order() {
+    fn projections_run_planar_quadric_beside_then_crease_whatever_the_field_order() {
         let h = Header::new(Mode::Swing, 3, 1)
             .with(tag::ANGLE_BITS, 7u64)
+            .with(tag::BESIDE_PROJECTION, 25u64)
             .with(tag::CREASE_PROJECTION, 50u64)
             .with(tag::QUADRIC_PROJECTION, 25u64)
             .with(tag::PLANAR_TOLERANCE, 200u64);
@@ -241,6 +254,10 @@ mod tests {
                     factor: 0.25,
                     angle_bits: 7
                 },
+                StatedProjection::Beside {
+                    factor: 0.25,
+                    angle_bits: 7
+                },
                 StatedProjection::Crease { max_move: 0.5 },
             ]
         );
@@ -248,7 +265,15 @@ mod tests {
             .iter()
             .map(|p| p.name())
             .collect();
-        assert_eq!(names, ["planar-region", "local quadric", "crease"]);
+        assert_eq!(
+            names,
+            [
+                "planar-region",
+                "local quadric",
+                "beside-crease quadric",
+                "crease"
+            ]
+        );
         // An exact stream states none, whatever its fields.
         let exact = Header::new(Mode::Exact, 3, 1).with(tag::CREASE_PROJECTION, 50u64);
         assert!(StatedProjection::all_of(&exact).is_empty());

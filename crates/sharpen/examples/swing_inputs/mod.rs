@@ -74,6 +74,9 @@ pub struct SwingInput {
     pub planar: bool,
     /// The stream states the local quadric projection after sharpening (field 31).
     pub quadric: bool,
+    /// The stream states the one-sided quadric projection beside creases (field 37).
+    pub beside: bool,
+    /// The stream states the crease projection (field 35).
     pub crease: bool,
     /// The stream carries a filter for after sharpening (fields 17 and 19).
     pub after_filter: bool,
@@ -88,6 +91,7 @@ pub enum Projections {
     None,
     Planar,
     Quadric,
+    Beside,
     All,
 }
 
@@ -120,6 +124,7 @@ impl SwingInput {
         let rank = |p: &whet_swing::StatedProjection| match p {
             whet_swing::StatedProjection::Planar { .. } => Projections::Planar,
             whet_swing::StatedProjection::Quadric { .. } => Projections::Quadric,
+            whet_swing::StatedProjection::Beside { .. } => Projections::Beside,
             whet_swing::StatedProjection::Crease { .. } => Projections::All,
         };
         for p in stated.projections.iter().filter(|p| rank(p) <= last) {
@@ -234,6 +239,7 @@ pub fn swing_input_of(original: Mesh, key: &str, rate: Rate, angles: Angles) -> 
         after_filter: !whet_codec::SurfaceFilter::after_sharpening_of(&header).is_none(),
         planar: whet_codec::SharpenHint::planar_of(&header).is_some(),
         quadric: whet_codec::SharpenHint::quadric_of(&header).is_some(),
+        beside: whet_codec::SharpenHint::beside_of(&header).is_some(),
         crease: whet_codec::SharpenHint::crease_of(&header).is_some(),
         original,
         decoded,

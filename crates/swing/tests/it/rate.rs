@@ -228,22 +228,22 @@ fn automatic_angle_bits_climb_on_flat_parts_and_stay_low_on_smooth_ones() {
     // factors and curved walls, in one pass and in two, each the same retiling, the best of
     // them refined: 2 neighbours without curved walls, 8 with, and itself in one more
     // pass; and none), then tried the
-    // chosen one with the planar-region projection, the local quadric one and the crease
-    // one, and without its filter for after sharpening.
+    // chosen one with the planar-region projection, the local quadric one, the one-sided
+    // one beside creases and the crease one, and without its filter for after sharpening.
     let unprojected = out
         .sharpen_trials
         .iter()
-        .filter(|t| !t.planar && !t.quadric && !t.crease && t.sharpened_filter)
+        .filter(|t| !t.planar && !t.quadric && !t.beside && !t.crease && t.sharpened_filter)
         .count();
     assert!(
         [25, 28, 34].contains(&unprojected),
         "{:?}",
         out.sharpen_trials
     );
-    // (Plus three projections, and the chosen sharpening without its filter for after
-    // sharpening with its three.)
+    // (Plus four projections, and the chosen sharpening without its filter for after
+    // sharpening with its four.)
     assert!(
-        out.sharpen_trials.len() <= unprojected + 7,
+        out.sharpen_trials.len() <= unprojected + 9,
         "{:?}",
         out.sharpen_trials
     );
@@ -331,7 +331,7 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
         let (trials, refined): (Vec<&SharpenTrial>, Vec<_>) = out
             .sharpen_trials
             .iter()
-            .partition(|t| t.sharpened_filter && !t.planar && !t.quadric && !t.crease);
+            .partition(|t| t.sharpened_filter && !t.planar && !t.quadric && !t.beside && !t.crease);
         let input_max = out.sharpen_input_max_pct.unwrap();
         assert_eq!(
             trials.last().map(|t| t.hint),
@@ -376,13 +376,15 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
         let (with, bare): (Vec<&SharpenTrial>, Vec<_>) =
             refined.into_iter().partition(|t| t.sharpened_filter);
         let sharpened = hint != SharpenHint::Unsharpened;
-        assert_eq!(with.len(), if sharpened { 3 } else { 0 }, "{name}");
-        assert!(bare.is_empty() || (sharpened && bare.len() == 4), "{name}");
+        assert_eq!(with.len(), if sharpened { 4 } else { 0 }, "{name}");
+        assert!(bare.is_empty() || (sharpened && bare.len() == 5), "{name}");
         let h = header(&out.bytes);
         let stated = SharpenHint::planar_of(&h);
         assert_eq!(stated.map(|s| s.0), out.planar_factor, "{name}");
         let stated = SharpenHint::quadric_of(&h);
         assert_eq!(stated.map(|s| s.0), out.quadric_factor, "{name}");
+        let stated = SharpenHint::beside_of(&h);
+        assert_eq!(stated.map(|s| s.0), out.beside_factor, "{name}");
         assert_eq!(SharpenHint::crease_of(&h), out.crease_factor, "{name}");
         let (unprojected, chosen) = if sharpened {
             // The candidate the refinements start from: the same sharpening unprojected.
@@ -407,7 +409,8 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
                 for (k, s) in steps.iter().enumerate() {
                     assert_eq!(s.planar, current.planar || k == 0, "{name}: {s:?}");
                     assert_eq!(s.quadric, current.quadric || k == 1, "{name}: {s:?}");
-                    assert_eq!(s.crease, k == 2, "{name}: {s:?}");
+                    assert_eq!(s.beside, current.beside || k == 2, "{name}: {s:?}");
+                    assert_eq!(s.crease, k == 3, "{name}: {s:?}");
                     assert_eq!(s.sharpened_filter, start.sharpened_filter, "{name}");
                     if s.score() < 0.995 * current.score() && admit(s) {
                         current = **s;
@@ -417,7 +420,10 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
             };
             let mut end = path_end(base, &with);
             if let Some((first, steps)) = bare.split_first() {
-                assert!(!first.planar && !first.quadric && !first.crease, "{name}");
+                assert!(
+                    !first.planar && !first.quadric && !first.beside && !first.crease,
+                    "{name}"
+                );
                 let without = path_end(**first, steps);
                 if without.score() < 0.995 * end.score() && admit(&without) {
                     end = without;
@@ -426,12 +432,16 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
             assert_eq!(out.rms_pct, Some(end.rms_pct), "{name}");
             assert_eq!(out.planar_factor.is_some(), end.planar, "{name}");
             assert_eq!(out.quadric_factor.is_some(), end.quadric, "{name}");
+            assert_eq!(out.beside_factor.is_some(), end.beside, "{name}");
             assert_eq!(out.crease_factor.is_some(), end.crease, "{name}");
             if let Some(f) = out.planar_factor {
                 assert_eq!(f, whet_swing::PLANAR_FACTOR);
             }
             if let Some(f) = out.quadric_factor {
                 assert_eq!(f, whet_swing::QUADRIC_FACTOR);
+            }
+            if let Some(f) = out.beside_factor {
+                assert_eq!(f, whet_swing::BESIDE_FACTOR);
             }
             if let Some(f) = out.crease_factor {
                 assert_eq!(f, whet_swing::CREASE_MOVE);
