@@ -8,7 +8,7 @@
 //! 300 000 samples a direction).
 //!
 //! ```text
-//! cargo run --release -p whet-sharpen --example beside_sweep -- [factor 0.25] [rings 3] [fixture ...]
+//! cargo run --release -p whet-sharpen --example beside_sweep -- [factor 0.25] [rings 3] [normal angle 30] [crease angle 30] [fixture ...]
 //! ```
 #![allow(clippy::unwrap_used)] // a measurement tool
 
@@ -28,7 +28,8 @@ fn main() {
         })
     };
     let (factor, rings) = (arg(1, 0.25), arg(2, 3.0) as usize);
-    let only: Vec<&String> = args.iter().skip(3).collect();
+    let (normal_angle, crease_angle) = (arg(3, 30.0), arg(4, 30.0));
+    let only: Vec<&String> = args.iter().skip(5).collect();
     println!("| stream | input RMS % | without: RMS %, max % (RMS gain) | with the projection | moved / beside |");
     println!("|---|---|---|---|---|");
     let (mut log_gain, mut rows, mut max_worse) = (0.0, 0, 0);
@@ -40,7 +41,10 @@ fn main() {
         }
         let mut base = s.decode_sharpen_through(swing_inputs::Projections::Quadric);
         let mut fitted = base.clone();
-        let opts = BesideOptions::for_swing(s.angle_bits, factor).with_rings(rings);
+        let opts = BesideOptions::for_swing(s.angle_bits, factor)
+            .with_rings(rings)
+            .with_max_normal_angle_degrees(normal_angle)
+            .with_crease_angle_degrees(crease_angle);
         let report = project_beside_creases_onto_local_quadrics(&mut fitted, &opts)
             .unwrap_or_else(|e| panic!("{name}: {e}"));
         if s.crease {

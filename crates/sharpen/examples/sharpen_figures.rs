@@ -188,7 +188,7 @@ fn stated_name(s: &swing_inputs::SwingInput) -> String {
     match s.sharpen_hint {
         Some(SharpenHint::Unsharpened) => "none".to_string(),
         h => format!(
-            "{} {}{}{}{}{}{}{}",
+            "{} {}{}{}{}{}{}{}{}",
             h.map_or("extended", SharpenHint::name),
             s.smooth_factor,
             match s.curved_walls {
@@ -202,6 +202,7 @@ fn stated_name(s: &swing_inputs::SwingInput) -> String {
             },
             if s.planar { " + planes" } else { "" },
             if s.quadric { " + quadrics" } else { "" },
+            if s.beside { " + beside" } else { "" },
             if s.crease { " + creases" } else { "" },
             if s.after_filter { "" } else { " − filter" }
         ),

@@ -56,6 +56,22 @@ impl BesideOptions {
         BesideOptions { rings, ..self }
     }
 
+    /// The options with creases at `degrees`.
+    pub const fn with_crease_angle_degrees(self, degrees: f64) -> BesideOptions {
+        BesideOptions {
+            crease_angle_degrees: degrees,
+            ..self
+        }
+    }
+
+    /// The options with the normal-angle limit of fitted points `degrees`.
+    pub const fn with_max_normal_angle_degrees(self, degrees: f64) -> BesideOptions {
+        BesideOptions {
+            max_normal_angle_degrees: degrees,
+            ..self
+        }
+    }
+
     /// The options for a swing stream of `angle_bits` angle bits whose header states the
     /// move limit `factor` in angle steps, as the local quadric projection's
     /// ([`crate::QuadricOptions::for_swing`]).
