@@ -171,7 +171,8 @@ pub fn run(args: &DecodeArgs) -> CliResult {
                 whet_codec::SurfaceFilter::after_sharpening_of(h)
                     .apply_after_sharpening(&mesh, &mut s.mesh);
                 // Then the flat faces onto their planes, the curved ones onto local
-                // quadrics and the crease vertices onto their sides' intersection, when the
+                // quadrics, the face vertices beside creases onto their own side's quadric
+                // and the crease vertices onto their sides' intersection, when the
                 // stream says so.
                 super::sharpen::project_as_stated(h, &mut s.mesh);
             }

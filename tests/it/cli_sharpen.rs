@@ -980,6 +980,61 @@ fn decode_sharpen_applies_a_stated_crease_projection() {
     assert_eq!(projected.positions, expected.positions);
 }
 
+/// `whet decode --sharpen` applies a stated one-sided quadric projection (header field 37,
+/// in hundredths of the angle step) after the other face projections and before the crease
+/// projection (field 35), whatever the fields' order in the header: its output is what the
+/// same stream decodes to without either field, then the one-sided projection, then the
+/// crease projection.
+#[test]
+fn decode_sharpen_applies_a_stated_beside_projection_before_the_crease_one() {
+    let dir = scratch_dir("cli-beside-projection");
+    let mc = chamfered_cube(&dir);
+    let stream = dir.join("c.whet");
+    let o = whet(&["encode", s(&mc), "-o", s(&stream), "--bpv", "3"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let container = whet_format::parse(
+        &std::fs::read(&stream).unwrap(),
+        &whet_format::Limits::DEFAULT,
+    )
+    .unwrap();
+    assert!(whet_codec::SharpenHint::beside_of(&container.header).is_none());
+    assert!(whet_codec::SharpenHint::crease_of(&container.header).is_none());
+    let decode = |input: &std::path::Path, name: &str| {
+        let out = dir.join(name);
+        let o = whet(&["decode", s(input), "-o", s(&out), "--sharpen"]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        whet_io::read_path(&out, None).unwrap()
+    };
+    let plain = decode(&stream, "plain.off");
+    let mut stating = container.clone();
+    stating.header = stating
+        .header
+        .clone()
+        .with(whet_format::tag::CREASE_PROJECTION, 50u64)
+        .with(whet_format::tag::BESIDE_PROJECTION, 25u64);
+    let (factor, angle_bits) = whet_codec::SharpenHint::beside_of(&stating.header).unwrap();
+    assert_eq!(factor, 0.25);
+    let stated = dir.join("stated.whet");
+    std::fs::write(&stated, stating.to_bytes().unwrap()).unwrap();
+    let projected = decode(&stated, "projected.off");
+    let mut expected = plain.clone();
+    let beside = whet_sharpen::BesideOptions::for_swing(angle_bits, factor);
+    let report =
+        whet_sharpen::project_beside_creases_onto_local_quadrics(&mut expected, &beside).unwrap();
+    // The faces beside the cube's twelve sharpened edges carry the angles' noise.
+    assert!(report.moved_vertices > 12, "{report:?}");
+    let crease = whet_sharpen::CreaseOptions::DEFAULT.with_max_move(0.5);
+    whet_sharpen::project_creases_onto_local_quadrics(&mut expected, &crease).unwrap();
+    assert_eq!(projected.triangles, expected.triangles);
+    // The OFF writer prints shortest round-trip digits: the files agree to the bit.
+    assert_eq!(projected.positions, expected.positions);
+    // In the other order the output differs: the crease fits read the moved face vertices.
+    let mut other = plain.clone();
+    whet_sharpen::project_creases_onto_local_quadrics(&mut other, &crease).unwrap();
+    whet_sharpen::project_beside_creases_onto_local_quadrics(&mut other, &beside).unwrap();
+    assert_ne!(other.positions, expected.positions);
+}
+
 /// The library's `whet::decode_sharpened` writes what `whet decode --sharpen` writes, on a
 /// stream that states a sharpening and projections (and its snap vetoes, where it carries
 /// them), and on one that states none.
