@@ -9,10 +9,10 @@
 //! vertex moves along its normal onto it. docs/sharpen.md, "One-sided quadric projection".
 
 use glam::DVec3;
-use whet_mesh::{CornerId, Mesh, VertexId};
+use whet_mesh::{Mesh, VertexId};
 
-use crate::crease::crease_edges;
-use crate::planar::{add_height_sample, checked_table, solve6};
+use crate::crease::{crease_edges, SideReach};
+use crate::planar::{add_height_sample, checked_table, solve6, vertex_normals};
 use crate::Error;
 
 /// Most triangles a gathering takes, per square of its reach in mean edges (as the crease
@@ -142,16 +142,7 @@ pub fn project_beside_creases_onto_local_quadrics(
         return Ok(report);
     }
     let (crease, on_crease) = crease_edges(mesh, &table, opts.crease_angle_degrees);
-    let mut normals = vec![DVec3::ZERO; nv];
-    for (t, tri) in mesh.triangles.iter().enumerate() {
-        let c = mesh.face_cross(t);
-        for &v in tri {
-            normals[v as usize] += c;
-        }
-    }
-    for n in &mut normals {
-        *n = n.normalize_or_zero();
-    }
+    let normals = vertex_normals(mesh);
     let cos_max = opts.max_normal_angle_degrees.to_radians().cos();
     let max_move = opts.max_move * edge;
     let max_triangles = MAX_TRIANGLES_PER_SQUARED_RING * opts.rings * opts.rings;
@@ -172,7 +163,6 @@ pub fn project_beside_creases_onto_local_quadrics(
             continue;
         }
         let stamp = v as u32;
-        gathered.clear();
         stack.clear();
         // The fan: its edges at v are no crease (v is on none).
         for c in table.vertex_corners(vid) {
@@ -182,33 +172,20 @@ pub fn project_beside_creases_onto_local_quadrics(
                 stack.push(t);
             }
         }
-        let mut near = false;
-        while let Some(t) = stack.pop() {
-            gathered.push(t);
-            if gathered.len() > max_triangles {
-                continue 'vertices;
-            }
-            near |= mesh.triangles[t].iter().any(|&w| on_crease[w as usize]);
-            for k in 0..3 {
-                let c = 3 * t + k;
-                let Some(o) = table.opposite(CornerId(c as u32)) else {
-                    continue;
-                };
-                let u = o.index() / 3;
-                if crease[c] || tri_stamp[u] == stamp {
-                    continue;
-                }
-                let centroid = mesh.triangles[u]
-                    .iter()
-                    .map(|&w| p[w as usize])
-                    .sum::<DVec3>()
-                    / 3.0;
-                if centroid.distance(p[v]) < reach {
-                    tri_stamp[u] = stamp;
-                    stack.push(u);
-                }
-            }
+        let side = SideReach {
+            mesh,
+            table: &table,
+            crease: &crease,
+            centre: p[v],
+            reach,
+            max_triangles,
+        };
+        if !side.gather(stamp, &mut tri_stamp, &mut stack, &mut gathered) {
+            continue;
         }
+        let near = gathered
+            .iter()
+            .any(|&t| mesh.triangles[t].iter().any(|&w| on_crease[w as usize]));
         if !near {
             continue;
         }

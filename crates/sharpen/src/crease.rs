@@ -129,6 +129,62 @@ impl SideFit {
     }
 }
 
+/// A side's gathering, as the crease and one-sided projections take it: across edges that
+/// are no crease, every triangle whose centroid lies within `reach` of `centre`, at most
+/// `max_triangles` of them.
+pub(crate) struct SideReach<'a> {
+    pub mesh: &'a Mesh,
+    pub table: &'a whet_mesh::CornerTable,
+    /// Per corner, whether the edge it faces is a crease.
+    pub crease: &'a [bool],
+    pub centre: DVec3,
+    pub reach: f64,
+    pub max_triangles: usize,
+}
+
+impl SideReach<'_> {
+    /// Gathers, depth first from the triangles on `stack` (already marked `stamp` in
+    /// `tri_stamp`), into `gathered` (cleared first), marking each triangle it takes. False
+    /// when the side holds more than `max_triangles`: a vertex of very high valence within
+    /// the reach, whose gathering would not stay linear in the mesh.
+    pub fn gather(
+        &self,
+        stamp: u32,
+        tri_stamp: &mut [u32],
+        stack: &mut Vec<usize>,
+        gathered: &mut Vec<usize>,
+    ) -> bool {
+        let p = &self.mesh.positions;
+        gathered.clear();
+        while let Some(t) = stack.pop() {
+            gathered.push(t);
+            if gathered.len() > self.max_triangles {
+                return false;
+            }
+            for k in 0..3 {
+                let c = 3 * t + k;
+                let Some(o) = self.table.opposite(CornerId(c as u32)) else {
+                    continue;
+                };
+                let u = o.index() / 3;
+                if self.crease[c] || tri_stamp[u] == stamp {
+                    continue;
+                }
+                let centroid = self.mesh.triangles[u]
+                    .iter()
+                    .map(|&w| p[w as usize])
+                    .sum::<DVec3>()
+                    / 3.0;
+                if centroid.distance(self.centre) < self.reach {
+                    tri_stamp[u] = stamp;
+                    stack.push(u);
+                }
+            }
+        }
+        true
+    }
+}
+
 /// Per corner, whether the edge it faces is a crease (its two triangles' normals differ by
 /// more than `degrees`; a degenerate triangle, without a normal, makes all its edges
 /// creases), and per vertex, whether it is on a crease edge.
@@ -243,36 +299,21 @@ pub fn project_creases_onto_local_quadrics(
                 vert_stamp.fill(NONE);
                 stamp = 0;
             }
-            gathered.clear();
             stack.clear();
             for &t in &sides[s] {
                 tri_stamp[t] = stamp;
                 stack.push(t);
             }
-            while let Some(t) = stack.pop() {
-                gathered.push(t);
-                if gathered.len() > max_triangles {
-                    continue 'vertices;
-                }
-                for k in 0..3 {
-                    let c = 3 * t + k;
-                    let Some(o) = table.opposite(CornerId(c as u32)) else {
-                        continue;
-                    };
-                    let u = o.index() / 3;
-                    if crease[c] || tri_stamp[u] == stamp {
-                        continue;
-                    }
-                    let centroid = mesh.triangles[u]
-                        .iter()
-                        .map(|&w| p[w as usize])
-                        .sum::<DVec3>()
-                        / 3.0;
-                    if centroid.distance(p[v]) < reach {
-                        tri_stamp[u] = stamp;
-                        stack.push(u);
-                    }
-                }
+            let side = SideReach {
+                mesh,
+                table: &table,
+                crease: &crease,
+                centre: p[v],
+                reach,
+                max_triangles,
+            };
+            if !side.gather(stamp, &mut tri_stamp, &mut stack, &mut gathered) {
+                continue 'vertices;
             }
             if sides[1 - s].iter().any(|&t| tri_stamp[t] == stamp) {
                 continue 'vertices;

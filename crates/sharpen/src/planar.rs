@@ -339,6 +339,22 @@ fn fit_plane(pts: &[DVec3], normal: DVec3) -> Option<PlaneFit> {
     )
 }
 
+/// The area-weighted unit normal of each vertex of `mesh` (zero where its triangles' cross
+/// products cancel or it has none), as the local quadric and one-sided projections take them.
+pub(crate) fn vertex_normals(mesh: &Mesh) -> Vec<DVec3> {
+    let mut normals = vec![DVec3::ZERO; mesh.positions.len()];
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        let c = mesh.face_cross(t);
+        for &v in tri {
+            normals[v as usize] += c;
+        }
+    }
+    for n in &mut normals {
+        *n = n.normalize_or_zero();
+    }
+    normals
+}
+
 /// Adds one sample of height `h` with quadratic basis `b` (`[u^2, uv, v^2, u, v, 1]`) to
 /// the least-squares normal equations `m` of a quadratic height field (augmented: the right
 /// side in column 6), as the planar, quadric and crease fits all build them.

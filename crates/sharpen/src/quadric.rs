@@ -10,7 +10,7 @@
 use glam::DVec3;
 use whet_mesh::{Mesh, VertexId};
 
-use crate::planar::{add_height_sample, checked_table, solve6};
+use crate::planar::{add_height_sample, checked_table, solve6, vertex_normals};
 use crate::Error;
 
 /// Most points a fit gathers, per square of its ring count: 144 for three rings, about four
@@ -118,16 +118,7 @@ pub fn project_onto_local_quadrics(
     let table = checked_table(mesh)?;
     let p = &mesh.positions;
     let nv = p.len();
-    let mut normals = vec![DVec3::ZERO; nv];
-    for (t, tri) in mesh.triangles.iter().enumerate() {
-        let c = mesh.face_cross(t);
-        for &v in tri {
-            normals[v as usize] += c;
-        }
-    }
-    for n in &mut normals {
-        *n = n.normalize_or_zero();
-    }
+    let normals = vertex_normals(mesh);
     let edge = table.mean_edge_length(p);
     let max_move = opts.max_move * edge;
     let cos_max = opts.max_normal_angle_degrees.to_radians().cos();
