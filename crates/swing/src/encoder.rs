@@ -129,9 +129,9 @@ pub const QUADRIC_FACTOR: f64 = 0.25;
 /// The one-sided quadric projection's move limit, in angle steps, that the encoder tries
 /// after the local quadric projection (`whet_sharpen::BesideOptions::for_swing`;
 /// docs/swing.md section 2): a quarter step, as the local quadric projection's. Of 0.1,
-/// 0.15, 0.25, 0.5, 1 and 2 steps on the fandisk rows of the sharpening figures
-/// (`beside_sweep` in whet-sharpen), 0.25 gained the most (docs/results.md, "One-sided
-/// quadric projection").
+/// 0.15, 0.25, 0.35, 0.5 and 1 steps on the 42 sharpened swing rows of the sharpening
+/// figures (`beside_sweep` in whet-sharpen), 0.25 gained the most (docs/results.md,
+/// "One-sided quadric projection").
 pub const BESIDE_FACTOR: f64 = 0.25;
 
 /// The crease projection's move limit, in mean edge lengths, that the encoder tries after
