@@ -931,14 +931,10 @@ fn sharpen_leaves_an_already_sharp_original_alone_unless_told() {
     assert!(j["new_vertices"].as_u64().unwrap() > 0);
 }
 
-/// `whet decode --sharpen` applies the crease projection a swing stream states (optional
-/// header field 35, in hundredths of the mean edge length) after the sharpening and the
-/// other projections: its output is the projection of what the same stream decodes to
-/// without the field.
-#[test]
-fn decode_sharpen_applies_a_stated_crease_projection() {
-    let dir = scratch_dir("cli-crease-projection");
-    let mc = chamfered_cube(&dir);
+/// A chamfered cube encoded at 3 bits per vertex (no sharpening fields), its stream's path
+/// and its parsed container.
+fn plain_cube_stream(dir: &std::path::Path) -> (std::path::PathBuf, whet_format::Container) {
+    let mc = chamfered_cube(dir);
     let stream = dir.join("c.whet");
     let o = whet(&["encode", s(&mc), "-o", s(&stream), "--bpv", "3"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -947,22 +943,50 @@ fn decode_sharpen_applies_a_stated_crease_projection() {
         &whet_format::Limits::DEFAULT,
     )
     .unwrap();
-    assert!(whet_codec::SharpenHint::crease_of(&container.header).is_none());
-    let decode = |input: &std::path::Path, name: &str| {
-        let out = dir.join(name);
-        let o = whet(&["decode", s(input), "-o", s(&out), "--sharpen"]);
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        whet_io::read_path(&out, None).unwrap()
-    };
-    let plain = decode(&stream, "plain.off");
+    (stream, container)
+}
+
+/// What `whet decode --sharpen` writes for `input`, read back (as `dir/name`).
+fn decode_sharpened_file(
+    dir: &std::path::Path,
+    input: &std::path::Path,
+    name: &str,
+) -> whet_mesh::Mesh {
+    let out = dir.join(name);
+    let o = whet(&["decode", s(input), "-o", s(&out), "--sharpen"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    whet_io::read_path(&out, None).unwrap()
+}
+
+/// `container` with `header` in place of its own, written to `dir/stated.whet`.
+fn write_stating(
+    dir: &std::path::Path,
+    container: &whet_format::Container,
+    header: whet_format::Header,
+) -> std::path::PathBuf {
     let mut stating = container.clone();
-    stating.header = stating
+    stating.header = header;
+    let stated = dir.join("stated.whet");
+    std::fs::write(&stated, stating.to_bytes().unwrap()).unwrap();
+    stated
+}
+
+/// `whet decode --sharpen` applies the crease projection a swing stream states (optional
+/// header field 35, in hundredths of the mean edge length) after the sharpening and the
+/// other projections: its output is the projection of what the same stream decodes to
+/// without the field.
+#[test]
+fn decode_sharpen_applies_a_stated_crease_projection() {
+    let dir = scratch_dir("cli-crease-projection");
+    let (stream, container) = plain_cube_stream(&dir);
+    assert!(whet_codec::SharpenHint::crease_of(&container.header).is_none());
+    let plain = decode_sharpened_file(&dir, &stream, "plain.off");
+    let header = container
         .header
         .clone()
         .with(whet_format::tag::CREASE_PROJECTION, 50u64);
-    let stated = dir.join("stated.whet");
-    std::fs::write(&stated, stating.to_bytes().unwrap()).unwrap();
-    let projected = decode(&stated, "projected.off");
+    let stated = write_stating(&dir, &container, header);
+    let projected = decode_sharpened_file(&dir, &stated, "projected.off");
     let mut expected = plain.clone();
     let opts = whet_sharpen::CreaseOptions::DEFAULT.with_max_move(0.5);
     let report = whet_sharpen::project_creases_onto_local_quadrics(&mut expected, &opts).unwrap();
@@ -988,35 +1012,19 @@ fn decode_sharpen_applies_a_stated_crease_projection() {
 #[test]
 fn decode_sharpen_applies_a_stated_beside_projection_before_the_crease_one() {
     let dir = scratch_dir("cli-beside-projection");
-    let mc = chamfered_cube(&dir);
-    let stream = dir.join("c.whet");
-    let o = whet(&["encode", s(&mc), "-o", s(&stream), "--bpv", "3"]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let container = whet_format::parse(
-        &std::fs::read(&stream).unwrap(),
-        &whet_format::Limits::DEFAULT,
-    )
-    .unwrap();
+    let (stream, container) = plain_cube_stream(&dir);
     assert!(whet_codec::SharpenHint::beside_of(&container.header).is_none());
     assert!(whet_codec::SharpenHint::crease_of(&container.header).is_none());
-    let decode = |input: &std::path::Path, name: &str| {
-        let out = dir.join(name);
-        let o = whet(&["decode", s(input), "-o", s(&out), "--sharpen"]);
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        whet_io::read_path(&out, None).unwrap()
-    };
-    let plain = decode(&stream, "plain.off");
-    let mut stating = container.clone();
-    stating.header = stating
+    let plain = decode_sharpened_file(&dir, &stream, "plain.off");
+    let header = container
         .header
         .clone()
         .with(whet_format::tag::CREASE_PROJECTION, 50u64)
         .with(whet_format::tag::BESIDE_PROJECTION, 25u64);
-    let (factor, angle_bits) = whet_codec::SharpenHint::beside_of(&stating.header).unwrap();
+    let (factor, angle_bits) = whet_codec::SharpenHint::beside_of(&header).unwrap();
     assert_eq!(factor, 0.25);
-    let stated = dir.join("stated.whet");
-    std::fs::write(&stated, stating.to_bytes().unwrap()).unwrap();
-    let projected = decode(&stated, "projected.off");
+    let stated = write_stating(&dir, &container, header);
+    let projected = decode_sharpened_file(&dir, &stated, "projected.off");
     let mut expected = plain.clone();
     let beside = whet_sharpen::BesideOptions::for_swing(angle_bits, factor);
     let report =
