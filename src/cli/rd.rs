@@ -36,7 +36,7 @@ type RateCheck = fn(f64) -> Option<String>;
 /// sweep whose arguments are wrong is refused before it starts (exit 2), while a row that
 /// fails on one mesh (a rate too high for it, say) stays a row with its error.
 fn check_rates(plan: &Plan) -> CliResult {
-    let lists: [(&str, &str, &[f64], RateCheck); 4] = [
+    let lists: [(&str, &str, &[f64], RateCheck); 5] = [
         ("swing", "--rates", &plan.rates, swing_rate_problem),
         (
             "exact",
@@ -46,6 +46,12 @@ fn check_rates(plan: &Plan) -> CliResult {
         ),
         (
             "exact-traversal",
+            "--exact-bits",
+            &plan.exact_bits,
+            exact_rate_problem,
+        ),
+        (
+            "exact-traversal-static",
             "--exact-bits",
             &plan.exact_bits,
             exact_rate_problem,
@@ -81,7 +87,8 @@ pub fn check_samples(samples: usize) -> CliResult {
 
 /// The exact mode as an rd codec; the rate is the quantization bits. Mode `exact` codes
 /// with the default prediction, `exact-traversal` with the traversal prediction (the faster
-/// decoder; compare their decode-time columns).
+/// decoder; compare their decode-time columns), `exact-traversal-static` with it and the
+/// static residual code (faster again).
 struct ExactCodec {
     prediction: whet_codec::ExactPrediction,
 }
@@ -90,6 +97,7 @@ impl Codec for ExactCodec {
     fn name(&self) -> String {
         match self.prediction {
             whet_codec::ExactPrediction::Traversal => "exact-traversal".into(),
+            whet_codec::ExactPrediction::TraversalStatic => "exact-traversal-static".into(),
             _ => "exact".into(),
         }
     }
@@ -183,7 +191,7 @@ pub struct RdArgs {
     /// Control vertex counts of the subdiv mode's curve, comma separated.
     #[arg(long, value_delimiter = ',', default_value = "100,200,400,800")]
     subdiv_control: Vec<f64>,
-    /// Codec modes to sweep (swing, exact, exact-traversal, subdiv).
+    /// Codec modes to sweep (swing, exact, exact-traversal, exact-traversal-static, subdiv).
     #[arg(long, value_delimiter = ',', default_value = "swing,exact")]
     modes: Vec<String>,
     /// Post-processing stages to measure after decoding.
@@ -301,6 +309,9 @@ pub fn run_plan(meshes: Vec<(String, Mesh)>, plan: &Plan) -> CliResult<(Vec<Poin
     let exact_traversal = ExactCodec {
         prediction: whet_codec::ExactPrediction::Traversal,
     };
+    let exact_traversal_static = ExactCodec {
+        prediction: whet_codec::ExactPrediction::TraversalStatic,
+    };
     let subdiv = SubdivCodec;
     let sharpens = plan.stages.iter().any(|s| s == "sharpened" || s == "bent");
     let swing = SwingCodec {
@@ -315,11 +326,11 @@ pub fn run_plan(meshes: Vec<(String, Mesh)>, plan: &Plan) -> CliResult<(Vec<Poin
     for m in &plan.modes {
         match m.as_str() {
             "swing" => codecs.push(CodecSweep::new(&swing, plan.rates.clone())),
-            "exact" | "exact-traversal" => {
-                let codec = if m == "exact" {
-                    &exact
-                } else {
-                    &exact_traversal
+            "exact" | "exact-traversal" | "exact-traversal-static" => {
+                let codec = match m.as_str() {
+                    "exact" => &exact,
+                    "exact-traversal" => &exact_traversal,
+                    _ => &exact_traversal_static,
                 };
                 let mut c = CodecSweep::new(codec, plan.exact_bits.clone());
                 if let Some(s) = &plan.exact_stages {
@@ -330,7 +341,8 @@ pub fn run_plan(meshes: Vec<(String, Mesh)>, plan: &Plan) -> CliResult<(Vec<Poin
             "subdiv" => codecs.push(CodecSweep::new(&subdiv, plan.subdiv_control.clone())),
             other => {
                 return Err(Failure::input(anyhow::anyhow!(
-                    "unknown mode {other:?} (available: swing, exact, exact-traversal, subdiv)"
+                    "unknown mode {other:?} (available: swing, exact, exact-traversal, \
+                     exact-traversal-static, subdiv)"
                 )))
             }
         }

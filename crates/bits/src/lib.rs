@@ -2,7 +2,8 @@
 //! ([`RangeEncoder`], [`RangeDecoder`]) with its probability models ([`BitModel`], [`BitTree`],
 //! [`SymbolModel`], [`UnsignedIntModel`], [`SignedIntModel`]), a [`CostCounter`] that prices
 //! symbols in fractions of a bit with the same models so encoders can compare choices before
-//! making them, and fixed-width bit fields ([`RawBitWriter`], [`RawBitReader`]). All
+//! making them, a static-table rANS residual code for streams that must decode fast
+//! ([`StaticResidualEncoder`], [`StaticResidualDecoder`]), and fixed-width bit fields ([`RawBitWriter`], [`RawBitReader`]). All
 //! arithmetic is integer, so streams are identical on every machine.
 //!
 //! ```
@@ -29,6 +30,7 @@
 mod cost;
 mod models;
 mod range_coder;
+mod rans;
 mod raw;
 mod residual;
 
@@ -38,6 +40,10 @@ pub use models::{
     UnsignedIntModel, ADAPT_SHIFT, COUNTING_PROB_BITS, PROB_BITS, PROB_ONE,
 };
 pub use range_coder::{RangeDecoder, RangeEncoder};
+pub use rans::{
+    StaticResidualDecoder, StaticResidualEncoder, MAX_STATIC_CONTEXTS, STATIC_LANES, STATIC_PREC,
+    STATIC_SYMBOLS,
+};
 pub use raw::{RawBitReader, RawBitWriter};
 pub use residual::{CdfModel, ResidualModel, CDF_SYMBOLS};
 

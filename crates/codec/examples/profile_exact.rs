@@ -1,7 +1,7 @@
 //! Times the stages of the exact mode on a ~1.3M-triangle icosphere (a profiling aid:
 //! `cargo run --release -p whet-codec --example profile_exact -- [encodes] [decodes]`,
 //! e.g. `-- 0 20` to profile decoding alone). The icosphere's vertices and triangles are
-//! shuffled (the worst memory order an encoder meets); `PROFILE_PREDICTION=traversal` codes
+//! shuffled (the worst memory order an encoder meets); `PROFILE_PREDICTION=traversal` (or `traversal-static`) codes
 //! with the traversal prediction; `PROFILE_ORDER=natural` keeps the
 //! generator's order, and `PROFILE_MESH=<file>` profiles that mesh in its file's order;
 //! `PROFILE_REUSE=1` encodes with one [`EncodeBuffers`] and decodes with one
@@ -49,6 +49,9 @@ fn main() {
     }
     let opts = match std::env::var("PROFILE_PREDICTION").as_deref() {
         Ok("traversal") => EncodeOptions::DEFAULT.with_prediction(ExactPrediction::Traversal),
+        Ok("traversal-static") => {
+            EncodeOptions::DEFAULT.with_prediction(ExactPrediction::TraversalStatic)
+        }
         _ => EncodeOptions::DEFAULT,
     };
     // PROFILE_REUSE=1: one set of buffers for every encode and every decode.
@@ -68,6 +71,7 @@ fn main() {
         }
     }
     let e = e.unwrap();
+    eprintln!("stream: {} bytes", e.bytes.len());
     let mut buffers = DecodeBuffers::new();
     for _ in 0..decodes {
         let t = Instant::now();

@@ -188,7 +188,7 @@ pub fn decode_container_reusing(
                 None => ExactPrediction::Degree,
                 Some(code) => ExactPrediction::from_code(code).ok_or_else(|| {
                     Error::Corrupt(format!(
-                        "unknown exact prediction {code} (this whet reads 0 and 1; a newer whet may \
+                        "unknown exact prediction {code} (this whet reads 0, 1 and 2; a newer whet may \
                          have written it)"
                     ))
                 })?,

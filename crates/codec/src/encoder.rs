@@ -8,6 +8,7 @@ use whet_mesh::{morton_spread, ManifoldRepair, Mesh, Scratch};
 
 /// The format version of header field `exact_prediction`.
 const VERSION_1_5: Version = Version::new(1, 5);
+const VERSION_1_6: Version = Version::new(1, 6);
 
 /// Options of [`Encoder`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -229,8 +230,15 @@ impl Encoder {
         if prediction != ExactPrediction::Degree {
             // A reader before format 1.5 refuses the field by tag instead of misreading the
             // geometry.
-            if header.version < VERSION_1_5 {
-                header = header.with_version(VERSION_1_5);
+            // (Value 2, the static residual code, is format 1.6: a 1.5 reader refuses the
+            // value as an unknown prediction.)
+            let needed = if prediction == ExactPrediction::TraversalStatic {
+                VERSION_1_6
+            } else {
+                VERSION_1_5
+            };
+            if header.version < needed {
+                header = header.with_version(needed);
             }
             header = header.with(tag::EXACT_PREDICTION, prediction.code());
         }

@@ -370,6 +370,95 @@ impl ResidualIo for ResidualReader<'_, '_> {
     }
 }
 
+/// Contexts of the static residual code: the traversal's two classes (a gate fallback, one
+/// parallelogram) x axis x previous axis's bucket, then the start triangles' three axes.
+const STATIC_CONTEXTS: usize = 2 * 3 * PREV_BUCKETS + 3;
+
+/// The static code's context of a residual (see [`STATIC_CONTEXTS`]).
+#[inline(always)]
+fn static_context(class: Option<usize>, axis: usize, prev: usize) -> usize {
+    match class {
+        Some(cl) => (cl.min(1) * 3 + axis) * PREV_BUCKETS + prev,
+        None => 2 * 3 * PREV_BUCKETS + axis,
+    }
+}
+
+/// Writes residuals to a static residual code ([`ExactPrediction::TraversalStatic`]); the
+/// traversal order never selects, so [`ResidualIo::select`] takes every candidate.
+pub(crate) struct StaticResidualWriter {
+    pub enc: whet_bits::StaticResidualEncoder,
+}
+
+impl ResidualIo for StaticResidualWriter {
+    fn select(&mut self, _: &mut PositionModels, cands: &[[i64; 3]], _: &[i32; 3]) -> u32 {
+        (1u32 << cands.len()) - 1
+    }
+    fn raw(&mut self, bits: u32, q: &mut [i32; 3]) {
+        for c in q.iter() {
+            self.enc.encode_raw(bits, *c as u32);
+        }
+    }
+    #[inline(always)]
+    fn residual(
+        &mut self,
+        _: &mut PositionModels,
+        class: Option<usize>,
+        prediction: [i32; 3],
+        q: &mut [i32; 3],
+    ) {
+        let mut prev = 0usize;
+        for axis in 0..3 {
+            let r = q[axis].wrapping_sub(prediction[axis]);
+            self.enc.encode(static_context(class, axis, prev), axis, r);
+            prev = bucket(r);
+        }
+    }
+}
+
+/// Reads residuals from a static residual code.
+pub(crate) struct StaticResidualReader<'a> {
+    pub dec: whet_bits::StaticResidualDecoder<'a>,
+    /// Largest valid grid coordinate.
+    pub max_level: i32,
+    /// Set when a decoded coordinate left the grid: the stream is corrupt, stop early.
+    pub invalid: bool,
+}
+
+impl ResidualIo for StaticResidualReader<'_> {
+    fn exhausted(&self) -> bool {
+        self.invalid || self.dec.overran()
+    }
+    fn select(&mut self, _: &mut PositionModels, cands: &[[i64; 3]], _: &[i32; 3]) -> u32 {
+        (1u32 << cands.len()) - 1
+    }
+    fn raw(&mut self, bits: u32, q: &mut [i32; 3]) {
+        for c in q.iter_mut() {
+            *c = self.dec.decode_raw(bits) as i32;
+            self.invalid |= outside_grid(*c, self.max_level);
+        }
+    }
+    #[inline(always)]
+    fn residual(
+        &mut self,
+        _: &mut PositionModels,
+        class: Option<usize>,
+        prediction: [i32; 3],
+        q: &mut [i32; 3],
+    ) {
+        let mut prev = 0usize;
+        for axis in 0..3 {
+            // The next context from the symbol's bit length (the same as `bucket(r)`), not
+            // from `r`, which waits for the raw bits.
+            let (r, length) = self
+                .dec
+                .decode_with_length(static_context(class, axis, prev), axis);
+            q[axis] = prediction[axis].wrapping_add(r);
+            self.invalid |= outside_grid(q[axis], self.max_level);
+            prev = (length as usize).min(PREV_BUCKETS - 1);
+        }
+    }
+}
+
 /// Per position `j` of a corner in its triangle, `(j, next)` and `(j, prev)`: the corner
 /// after corner `c` is `c - j + next`, the one before `c - j + prev`.
 const AFTER_BEFORE_CORNER: [((usize, usize), (usize, usize)); 3] =
@@ -905,6 +994,12 @@ pub enum ExactPrediction {
     /// more bytes on most meshes and up to about 50 % on blocky CAD parts (one parallelogram
     /// across a crease predicts badly). Format 1.5.
     Traversal,
+    /// The traversal order and prediction of [`ExactPrediction::Traversal`], its residuals
+    /// coded with one static frequency table per context for the whole stream and two
+    /// interleaved rANS states, one per axis ([`whet_bits::StaticResidualEncoder`]) instead of adaptive
+    /// models: a table lookup per coordinate where the adaptive code searches and updates a
+    /// 32-entry table, for streams that must decode fastest. Format 1.6.
+    TraversalStatic,
 }
 
 impl ExactPrediction {
@@ -913,6 +1008,7 @@ impl ExactPrediction {
         match self {
             ExactPrediction::Degree => 0,
             ExactPrediction::Traversal => 1,
+            ExactPrediction::TraversalStatic => 2,
         }
     }
 
@@ -921,6 +1017,7 @@ impl ExactPrediction {
         match code {
             0 => Some(ExactPrediction::Degree),
             1 => Some(ExactPrediction::Traversal),
+            2 => Some(ExactPrediction::TraversalStatic),
             _ => None,
         }
     }
@@ -1050,6 +1147,16 @@ fn encode_exact_with(
             scratch.give(states);
             (sink.finish(), None)
         }
+        ExactPrediction::TraversalStatic => {
+            let mut io = StaticResidualWriter {
+                enc: whet_bits::StaticResidualEncoder::new(STATIC_CONTEXTS),
+            };
+            let states = scratch.take_empty(conn.table.vertex_count());
+            let states = code_positions_traversal(&conn, bits, &mut q, &mut io, states)
+                .map_err(whet_edgebreaker::Error::from)?;
+            scratch.give(states);
+            (io.enc.finish(), None)
+        }
     };
     scratch.give(q);
     let components = conn.starts.len();
@@ -1114,6 +1221,15 @@ pub(crate) struct ExactBuffers {
     pub positions: Vec<whet_mesh::DVec3>,
 }
 
+/// The decoder's error for a static residual code that failed its checks.
+fn geometry_error(e: &whet_bits::Error) -> crate::Error {
+    match e {
+        whet_bits::Error::Truncated => crate::Error::Truncated("geometry"),
+        whet_bits::Error::Corrupt(what) => crate::Error::Corrupt(format!("geometry: {what}")),
+        other => crate::Error::Corrupt(format!("geometry: {other}")),
+    }
+}
+
 pub(crate) fn decode_exact(
     connectivity: &[u8],
     geometry: &[u8],
@@ -1137,36 +1253,57 @@ pub(crate) fn decode_exact(
     // it is known (decoded in this decode), so only new entries need a value.
     let mut q = std::mem::take(&mut buffers.grid);
     q.resize(nv, [0; 3]);
-    let mut dec = RangeDecoder::new(geometry).map_err(|_| crate::Error::Truncated("geometry"))?;
-    // The degree order's payload opens with its strategy bit; the traversal order has none.
-    let constrained = prediction == ExactPrediction::Degree && dec.decode_direct(1) == 1;
-    let mut io = ResidualReader {
-        dec: &mut dec,
-        constrained,
-        max_level: quantizer.max_level(),
-        invalid: false,
-    };
     // Per vertex, whether it was decoded: the degree walk's flags, or the traversal's
-    // states (kept for the next decode).
-    let (known, states) = match prediction {
-        ExactPrediction::Degree => (
-            code_positions(&conn, quantizer.bits, &mut q, &mut io)
-                .map_err(whet_edgebreaker::Error::from)?,
-            None,
-        ),
-        ExactPrediction::Traversal => {
-            let states = std::mem::take(&mut buffers.states);
-            let states = code_positions_traversal(&conn, quantizer.bits, &mut q, &mut io, states)
-                .map_err(whet_edgebreaker::Error::from)?;
-            (Vec::new(), Some(states))
+    // states (kept for the next decode); and whether a coordinate left the grid (every one
+    // the readers decode is checked as it is written, so below only each real vertex's
+    // state is).
+    let (known, states, off_grid) = if prediction == ExactPrediction::TraversalStatic {
+        let dec = whet_bits::StaticResidualDecoder::new(geometry, STATIC_CONTEXTS)
+            .map_err(|e| geometry_error(&e))?;
+        let mut io = StaticResidualReader {
+            dec,
+            max_level: quantizer.max_level(),
+            invalid: false,
+        };
+        let states = std::mem::take(&mut buffers.states);
+        let states = code_positions_traversal(&conn, quantizer.bits, &mut q, &mut io, states)
+            .map_err(whet_edgebreaker::Error::from)?;
+        if !io.invalid {
+            io.dec.finish().map_err(|e| geometry_error(&e))?;
         }
+        (Vec::new(), Some(states), io.invalid)
+    } else {
+        let mut dec =
+            RangeDecoder::new(geometry).map_err(|_| crate::Error::Truncated("geometry"))?;
+        // The degree order's payload opens with its strategy bit; the traversal order has
+        // none.
+        let constrained = prediction == ExactPrediction::Degree && dec.decode_direct(1) == 1;
+        let mut io = ResidualReader {
+            dec: &mut dec,
+            constrained,
+            max_level: quantizer.max_level(),
+            invalid: false,
+        };
+        let (known, states) = match prediction {
+            ExactPrediction::Degree => (
+                code_positions(&conn, quantizer.bits, &mut q, &mut io)
+                    .map_err(whet_edgebreaker::Error::from)?,
+                None,
+            ),
+            _ => {
+                let states = std::mem::take(&mut buffers.states);
+                let states =
+                    code_positions_traversal(&conn, quantizer.bits, &mut q, &mut io, states)
+                        .map_err(whet_edgebreaker::Error::from)?;
+                (Vec::new(), Some(states))
+            }
+        };
+        let off_grid = io.invalid;
+        if dec.finish().is_err() {
+            return Err(crate::Error::Truncated("geometry"));
+        }
+        (known, states, off_grid)
     };
-    // Every coordinate the reader decoded was checked against the grid as it was written
-    // (`ResidualReader::invalid`), so below only each real vertex's state is.
-    let off_grid = io.invalid;
-    if dec.finish().is_err() {
-        return Err(crate::Error::Truncated("geometry"));
-    }
     // decode_connectivity numbers the vertices in traversal order, the real ones first: the
     // output is ids 0..real in order, and the triangles that touch no dummy.
     let real = conn.is_dummy.iter().position(|&d| d).unwrap_or(nv);

@@ -60,11 +60,12 @@ pub fn fuzz_exact_payloads(data: &[u8]) {
         triangles: 0,
         clers_histogram: [0; 5],
     };
-    // Both geometry orders read the same bytes: the traversal order's payload has no
-    // strategy bit, so each input reaches both decoders.
+    // Every geometry order reads the same bytes (the traversal orders' payloads have no
+    // strategy bit), so each input reaches every decoder.
     for prediction in [
         crate::ExactPrediction::Degree,
         crate::ExactPrediction::Traversal,
+        crate::ExactPrediction::TraversalStatic,
     ] {
         let fresh = crate::decode_exact_payloads(&p, prediction);
         if let Ok(mesh) = &fresh {

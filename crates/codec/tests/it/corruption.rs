@@ -20,11 +20,12 @@ fn sample_stream_with(prediction: whet_codec::ExactPrediction) -> Vec<u8> {
     encode(&m, &opts).unwrap().bytes
 }
 
-/// Streams of both exact predictions.
-fn sample_streams() -> [Vec<u8>; 2] {
+/// Streams of every exact prediction.
+fn sample_streams() -> [Vec<u8>; 3] {
     [
         sample_stream(),
         sample_stream_with(whet_codec::ExactPrediction::Traversal),
+        sample_stream_with(whet_codec::ExactPrediction::TraversalStatic),
     ]
 }
 
@@ -164,12 +165,26 @@ fn the_exact_prediction_field_is_written_read_and_refused_when_unknown() {
         decode(&d, &DecodeOptions::DEFAULT).unwrap(),
     );
     assert_eq!(mt, md);
+    // The static residual code: value 2, format 1.6, the same mesh again; its payload read
+    // as the adaptive traversal code's is refused or another mesh.
+    let static_opts = EncodeOptions::DEFAULT.with_prediction(ExactPrediction::TraversalStatic);
+    let st = encode(&m, &static_opts).unwrap().bytes;
+    let cs = parse(&st, &Limits::DEFAULT).unwrap();
+    assert_eq!(cs.header.get_u64(tag::EXACT_PREDICTION), Some(2));
+    assert_eq!(cs.header.version, whet_codec::Version::new(1, 6));
+    assert_eq!(decode(&st, &DecodeOptions::DEFAULT).unwrap(), mt);
+    let mut c = cs.clone();
+    c.header.set(tag::EXACT_PREDICTION, 1u64);
+    match decode(&c.to_bytes().unwrap(), &DecodeOptions::DEFAULT) {
+        Ok(other) => assert_ne!(other, mt),
+        Err(e) => assert!(e.is_input_error(), "{e}"),
+    }
     // An unknown value, with valid CRCs.
     let mut c = ct.clone();
-    c.header.set(tag::EXACT_PREDICTION, 2u64);
+    c.header.set(tag::EXACT_PREDICTION, 3u64);
     let e = decode(&c.to_bytes().unwrap(), &DecodeOptions::DEFAULT).unwrap_err();
     assert!(e.is_input_error(), "{e}");
-    assert!(e.to_string().contains("exact prediction 2"), "{e}");
+    assert!(e.to_string().contains("exact prediction 3"), "{e}");
     // Without the field the traversal payload is read as the degree order's: refused or a
     // different mesh, never the same one (the field is what keeps old readers out).
     let mut c = ct;

@@ -14,10 +14,11 @@ fn canonical(t: [u32; 3]) -> [u32; 3] {
     [t[r], t[(r + 1) % 3], t[(r + 2) % 3]]
 }
 
-/// Checks a decoded mesh against its source through the report's vertex order, for both
-/// exact-mode predictions; returns the default (degree order) stream.
+/// Checks a decoded mesh against its source through the report's vertex order, for every
+/// exact-mode prediction; returns the default (degree order) stream.
 pub fn check_round_trip(mesh: &Mesh, bits: u32) -> Vec<u8> {
     check_round_trip_with(mesh, bits, ExactPrediction::Traversal);
+    check_round_trip_with(mesh, bits, ExactPrediction::TraversalStatic);
     check_round_trip_with(mesh, bits, ExactPrediction::Degree)
 }
 
@@ -84,7 +85,11 @@ fn reused_buffers_decode_what_decode_decodes() {
     let mut buffers = DecodeBuffers::new();
     for round in 0..2 {
         for (i, mesh) in meshes.iter().enumerate() {
-            for prediction in [ExactPrediction::Traversal, ExactPrediction::Degree] {
+            for prediction in [
+                ExactPrediction::Traversal,
+                ExactPrediction::TraversalStatic,
+                ExactPrediction::Degree,
+            ] {
                 let opts = EncodeOptions::DEFAULT
                     .with_quant_bits(10 + i as u32)
                     .with_prediction(prediction);
@@ -146,7 +151,11 @@ fn reused_encoder_buffers_encode_what_encode_encodes() {
         Mesh::default(),
         torus(6, 5),
     ];
-    for prediction in [ExactPrediction::Traversal, ExactPrediction::Degree] {
+    for prediction in [
+        ExactPrediction::Traversal,
+        ExactPrediction::TraversalStatic,
+        ExactPrediction::Degree,
+    ] {
         let mut buffers = EncodeBuffers::new();
         for round in 0..2 {
             for (i, mesh) in meshes.iter().enumerate() {
@@ -178,7 +187,11 @@ fn one_triangle_and_empty() {
     let one = Mesh::new(vec![DVec3::ZERO, DVec3::X, DVec3::Y], vec![[0, 1, 2]]);
     check_round_trip(&one, 10);
     let empty = Mesh::default();
-    for prediction in [ExactPrediction::Degree, ExactPrediction::Traversal] {
+    for prediction in [
+        ExactPrediction::Degree,
+        ExactPrediction::Traversal,
+        ExactPrediction::TraversalStatic,
+    ] {
         let opts = EncodeOptions::DEFAULT.with_prediction(prediction);
         let enc = encode(&empty, &opts).unwrap();
         let dec = decode(&enc.bytes, &DecodeOptions::DEFAULT).unwrap();
@@ -389,7 +402,11 @@ fn read_and_streaming_decoders_agree_for_any_chunking() {
         &union(torus(9, 5), &punch(&icosphere(2), |i| i % 13 == 0), 4.0),
         9,
     );
-    for prediction in [ExactPrediction::Degree, ExactPrediction::Traversal] {
+    for prediction in [
+        ExactPrediction::Degree,
+        ExactPrediction::Traversal,
+        ExactPrediction::TraversalStatic,
+    ] {
         let opts = EncodeOptions::DEFAULT.with_prediction(prediction);
         let enc = encode(&m, &opts).unwrap();
         let whole = decode(&enc.bytes, &DecodeOptions::DEFAULT).unwrap();
