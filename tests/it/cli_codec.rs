@@ -79,9 +79,10 @@ fn the_traversal_prediction_round_trips_and_is_reported() {
     assert!(bt > bd && bt * 3 < bd * 4, "{bd} {bt}");
     let info = whet_json(&["info", s(&trav), "--json"]);
     assert_eq!(info["triangles"], 12946);
-    // The static residual code: the traversal's residuals, their tables sent once. On this
-    // 6.5k-vertex part its tables and the static statistics cost 5.3 % over the adaptive
-    // code (14,322 -> 15,082 bytes when added, 2026-12-06); held within 8 %.
+    // The static codes: the traversal's residuals and labels, their tables sent once. On
+    // this 6.5k-vertex part the tables and the static statistics cost 6.2 % over the
+    // adaptive codes (14,322 -> 15,205 bytes, labels 831 -> 954 bytes, when added,
+    // 2026-12-06); held within 8 % and 25 %.
     let stat = dir.join("s.whet");
     let js = whet_json(&[
         "encode",
@@ -95,7 +96,11 @@ fn the_traversal_prediction_round_trips_and_is_reported() {
         "--json",
     ]);
     assert_eq!(js["prediction"], "traversal-static");
-    assert_eq!(js["connectivity_bits"], jd["connectivity_bits"]);
+    let (cd, cs) = (
+        jd["connectivity_bits"].as_u64().unwrap(),
+        js["connectivity_bits"].as_u64().unwrap(),
+    );
+    assert!(cs * 100 < cd * 125, "{cd} {cs}");
     let bs = js["bytes"].as_u64().unwrap();
     assert!(bs * 100 < bt * 108, "{bt} {bs}");
     let (od, ot, os) = (dir.join("d.off"), dir.join("t.off"), dir.join("s.off"));

@@ -10,6 +10,8 @@
 //! below the leading one; the `L - 2` bits below `h` and then (for `z != 0`) the sign go to a
 //! separate raw-bit stream, least significant bit first, as one field (sign in its lowest
 //! bit). Symbols are entropy coded in the caller's context (below [`MAX_STATIC_CONTEXTS`]).
+//! A caller with an alphabet of its own (up to 64 symbols, no raw bits) codes its symbols
+//! directly ([`StaticResidualEncoder::encode_symbol`]).
 //!
 //! Layout of [`StaticResidualEncoder::finish`]'s bytes (docs/format.md, "Static residual
 //! code"): the context mask (varint: bit `k` set when context `k` has a table); per present
@@ -198,6 +200,18 @@ impl StaticResidualEncoder {
             let mantissa = u64::from(z) & ((1u64 << extra) - 1);
             self.raw.push(extra + 1, mantissa << 1 | u64::from(r < 0));
         }
+    }
+
+    /// Codes a symbol (below [`STATIC_SYMBOLS`]; taken modulo it) in `context` on `lane`,
+    /// with no raw bits: for alphabets of their own (the decoder reads it with
+    /// [`StaticResidualDecoder::decode_symbol`]).
+    #[inline]
+    pub fn encode_symbol(&mut self, context: usize, lane: usize, symbol: usize) {
+        let context = context.min(self.contexts - 1);
+        let s = symbol % STATIC_SYMBOLS;
+        self.items
+            .push((context as u16) << 8 | ((lane % STATIC_LANES) as u16) << 6 | s as u16);
+        self.counts[context][s] += 1;
     }
 
     /// Appends a raw field of `bits` bits (at most 32) to the raw-bit stream.
@@ -427,17 +441,23 @@ impl<'a> StaticResidualDecoder<'a> {
         self.decode_with_length(context, lane).0
     }
 
-    /// [`StaticResidualDecoder::decode`], with the bit length of the residual's magnitude
-    /// (0 for 0), known from the symbol before its raw bits are read: a caller whose next
-    /// context depends on it need not wait for them.
+    /// The next symbol coded by [`StaticResidualEncoder::encode_symbol`] in `context` on
+    /// `lane` (as [`StaticResidualDecoder::decode`] for a context past the decoder's count).
     #[inline(always)]
-    pub fn decode_with_length(&mut self, context: usize, lane: usize) -> (i32, u32) {
+    pub fn decode_symbol(&mut self, context: usize, lane: usize) -> usize {
         let context = context % MAX_STATIC_CONTEXTS;
         let lane = lane % STATIC_LANES;
         let x = self.states[lane];
         let slot = x & SLOT_MASK;
         let s = usize::from(self.slots[context][slot as usize]) % STATIC_SYMBOLS;
-        let fc = self.fc[context][s];
+        self.states[lane] = self.advance(x, self.fc[context][s], slot);
+        s
+    }
+
+    /// The state after decoding the symbol of `fc` (`frequency << 16 | cumulative`) at
+    /// `slot` of state `x`, renormalised.
+    #[inline(always)]
+    fn advance(&mut self, x: u32, fc: u32, slot: u32) -> u32 {
         let mut x = (fc >> 16) * (x >> STATIC_PREC) + slot - (fc & 0xFFFF);
         if x < LOWER {
             let w = match self.words.get(self.word_pos..self.word_pos + 2) {
@@ -450,6 +470,20 @@ impl<'a> StaticResidualDecoder<'a> {
             self.word_pos += 2;
             x = x << 16 | w;
         }
+        x
+    }
+
+    /// [`StaticResidualDecoder::decode`], with the bit length of the residual's magnitude
+    /// (0 for 0), known from the symbol before its raw bits are read: a caller whose next
+    /// context depends on it need not wait for them.
+    #[inline(always)]
+    pub fn decode_with_length(&mut self, context: usize, lane: usize) -> (i32, u32) {
+        let context = context % MAX_STATIC_CONTEXTS;
+        let lane = lane % STATIC_LANES;
+        let x = self.states[lane];
+        let slot = x & SLOT_MASK;
+        let s = usize::from(self.slots[context][slot as usize]) % STATIC_SYMBOLS;
+        let x = self.advance(x, self.fc[context][s], slot);
         self.states[lane] = x;
         let length = SYMBOL_LENGTH[s];
         if s == 0 {
@@ -601,6 +635,26 @@ mod tests {
                 let _ = dec.finish();
             }
         }
+    }
+
+    #[test]
+    fn symbols_of_their_own_alphabet_round_trip_between_residuals() {
+        let mut enc = StaticResidualEncoder::new(4);
+        for i in 0..5000usize {
+            enc.encode_symbol(i % 3, 0, (i * i) % 5);
+            if i % 7 == 0 {
+                enc.encode(3, 1, i as i32 - 2500);
+            }
+        }
+        let bytes = enc.finish();
+        let mut dec = StaticResidualDecoder::new(&bytes, 4).unwrap();
+        for i in 0..5000usize {
+            assert_eq!(dec.decode_symbol(i % 3, 0), (i * i) % 5);
+            if i % 7 == 0 {
+                assert_eq!(dec.decode(3, 1), i as i32 - 2500);
+            }
+        }
+        dec.finish().unwrap();
     }
 
     proptest! {

@@ -1,8 +1,9 @@
 //! Exact-mode encode and decode throughput on a ~1M-triangle mesh (issue target: decode at
-//! 20 M triangles/s, encode at 5 M triangles/s on one core), with the default prediction
-//! and with the traversal prediction (`*_traversal`); `*_reusing` encodes with one set of
-//! [`EncodeBuffers`] or decodes with one set of [`DecodeBuffers`] throughout, as a server
-//! coding mesh after mesh would.
+//! 20 M triangles/s, encode at 5 M triangles/s on one core), with the default prediction,
+//! the traversal prediction (`*_traversal`) and the traversal prediction with the static
+//! codes (`*_traversal_static`); `*_reusing` encodes with one set of [`EncodeBuffers`] or
+//! decodes with one set of [`DecodeBuffers`] throughout, as a server coding mesh after mesh
+//! would.
 #![allow(clippy::unwrap_used)] // benches may panic on their own setup
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
@@ -41,6 +42,19 @@ fn bench(c: &mut Criterion) {
     g.bench_function("decode_1.3M_traversal", |b| {
         b.iter(|| black_box(decode(&enc_fast.bytes, &DecodeOptions::DEFAULT).unwrap()))
     });
+    // The traversal order with the static residual and label codes.
+    let fastest = opts.with_prediction(ExactPrediction::TraversalStatic);
+    let enc_fastest = encode(&mesh, &fastest).unwrap();
+    eprintln!(
+        "traversal prediction, static codes: {} bytes",
+        enc_fastest.bytes.len()
+    );
+    g.bench_function("encode_1.3M_traversal_static", |b| {
+        b.iter(|| black_box(encode(&mesh, &fastest).unwrap()))
+    });
+    g.bench_function("decode_1.3M_traversal_static", |b| {
+        b.iter(|| black_box(decode(&enc_fastest.bytes, &DecodeOptions::DEFAULT).unwrap()))
+    });
     // An encoder that encodes one mesh after another keeps its buffers
     // (`Encoder::encode_reusing`), as a decoder that decodes one stream after another keeps
     // its own and gives each mesh back when done with it (`decode_reusing`): no fresh
@@ -48,6 +62,7 @@ fn bench(c: &mut Criterion) {
     for (name, o) in [
         ("encode_1.3M_reusing", opts),
         ("encode_1.3M_traversal_reusing", fast),
+        ("encode_1.3M_traversal_static_reusing", fastest),
     ] {
         let encoder = Encoder::new(o);
         let mut buffers = EncodeBuffers::new();
@@ -58,6 +73,7 @@ fn bench(c: &mut Criterion) {
     for (name, bytes) in [
         ("decode_1.3M_reusing", &enc.bytes),
         ("decode_1.3M_traversal_reusing", &enc_fast.bytes),
+        ("decode_1.3M_traversal_static_reusing", &enc_fastest.bytes),
     ] {
         let mut buffers = DecodeBuffers::new();
         g.bench_function(name, |b| {

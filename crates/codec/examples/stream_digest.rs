@@ -39,6 +39,7 @@ fn main() {
     for (prediction, label) in [
         (ExactPrediction::Degree, ""),
         (ExactPrediction::Traversal, " traversal"),
+        (ExactPrediction::TraversalStatic, " traversal-static"),
     ] {
         print_streams(&meshes, prediction, label);
     }

@@ -995,10 +995,12 @@ pub enum ExactPrediction {
     /// across a crease predicts badly). Format 1.5.
     Traversal,
     /// The traversal order and prediction of [`ExactPrediction::Traversal`], its residuals
-    /// coded with one static frequency table per context for the whole stream and two
-    /// interleaved rANS states, one per axis ([`whet_bits::StaticResidualEncoder`]) instead of adaptive
-    /// models: a table lookup per coordinate where the adaptive code searches and updates a
-    /// 32-entry table, for streams that must decode fastest. Format 1.6.
+    /// coded with one static frequency table per context for the whole stream and four
+    /// interleaved rANS states, one per axis ([`whet_bits::StaticResidualEncoder`]) instead
+    /// of adaptive models, and the connectivity's labels likewise
+    /// ([`whet_edgebreaker::LabelCode::Static`]): a table lookup per coordinate and per label
+    /// where the adaptive codes search and update their models, for streams that must decode
+    /// fastest. Format 1.6.
     TraversalStatic,
 }
 
@@ -1009,6 +1011,15 @@ impl ExactPrediction {
             ExactPrediction::Degree => 0,
             ExactPrediction::Traversal => 1,
             ExactPrediction::TraversalStatic => 2,
+        }
+    }
+
+    /// How the connectivity payload of a stream with this prediction codes its labels: the
+    /// static code with the static residual code.
+    pub const fn label_code(self) -> whet_edgebreaker::LabelCode {
+        match self {
+            ExactPrediction::TraversalStatic => whet_edgebreaker::LabelCode::Static,
+            _ => whet_edgebreaker::LabelCode::Adaptive,
         }
     }
 
@@ -1080,10 +1091,11 @@ fn encode_exact_with(
         ));
     }
     let quantizer = crate::Quantizer::new(bbox, bits);
-    let mut enc = whet_edgebreaker::encode_connectivity_with_table_in(
+    let mut enc = whet_edgebreaker::encode_connectivity_coded_in(
         table,
         &mesh.triangles,
         mesh.positions.len(),
+        prediction.label_code(),
         scratch,
     )?;
     let clers_histogram = enc.histogram();
@@ -1238,9 +1250,10 @@ pub(crate) fn decode_exact(
     prediction: ExactPrediction,
     buffers: &mut ExactBuffers,
 ) -> Result<whet_mesh::Mesh, crate::Error> {
-    let (conn, used) = whet_edgebreaker::decode_connectivity_reusing(
+    let (conn, used) = whet_edgebreaker::decode_connectivity_coded(
         connectivity,
         limits,
+        prediction.label_code(),
         &mut buffers.connectivity,
     )?;
     if used != connectivity.len() {

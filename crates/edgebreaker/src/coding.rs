@@ -9,6 +9,11 @@
 //! | split events, by increasing source | range coded: source delta, `source - split`, right bit |
 //! | dummy vertex positions in traversal order, increasing | range coded deltas |
 //! | labels in decoding order (last first), the forced first E omitted | range coded, context = remaining valence (6) x previous decoded label (5) |
+//!
+//! With [`LabelCode::Static`] the labels (same order, same contexts) are one static code
+//! (whet-bits `StaticResidualEncoder::encode_symbol`, context `valence · 5 + previous`, one
+//! state) between the four counts and the side information: its length as a varint, then its
+//! bytes; the range-coded part then holds the split events and dummies alone.
 
 use crate::holes::close_holes;
 use crate::reverse_decoder::{ReverseBuffers, ReverseDecoder, VALENCE_CONTEXTS};
@@ -39,6 +44,83 @@ impl LabelModels {
         // valence_ctx < VALENCE_CONTEXTS and prev < 5, so the index is in range (a modulo
         // here was a division on the chain from one label to the next).
         &mut self.models[valence_ctx * 5 + prev as usize]
+    }
+}
+
+/// How a connectivity payload codes its labels.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum LabelCode {
+    /// Adaptive models per (remaining valence, previous label) context, range coded after
+    /// the side information (the layout in the module docs).
+    #[default]
+    Adaptive,
+    /// One static frequency table per context of the adaptive code, for the whole payload
+    /// (`whet_bits::StaticResidualEncoder::encode_symbol`): after the four counts, the
+    /// static stream's length (varint) and the stream, then the range-coded side
+    /// information alone. A table lookup per label where the adaptive code searches and
+    /// updates its model: for streams that must decode fastest.
+    Static,
+}
+
+/// Contexts of the static label code: remaining valence x previous label.
+const STATIC_LABEL_CONTEXTS: usize = VALENCE_CONTEXTS * 5;
+
+/// Where a label goes: the adaptive models on a range-coder sink, or a static code.
+trait LabelSink {
+    fn label(&mut self, context: usize, prev: Clers, sym: Clers);
+}
+
+/// The adaptive label code on any bit sink (the range encoder, or a cost counter).
+struct AdaptiveLabels<'a, S: BitSink> {
+    sink: &'a mut S,
+    models: LabelModels,
+}
+
+impl<S: BitSink> LabelSink for AdaptiveLabels<'_, S> {
+    #[inline]
+    fn label(&mut self, context: usize, prev: Clers, sym: Clers) {
+        self.sink
+            .encode_symbol(self.models.get(context, prev), sym as usize);
+    }
+}
+
+impl LabelSink for whet_bits::StaticResidualEncoder {
+    #[inline]
+    fn label(&mut self, context: usize, prev: Clers, sym: Clers) {
+        self.encode_symbol(context * 5 + prev as usize, 0, sym as usize);
+    }
+}
+
+/// Where labels come from when decoding: the adaptive models on a range decoder, or a
+/// static code.
+trait LabelSource {
+    fn label(&mut self, context: usize, prev: Clers) -> usize;
+    fn overran(&self) -> bool;
+}
+
+struct AdaptiveLabelSource<'a, 'b> {
+    dec: &'a mut RangeDecoder<'b>,
+    models: LabelModels,
+}
+
+impl LabelSource for AdaptiveLabelSource<'_, '_> {
+    #[inline(always)]
+    fn label(&mut self, context: usize, prev: Clers) -> usize {
+        self.dec.decode_symbol(self.models.get(context, prev))
+    }
+    fn overran(&self) -> bool {
+        self.dec.overran()
+    }
+}
+
+impl LabelSource for whet_bits::StaticResidualDecoder<'_> {
+    #[inline(always)]
+    fn label(&mut self, context: usize, prev: Clers) -> usize {
+        self.decode_symbol(context * 5 + prev as usize, 0)
+    }
+    fn overran(&self) -> bool {
+        whet_bits::StaticResidualDecoder::overran(self)
     }
 }
 
@@ -431,7 +513,7 @@ fn read_varint(bytes: &[u8], pos: &mut usize) -> Result<u64, Error> {
 
 /// Codes the labels in decoding order with their contexts, on any sink (the range encoder,
 /// or a cost counter to measure).
-fn code_labels<S: BitSink>(
+fn code_labels<S: LabelSink>(
     sink: &mut S,
     labels: &[Clers],
     splits: &[SplitEvent],
@@ -456,12 +538,11 @@ fn code_labels<S: BitSink>(
     coded
 }
 
-fn code_labels_with<S: BitSink>(
+fn code_labels_with<S: LabelSink>(
     sink: &mut S,
     labels: &[Clers],
     dec: &mut ReverseDecoder,
 ) -> Result<(), Error> {
-    let mut models = LabelModels::new();
     let mut prev = Clers::E;
     for &sym in labels.iter().rev() {
         let gate = dec.gate();
@@ -470,7 +551,7 @@ fn code_labels_with<S: BitSink>(
                 return Err(Error::Corrupt("a component does not end with E"));
             }
             None => {}
-            Some(g) => sink.encode_symbol(models.get(g.context, prev), sym as usize),
+            Some(g) => sink.label(g.context, prev, sym),
         }
         dec.apply(sym, gate)?;
         prev = sym;
@@ -505,6 +586,18 @@ pub fn encode_connectivity_with_table_in(
     open: CornerTable,
     triangles: &[[u32; 3]],
     vertex_count: usize,
+    scratch: &mut Scratch,
+) -> Result<EncodedConnectivity, Error> {
+    encode_connectivity_coded_in(open, triangles, vertex_count, LabelCode::Adaptive, scratch)
+}
+
+/// [`encode_connectivity_with_table_in`] with the labels in `labels`' code (the decoder
+/// must be told the same: [`decode_connectivity_coded`]).
+pub fn encode_connectivity_coded_in(
+    open: CornerTable,
+    triangles: &[[u32; 3]],
+    vertex_count: usize,
+    labels: LabelCode,
     scratch: &mut Scratch,
 ) -> Result<EncodedConnectivity, Error> {
     let has_boundary = open.first_boundary_corner().is_some();
@@ -611,7 +704,22 @@ pub fn encode_connectivity_with_table_in(
             prev_pos = pos as u32;
         }
     }
-    code_labels(&mut enc, &summary.labels, &summary.splits, scratch)?;
+    match labels {
+        LabelCode::Static => {
+            let mut sink = whet_bits::StaticResidualEncoder::new(STATIC_LABEL_CONTEXTS);
+            code_labels(&mut sink, &summary.labels, &summary.splits, scratch)?;
+            let coded = sink.finish();
+            write_varint(&mut bytes, coded.len() as u64);
+            bytes.extend_from_slice(&coded);
+        }
+        _ => {
+            let mut sink = AdaptiveLabels {
+                sink: &mut enc,
+                models: LabelModels::new(),
+            };
+            code_labels(&mut sink, &summary.labels, &summary.splits, scratch)?;
+        }
+    }
     bytes.extend_from_slice(&enc.finish());
     Ok(EncodedConnectivity {
         bytes,
@@ -632,7 +740,11 @@ pub fn encode_connectivity_with_table_in(
 /// Bits the labels alone cost with whet's contexts (measurement for reports and tests).
 pub fn label_bits(labels: &[Clers], splits: &[SplitEvent]) -> Result<f64, Error> {
     let mut counter = CostCounter::new();
-    code_labels(&mut counter, labels, splits, &mut Scratch::new())?;
+    let mut sink = AdaptiveLabels {
+        sink: &mut counter,
+        models: LabelModels::new(),
+    };
+    code_labels(&mut sink, labels, splits, &mut Scratch::new())?;
     Ok(counter.bits())
 }
 
@@ -705,6 +817,46 @@ pub fn decode_connectivity_reusing(
     limits: &ConnectivityLimits,
     buffers: &mut ConnectivityBuffers,
 ) -> Result<(Connectivity, usize), Error> {
+    decode_connectivity_coded(bytes, limits, LabelCode::Adaptive, buffers)
+}
+
+/// Decodes the labels `0..n` in decoding order from `src` into `decoded`, driving `rev`.
+#[inline(always)]
+fn decode_labels<L: LabelSource>(
+    src: &mut L,
+    rev: &mut ReverseDecoder,
+    decoded: &mut Vec<Clers>,
+    n: u32,
+) -> Result<(), Error> {
+    let mut prev = Clers::E;
+    for i in 0..n {
+        let gate = rev.gate();
+        let sym = match gate {
+            // Nothing open: the symbol is a forced E, not coded.
+            None => Clers::E,
+            Some(g) => Clers::from_index(src.label(g.context, prev))
+                .ok_or(Error::Corrupt("label out of range"))?,
+        };
+        rev.apply(sym, gate)?;
+        decoded.push(sym);
+        prev = sym;
+        // A stream cut short decodes zeros forever; stop early rather than building a
+        // huge garbage mesh.
+        if i % 4096 == 0 && src.overran() {
+            return Err(Error::Truncated);
+        }
+    }
+    Ok(())
+}
+
+/// [`decode_connectivity_reusing`] for a payload whose labels are in `labels`' code (what
+/// its encoder was told: [`encode_connectivity_coded_in`]).
+pub fn decode_connectivity_coded(
+    bytes: &[u8],
+    limits: &ConnectivityLimits,
+    labels: LabelCode,
+    buffers: &mut ConnectivityBuffers,
+) -> Result<(Connectivity, usize), Error> {
     let mut pos = 0usize;
     let n = read_varint(bytes, &mut pos)?;
     let k = read_varint(bytes, &mut pos)?;
@@ -725,6 +877,21 @@ pub fn decode_connectivity_reusing(
     if k > n || nsplits > n || ndummies > n || (n > 0 && k == 0) {
         return Err(Error::Corrupt("inconsistent connectivity counts"));
     }
+    // The static label stream comes before the side information.
+    let static_labels = match labels {
+        LabelCode::Static => {
+            let len = read_varint(bytes, &mut pos)?;
+            let end = usize::try_from(len)
+                .ok()
+                .and_then(|l| pos.checked_add(l))
+                .filter(|&e| e <= bytes.len())
+                .ok_or(Error::Truncated)?;
+            let coded = &bytes[pos..end];
+            pos = end;
+            Some(coded)
+        }
+        _ => None,
+    };
     let payload = bytes.get(pos..).ok_or(Error::Truncated)?;
     let mut dec = RangeDecoder::new(payload)?;
     let mut side = SideModels::new();
@@ -772,29 +939,22 @@ pub fn decode_connectivity_reusing(
         (triangles as usize).min(1 << 22),
         std::mem::take(&mut buffers.reverse),
     );
-    let mut models = LabelModels::new();
-    let mut prev = Clers::E;
     // Labels in decoding order (the reverse of the encoder's).
     let mut decoded: Vec<Clers> = std::mem::take(&mut buffers.labels);
     decoded.clear();
     decoded.reserve((n as usize).min(1 << 22));
-    for i in 0..n32 {
-        let gate = rev.gate();
-        let sym = match gate {
-            // Nothing open: the symbol is a forced E, not coded.
-            None => Clers::E,
-            Some(g) => {
-                let s = dec.decode_symbol(models.get(g.context, prev));
-                Clers::from_index(s).ok_or(Error::Corrupt("label out of range"))?
-            }
-        };
-        rev.apply(sym, gate)?;
-        decoded.push(sym);
-        prev = sym;
-        // A stream cut short decodes zeros forever; stop early rather than building a
-        // huge garbage mesh.
-        if i % 4096 == 0 && dec.overran() {
-            return Err(Error::Truncated);
+    match static_labels {
+        Some(coded) => {
+            let mut src = whet_bits::StaticResidualDecoder::new(coded, STATIC_LABEL_CONTEXTS)?;
+            decode_labels(&mut src, &mut rev, &mut decoded, n32)?;
+            src.finish()?;
+        }
+        None => {
+            let mut src = AdaptiveLabelSource {
+                dec: &mut dec,
+                models: LabelModels::new(),
+            };
+            decode_labels(&mut src, &mut rev, &mut decoded, n32)?;
         }
     }
     let consumed = pos + dec.position();

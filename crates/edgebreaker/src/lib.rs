@@ -24,9 +24,10 @@ mod reverse_decoder;
 mod traversal;
 
 pub use coding::{
-    decode_connectivity, decode_connectivity_reusing, encode_connectivity,
-    encode_connectivity_with_table, encode_connectivity_with_table_in, label_bits, Connectivity,
-    ConnectivityBuffers, ConnectivityLimits, EncodedConnectivity,
+    decode_connectivity, decode_connectivity_coded, decode_connectivity_reusing,
+    encode_connectivity, encode_connectivity_coded_in, encode_connectivity_with_table,
+    encode_connectivity_with_table_in, label_bits, Connectivity, ConnectivityBuffers,
+    ConnectivityLimits, EncodedConnectivity, LabelCode,
 };
 pub use holes::close_holes;
 pub use traversal::{

@@ -2,9 +2,25 @@
 
 use crate::*;
 use whet_edgebreaker::{
-    decode_connectivity, encode_connectivity, label_bits, Clers, ConnectivityLimits, Error,
+    decode_connectivity, decode_connectivity_coded, encode_connectivity,
+    encode_connectivity_coded_in, label_bits, Clers, ConnectivityBuffers, ConnectivityLimits,
+    Error, LabelCode,
 };
 use whet_mesh::Mesh;
+
+/// `mesh`'s connectivity with the static label code.
+fn encode_static(mesh: &Mesh) -> whet_edgebreaker::EncodedConnectivity {
+    let table = whet_mesh::CornerTable::from_triangles(&mesh.triangles, mesh.positions.len())
+        .expect("a table");
+    encode_connectivity_coded_in(
+        table,
+        &mesh.triangles,
+        mesh.positions.len(),
+        LabelCode::Static,
+        &mut whet_mesh::Scratch::new(),
+    )
+    .expect("encodes")
+}
 
 fn canonical(t: [u32; 3]) -> [u32; 3] {
     let r = (0..3).min_by_key(|&i| t[i]).unwrap();
@@ -51,6 +67,18 @@ fn round_trip(mesh: &Mesh) -> (f64, [usize; 5]) {
         stepped, traversed,
         "decoder steps differ from the traversal"
     );
+    // The static label code: the same connectivity from its own payload.
+    let stat = encode_static(mesh);
+    let (sdec, sused) = decode_connectivity_coded(
+        &stat.bytes,
+        &ConnectivityLimits::DEFAULT,
+        LabelCode::Static,
+        &mut ConnectivityBuffers::default(),
+    )
+    .expect("the static payload decodes");
+    assert_eq!(sused, stat.bytes.len(), "whole static payload consumed");
+    assert_eq!(sdec.summary, dec.summary);
+    assert_eq!(sdec.output_triangles(), dec.output_triangles());
     let mut want: Vec<[u32; 3]> = enc
         .connectivity
         .output_triangles()
@@ -232,6 +260,24 @@ fn truncated_and_corrupted_streams_fail_cleanly() {
     }
     // Recorded, not asserted to be zero: connectivity alone has no checksum.
     let _ = silently_different;
+    // The static label code likewise: every cut refused, no flip panics.
+    let stat = encode_static(&m).bytes;
+    let decode_static = |b: &[u8]| {
+        decode_connectivity_coded(
+            b,
+            &ConnectivityLimits::DEFAULT,
+            LabelCode::Static,
+            &mut ConnectivityBuffers::default(),
+        )
+    };
+    for cut in 0..stat.len() {
+        assert!(decode_static(&stat[..cut]).is_err(), "static cut at {cut}");
+    }
+    for i in 0..stat.len() * 8 {
+        let mut b = stat.clone();
+        b[i / 8] ^= 1 << (i % 8);
+        let _ = decode_static(&b);
+    }
 }
 
 #[test]
