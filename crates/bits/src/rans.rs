@@ -6,19 +6,19 @@
 //! read, and the chains of residuals on different states (lanes) overlap.
 //!
 //! A residual `r` (`|r| < 2^32`) is split into a symbol and raw bits: with `z = |r|` of bit
-//! length `L`, the symbol is `z` itself for `z < 2`, else `2 + 2 (L - 2) + h`, `h` the bit
-//! below the leading one; the `L - 2` bits below `h` and then (for `z != 0`) the sign go to a
-//! separate raw-bit stream, least significant bit first, as one field (sign in its lowest
-//! bit). Symbols are entropy coded in the caller's context (below [`MAX_STATIC_CONTEXTS`]).
-//! A caller with an alphabet of its own (up to 64 symbols, no raw bits) codes its symbols
-//! directly ([`StaticResidualEncoder::encode_symbol`]).
+//! length `L`, the symbol is `z` itself for `z < 8`, else `8 + 4 (L - 4) + h`, `h` the two
+//! bits below the leading one (128 symbols); the `L - 3` bits below `h` and then (for
+//! `z != 0`) the sign go to a separate raw-bit stream, least significant bit first, as one
+//! field (sign in its lowest bit). Symbols are entropy coded in the caller's context (below
+//! [`MAX_STATIC_CONTEXTS`]). A caller with an alphabet of its own (up to 128 symbols, no raw
+//! bits) codes its symbols directly ([`StaticResidualEncoder::encode_symbol`]).
 //!
-//! Layout of [`StaticResidualEncoder::finish`]'s bytes (docs/format.md, "Static residual
-//! code"): the context mask (varint: bit `k` set when context `k` has a table); per present
-//! context, in order, the symbol count `n` (varint, 1..=64) and `n` frequencies (varints,
-//! summing to exactly `2^12`); the two final rANS states (u32 little endian each, state 0
-//! first, [`STATIC_LANES`] of them); the count of 16-bit words (varint) and the words (little endian), in the order
-//! the decoder reads them; then the raw-bit stream to the end.
+//! Layout of [`StaticResidualEncoder::finish`]'s bytes (docs/format.md, "Exact geometry
+//! payload"): the context mask (varint: bit `k` set when context `k` has a table); per
+//! present context, in order, the symbol count `n` (varint, 1..=128) and `n` frequencies
+//! (varints, summing to exactly `2^12`); the [`STATIC_LANES`] final rANS states (u32 little
+//! endian each, state 0 first); the count of 16-bit words (varint) and the words (little
+//! endian), in the order the decoder reads them; then the raw-bit stream to the end.
 
 use crate::Error;
 
@@ -26,8 +26,13 @@ use crate::Error;
 pub const STATIC_PREC: u32 = 12;
 const TOTAL: u32 = 1 << STATIC_PREC;
 const SLOT_MASK: u32 = TOTAL - 1;
-/// Symbols of the residual alphabet (bit lengths up to 32, two sub-buckets from length 2).
-pub const STATIC_SYMBOLS: usize = 64;
+/// Symbols of the residual alphabet: magnitudes below [`DIRECT`] whole, then four per bit
+/// length up to 32 (the two bits below the leading one).
+pub const STATIC_SYMBOLS: usize = 128;
+/// Bits below a magnitude's leading one that its symbol holds.
+const SUB_BITS: u32 = 2;
+/// Magnitudes below this are symbols of their own.
+const DIRECT: u32 = 1 << (SUB_BITS + 1);
 /// Most contexts a static residual code distinguishes (one bit each in the context mask).
 pub const MAX_STATIC_CONTEXTS: usize = 64;
 /// Interleaved rANS states (lanes) of a static residual code.
@@ -38,23 +43,34 @@ const LOWER: u32 = 1 << 16;
 /// The symbol of magnitude `z` and the number of raw mantissa bits below it.
 #[inline(always)]
 fn symbol_of(z: u32) -> (u32, u32) {
-    if z < 2 {
+    if z < DIRECT {
         return (z, 0);
     }
     let len = 32 - z.leading_zeros();
-    let h = (z >> (len - 2)) & 1;
-    (2 + 2 * (len - 2) + h, len - 2)
+    let extra = len - 1 - SUB_BITS;
+    let top = (z >> extra) & ((1 << SUB_BITS) - 1);
+    (DIRECT + ((len - SUB_BITS - 2) << SUB_BITS) + top, extra)
 }
 
-/// Per symbol: the magnitude with the mantissa bits zero, and the number of mantissa bits.
+/// Per symbol: the magnitude with the raw mantissa bits zero, and the number of those bits.
 const SYMBOL_BASE: [(u32, u32); STATIC_SYMBOLS] = {
     let mut t = [(0u32, 0u32); STATIC_SYMBOLS];
-    t[1] = (1, 0);
-    let mut s = 2;
+    let mut s = 0;
     while s < STATIC_SYMBOLS {
-        let len = (s as u32 - 2) / 2 + 2;
-        let h = (s as u32 - 2) & 1;
-        t[s] = ((2 | h) << (len - 2), len - 2);
+        let k = s as u32;
+        t[s] = if k < DIRECT {
+            (k, 0)
+        } else {
+            let len = ((k - DIRECT) >> SUB_BITS) + SUB_BITS + 2;
+            let top = (k - DIRECT) & ((1 << SUB_BITS) - 1);
+            let extra = len - 1 - SUB_BITS;
+            // Lengths past 32 (symbols no magnitude has) keep the top bit in range.
+            if len > 32 {
+                (0, 0)
+            } else {
+                (((1 << SUB_BITS) | top) << extra, extra)
+            }
+        };
         s += 1;
     }
     t
@@ -63,10 +79,14 @@ const SYMBOL_BASE: [(u32, u32); STATIC_SYMBOLS] = {
 /// Per symbol, the bit length of its magnitudes.
 const SYMBOL_LENGTH: [u32; STATIC_SYMBOLS] = {
     let mut t = [0u32; STATIC_SYMBOLS];
-    t[1] = 1;
-    let mut s = 2;
+    let mut s = 0;
     while s < STATIC_SYMBOLS {
-        t[s] = (s as u32 - 2) / 2 + 2;
+        let k = s as u32;
+        t[s] = if k < DIRECT {
+            32 - k.leading_zeros()
+        } else {
+            ((k - DIRECT) >> SUB_BITS) + SUB_BITS + 2
+        };
         s += 1;
     }
     t
@@ -164,9 +184,9 @@ impl RawFields {
 #[derive(Debug)]
 pub struct StaticResidualEncoder {
     contexts: usize,
-    /// Per coded residual: its context, lane and symbol (`context << 8 | lane << 6 |
+    /// Per coded residual: its context, lane and symbol (`context << 16 | lane << 8 |
     /// symbol`).
-    items: Vec<u16>,
+    items: Vec<u32>,
     counts: Vec<[u64; STATIC_SYMBOLS]>,
     raw: RawFields,
 }
@@ -194,7 +214,7 @@ impl StaticResidualEncoder {
         let z = r.unsigned_abs();
         let (s, extra) = symbol_of(z);
         self.items
-            .push((context as u16) << 8 | ((lane % STATIC_LANES) as u16) << 6 | s as u16);
+            .push((context as u32) << 16 | ((lane % STATIC_LANES) as u32) << 8 | s);
         self.counts[context][s as usize] += 1;
         if z != 0 {
             let mantissa = u64::from(z) & ((1u64 << extra) - 1);
@@ -210,7 +230,7 @@ impl StaticResidualEncoder {
         let context = context.min(self.contexts - 1);
         let s = symbol % STATIC_SYMBOLS;
         self.items
-            .push((context as u16) << 8 | ((lane % STATIC_LANES) as u16) << 6 | s as u16);
+            .push((context as u32) << 16 | ((lane % STATIC_LANES) as u32) << 8 | s as u32);
         self.counts[context][s] += 1;
     }
 
@@ -265,8 +285,8 @@ impl StaticResidualEncoder {
         let mut states = [LOWER; STATIC_LANES];
         let mut words: Vec<u16> = Vec::with_capacity(self.items.len() / 2 + 4);
         for &item in self.items.iter().rev() {
-            let (f, c) = fc[usize::from(item >> 8)][usize::from(item & 0x3F)];
-            let x = &mut states[usize::from(item >> 6 & 3)];
+            let (f, c) = fc[(item >> 16) as usize][(item & 0xFF) as usize];
+            let x = &mut states[(item >> 8 & 0xFF) as usize];
             // Renormalise so that the coded state stays below 2^32: it is when x < f 2^20,
             // which one word off any state below 2^32 makes true.
             if u64::from(*x) >= u64::from(f) << (32 - STATIC_PREC) {
@@ -541,14 +561,17 @@ mod tests {
     }
 
     #[test]
-    fn symbols_split_magnitudes_into_two_buckets_per_length() {
-        assert_eq!(symbol_of(0), (0, 0));
-        assert_eq!(symbol_of(1), (1, 0));
-        assert_eq!(symbol_of(2), (2, 0));
-        assert_eq!(symbol_of(3), (3, 0));
-        assert_eq!(symbol_of(4), (4, 1));
-        assert_eq!(symbol_of(6), (5, 1));
-        assert_eq!(symbol_of(u32::MAX), (63, 30));
+    fn symbols_split_magnitudes_into_four_buckets_per_length() {
+        for z in 0..8 {
+            assert_eq!(symbol_of(z), (z, 0));
+        }
+        // 8..16: length 4, the two bits below the leading one in the symbol, one raw.
+        assert_eq!(symbol_of(8), (8, 1));
+        assert_eq!(symbol_of(9), (8, 1));
+        assert_eq!(symbol_of(10), (9, 1));
+        assert_eq!(symbol_of(15), (11, 1));
+        assert_eq!(symbol_of(16), (12, 2));
+        assert_eq!(symbol_of(u32::MAX), (123, 29));
         for z in (0..5000u32).chain([1 << 30, (1 << 31) - 1, 1 << 31, u32::MAX]) {
             let (s, extra) = symbol_of(z);
             let (base, e) = SYMBOL_BASE[s as usize];
@@ -561,7 +584,7 @@ mod tests {
     #[test]
     fn tables_sum_to_the_total_and_keep_every_seen_symbol() {
         let mut counts = [0u64; STATIC_SYMBOLS];
-        // 64 symbols each seen once and one seen a million times: the floors push the sum
+        // Every symbol seen once and one seen a million times: the floors push the sum
         // over and the excess comes off the big one.
         counts.iter_mut().for_each(|c| *c = 1);
         counts[5] = 1_000_000;
