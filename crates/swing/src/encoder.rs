@@ -774,10 +774,14 @@ impl SwingEncoder {
                 };
                 let gain = chosen_trial.rms_pct / rms - 1.0;
                 let cost = with.bytes.len() as f64 / chosen.bytes.len() as f64 - 1.0;
+                // The vetoes' bytes are not in the search's reserve (their count varies):
+                // with the projections' fields still to come, they must fit under a size
+                // target's upper bound.
                 if gain > cost
                     && max <= input_max
                     && rms <= none.rms_pct
                     && judged_trial.score() < chosen_trial.score()
+                    && self.below_size_ceiling(prep, with.bytes.len() + PROJECTION_FIELD_BYTES)
                 {
                     // The record shows the chosen candidate as its stream is written.
                     if let Some(t) = trials.iter_mut().find(|t| **t == chosen_trial) {
@@ -862,12 +866,27 @@ impl SwingEncoder {
     /// Whether a stream of `bytes` is not under the lower bound of the options' size target
     /// (`--bpv`, `--target-bytes`: the target less the tolerance); true without one.
     fn above_size_floor(&self, prep: &Prepared, bytes: usize) -> bool {
-        let target = match self.opts.rate {
-            Rate::BitsPerVertex(r) => (r * prep.mesh.positions.len() as f64 / 8.0).round(),
-            Rate::TargetBytes(n) => n as f64,
-            Rate::EdgeLength(_) | Rate::MaxError(_) => return true,
+        let target = match self.size_target(prep) {
+            Some(t) => t,
+            None => return true,
         };
         bytes as f64 >= (1.0 - self.opts.tolerance) * target.max(1.0)
+    }
+
+    /// Whether a stream of `bytes` stays within a size target's upper bound (always without
+    /// a size target).
+    fn below_size_ceiling(&self, prep: &Prepared, bytes: usize) -> bool {
+        self.size_target(prep)
+            .is_none_or(|t| bytes as f64 <= (1.0 + self.opts.tolerance) * t.max(1.0))
+    }
+
+    /// The stream size a size-targeted rate asks for, in bytes; `None` for other rates.
+    fn size_target(&self, prep: &Prepared) -> Option<f64> {
+        match self.opts.rate {
+            Rate::BitsPerVertex(r) => Some((r * prep.mesh.positions.len() as f64 / 8.0).round()),
+            Rate::TargetBytes(n) => Some(n as f64),
+            Rate::EdgeLength(_) | Rate::MaxError(_) => None,
+        }
     }
 
     /// The projections after sharpening tried on `start` (a stream stating a sharpening and
@@ -1834,9 +1853,15 @@ fn refinements(centre: &SharpenTrial) -> Vec<Candidate> {
 }
 
 /// Most bytes the sharpening choice (`--optimize-for sharpened`) adds to the size search's
-/// stream: header fields 21 (method, 2 bytes), 23, 25, 27 and 31 (3 each), 29 (2), and up to
-/// 2 more for the filter after sharpening refitted for the chosen sharpening.
-const LATE_FIELD_BYTES: usize = 20;
+/// stream in fields of a fixed size: header fields 21 (method, 2 bytes), 23, 25, 27, 31, 35
+/// and 37 (3 each), 29 (2), and up to 2 more for the filter after sharpening refitted for
+/// the chosen sharpening. The snap vetoes (field 33, of a varying size) are checked against
+/// the size target when chosen instead.
+const LATE_FIELD_BYTES: usize = 24;
+
+/// Bytes of the projections' fields (25, 31, 35 and 37, three each), stated after the snap
+/// vetoes are chosen.
+const PROJECTION_FIELD_BYTES: usize = 12;
 
 /// `out` with header field 25 stating the planar-region projection at `factor` angle steps
 /// (rounded to the field's hundredths, which is what a decoder reads). The field's three

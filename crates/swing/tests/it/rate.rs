@@ -319,6 +319,10 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
         let out = encode(&mesh, &opts.with_error_of(ErrorOf::Sharpened)).unwrap();
         let hint = out.sharpen_hint.unwrap();
         assert_ne!(hint, not, "{name}: {:?}", out.sharpen_trials);
+        // Every field the sharpening choice states after the size search still lands
+        // within the rate's tolerance.
+        let bpv_out = out.bits_per_original_vertex();
+        assert!((bpv_out / bpv - 1.0).abs() <= 0.05, "{name}: {bpv_out} bpv");
         assert_eq!(SharpenHint::of(&header(&out.bytes)), Some(hint));
         // 24 candidates of the grid (each with the filter for after sharpening fitted for
         // it), the grid's best refined (its neighbours in smooth factor and curved walls,
