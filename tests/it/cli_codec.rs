@@ -80,9 +80,9 @@ fn the_traversal_prediction_round_trips_and_is_reported() {
     let info = whet_json(&["info", s(&trav), "--json"]);
     assert_eq!(info["triangles"], 12946);
     // The static codes: the traversal's residuals and labels, their tables sent once. On
-    // this 6.5k-vertex part the tables and the static statistics cost 7.1 % over the
-    // adaptive codes (14,322 -> 15,335 bytes, labels 831 -> 954 bytes, when added,
-    // 2026-12-06); held within 10 % and 25 %.
+    // this 6.5k-vertex part the tables and the static statistics cost 6.7 % over the
+    // adaptive codes (14,322 -> 15,277 bytes, labels 831 -> 915 bytes, 2026-12-06); held
+    // within 10 % and 25 %.
     let stat = dir.join("s.whet");
     let js = whet_json(&[
         "encode",

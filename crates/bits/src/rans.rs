@@ -14,9 +14,11 @@
 //! bits) codes its symbols directly ([`StaticResidualEncoder::encode_symbol`]).
 //!
 //! Layout of [`StaticResidualEncoder::finish`]'s bytes (docs/format.md, "Exact geometry
-//! payload"): the context mask (varint: bit `k` set when context `k` has a table); per
-//! present context, in order, the symbol count `n` (varint, 1..=128) and `n` frequencies
-//! (varints, summing to exactly `2^12`); the [`STATIC_LANES`] final rANS states (u32 little
+//! payload"): the context mask (varint: bit `k` set when context `k` has a table); the
+//! tables as bit fields, least significant bit first, padded to a byte: per present
+//! context, in order, its symbol count less one (7 bits) and, for every symbol but the last,
+//! the Elias gamma code of its frequency plus one (the last is what the others leave of
+//! `2^12`, at least 1); the [`STATIC_LANES`] final rANS states (u32 little
 //! endian each, state 0 first); the count of 16-bit words (varint) and the words (little
 //! endian), in the order the decoder reads them; then the raw-bit stream to the end.
 
@@ -91,6 +93,50 @@ const SYMBOL_LENGTH: [u32; STATIC_SYMBOLS] = {
     }
     t
 };
+
+/// Appends the Elias gamma code of `v >= 1` (its bit length less one as zeros, a one, then
+/// the bits below its leading one), least significant bit first.
+fn push_gamma(out: &mut RawFields, v: u32) {
+    let len = 32 - v.leading_zeros();
+    out.push(len - 1, 0);
+    out.push(1, 1);
+    out.push(len - 1, u64::from(v) & ((1u64 << (len - 1)) - 1));
+}
+
+/// Reads the bit fields of the tables (see [`StaticResidualEncoder::finish`]).
+struct TableBits<'a> {
+    bytes: &'a [u8],
+    bit: usize,
+}
+
+impl TableBits<'_> {
+    fn read(&mut self, bits: u32) -> Result<u32, Error> {
+        let mut v = 0u32;
+        for i in 0..bits {
+            let byte = *self.bytes.get(self.bit / 8).ok_or(Error::Truncated)?;
+            v |= u32::from(byte >> (self.bit % 8) & 1) << i;
+            self.bit += 1;
+        }
+        Ok(v)
+    }
+
+    /// An Elias gamma code of a value up to `2^13 - 1`.
+    fn gamma(&mut self) -> Result<u32, Error> {
+        let mut zeros = 0;
+        while self.read(1)? == 0 {
+            zeros += 1;
+            if zeros > 12 {
+                return Err(Error::Corrupt("static residual code: frequency too large"));
+            }
+        }
+        Ok(1 << zeros | self.read(zeros)?)
+    }
+
+    /// Bytes read, the last one's padding included.
+    fn bytes_read(&self) -> usize {
+        self.bit.div_ceil(8)
+    }
+}
 
 /// Appends `v` as a LEB128 varint.
 fn put_varint(out: &mut Vec<u8>, mut v: u64) {
@@ -267,20 +313,27 @@ impl StaticResidualEncoder {
             }
         }
         put_varint(&mut out, mask);
+        // The tables as bit fields (most frequencies are small): per context its symbol
+        // count less one in 7 bits, then every frequency but the last (the total fixes it)
+        // as the Elias gamma code of the frequency plus one.
+        let mut tables = RawFields::default();
         for (k, counts) in self.counts.iter().enumerate() {
             if mask >> k & 1 == 0 {
                 continue;
             }
             let f = normalise(counts);
             let n = STATIC_SYMBOLS - f.iter().rev().take_while(|&&x| x == 0).count();
-            put_varint(&mut out, n as u64);
+            tables.push(7, (n - 1) as u64);
             let mut cum = 0u32;
             for s in 0..n {
-                put_varint(&mut out, u64::from(f[s]));
+                if s + 1 < n {
+                    push_gamma(&mut tables, f[s] + 1);
+                }
                 fc[k][s] = (f[s], cum);
                 cum += f[s];
             }
         }
+        out.extend_from_slice(&tables.finish());
         // rANS runs backwards: the last residual first, each on its lane's state.
         let mut states = [LOWER; STATIC_LANES];
         let mut words: Vec<u16> = Vec::with_capacity(self.items.len() / 2 + 4);
@@ -352,35 +405,36 @@ impl<'a> StaticResidualDecoder<'a> {
                 .into_boxed_slice()
                 .try_into()
                 .map_err(|_| Error::Corrupt("static residual code: table allocation"))?;
+        let mut table_bits = TableBits {
+            bytes: bytes.get(pos..).unwrap_or(&[]),
+            bit: 0,
+        };
         for k in 0..MAX_STATIC_CONTEXTS {
             if k >= contexts || mask >> k & 1 == 0 {
                 // Symbol 0 with the whole total: the identity on the state.
                 fc[k][0] = TOTAL << 16;
                 continue;
             }
-            let n = get_varint(bytes, &mut pos)?;
-            if n == 0 || n > STATIC_SYMBOLS as u64 {
-                return Err(Error::Corrupt("static residual code: bad symbol count"));
-            }
+            let n = table_bits.read(7)? as usize + 1;
             let mut cum = 0u32;
-            for s in 0..n as usize {
-                let f = get_varint(bytes, &mut pos)?;
-                if f > u64::from(TOTAL - cum) {
+            for s in 0..n {
+                let f = if s + 1 < n {
+                    table_bits.gamma()? - 1
+                } else {
+                    // The last frequency is what the others leave of the total: at least 1.
+                    TOTAL.saturating_sub(cum)
+                };
+                if f > TOTAL - cum || (s + 1 == n && f == 0) {
                     return Err(Error::Corrupt(
-                        "static residual code: frequencies exceed the total",
+                        "static residual code: frequencies do not sum to the total",
                     ));
                 }
-                let f = f as u32;
                 fc[k][s] = f << 16 | cum;
                 slots[k][cum as usize..(cum + f) as usize].fill(s as u8);
                 cum += f;
             }
-            if cum != TOTAL {
-                return Err(Error::Corrupt(
-                    "static residual code: frequencies do not sum to the total",
-                ));
-            }
         }
+        pos += table_bits.bytes_read();
         let mut state = [0u32; STATIC_LANES];
         for s in &mut state {
             let b = bytes.get(pos..pos + 4).ok_or(Error::Truncated)?;
@@ -613,9 +667,9 @@ mod tests {
         round_trip(&[], 3);
         let zeros: Vec<(usize, i32)> = (0..1000).map(|_| (1, 0)).collect();
         let bytes = round_trip(&zeros, 3);
-        // Mask, a table of one symbol (its count and its frequency, 2^12 in two bytes), four
+        // Mask, a table of one symbol (its count in 7 bits, its frequency implied), four
         // states, no words, the 13 raw bits.
-        assert_eq!(bytes.len(), 1 + 1 + 2 + 16 + 1 + 2, "{bytes:?}");
+        assert_eq!(bytes.len(), 1 + 1 + 16 + 1 + 2, "{bytes:?}");
     }
 
     #[test]
