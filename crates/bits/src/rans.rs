@@ -256,12 +256,9 @@ impl StaticResidualEncoder {
     /// independent chains (a caller puts the three axes of a vertex on three lanes).
     #[inline]
     pub fn encode(&mut self, context: usize, lane: usize, r: i32) {
-        let context = context.min(self.contexts - 1);
         let z = r.unsigned_abs();
         let (s, extra) = symbol_of(z);
-        self.items
-            .push((context as u32) << 16 | ((lane % STATIC_LANES) as u32) << 8 | s);
-        self.counts[context][s as usize] += 1;
+        self.encode_symbol(context, lane, s as usize);
         if z != 0 {
             let mantissa = u64::from(z) & ((1u64 << extra) - 1);
             self.raw.push(extra + 1, mantissa << 1 | u64::from(r < 0));
