@@ -140,8 +140,9 @@ pub struct EncodeArgs {
     #[arg(long, value_name = "E")]
     max_error: Option<f64>,
     /// Swing: bits of a quantized swing angle (3..=14), or `auto`: with --bpv,
-    /// --target-bytes or --max-error, try 5..=10 bits and keep the lowest error (or the
-    /// smallest stream meeting the target), measured on the output of --optimize-for.
+    /// --target-bytes or --max-error, walk from 6 bits up and then down within 4..=12 while
+    /// the score improves and keep the lowest error (or the smallest stream meeting the
+    /// target), measured on the output of --optimize-for.
     #[arg(long, value_name = "B|auto", default_value = "6")]
     angle_bits: AngleBits,
     /// Swing: which output --max-error and --angle-bits auto measure: the decoded mesh, or

@@ -176,9 +176,10 @@ pub struct RdArgs {
     /// Rates of the swing mode, bits per ORIGINAL vertex, comma separated.
     #[arg(long, value_delimiter = ',', default_value = "0.5,1,2,3,4,6")]
     rates: Vec<f64>,
-    /// Swing angle bits of the swing curve, or `auto`: at each rate the encoder tries 5..=10
-    /// bits and keeps the stream whose output measures the lowest RMS error (the sharpened
-    /// output when the stages sharpen, else the decoded one).
+    /// Swing angle bits of the swing curve, or `auto`: at each rate the encoder walks from 6
+    /// bits up and then down within 4..=12 while the error falls and keeps the stream whose
+    /// output measures the lowest RMS error (the sharpened output when the stages sharpen,
+    /// else the decoded one).
     #[arg(long, value_name = "B|auto", default_value = "auto")]
     angle_bits: AngleBits,
     /// Quantization bits of the exact mode's baseline curve, comma separated.

@@ -1040,18 +1040,17 @@ impl SwingEncoder {
             };
             Ok(Some((score, out)))
         };
-        // Hill climb from the default: upwards while the score improves, else downwards.
-        // Scores are noisy by a few % from one L to the next, so one worse step ends a
-        // direction only when it is worse by more than that.
+        // Hill climb from the default: upwards while the score improves, then downwards
+        // while it beats the best of both. Scores are noisy by a few % from one L to the
+        // next, so one worse step ends a direction only when it is worse by more than
+        // that. Both directions are walked: a noisy gain one bit up must not hide a real
+        // one below (at 0.5 bpv sharp_sphere and fertility climbed to 7 bits on a 5 %
+        // step while 4-5 bits measured 28-35 % lower).
         const NOISE: f64 = 1.03;
         let range = SwingOptions::AUTO_ANGLE_BITS;
         let start = SwingOptions::DEFAULT_ANGLE_BITS;
         let mut best: Option<(f64, SwingOutput)> = run(start)?;
-        let mut climbed = false;
         for dir in [1i32, -1] {
-            if dir == -1 && climbed {
-                break;
-            }
             let mut bits = start;
             let mut misses = 0;
             loop {
@@ -1066,7 +1065,6 @@ impl SwingEncoder {
                 let best_score = best.as_ref().map_or(f64::INFINITY, |b| b.0);
                 if score < best_score {
                     best = Some((score, out));
-                    climbed = true;
                     misses = 0;
                 } else {
                     misses += 1;
