@@ -424,6 +424,7 @@ impl EdgeSharpener {
         }
         let mut run = Run::new(mesh, table, &self.options, &mut self.scratch, report);
         run.input_may_be_sharp = self.options.keep_sharp_parts && !self.later_pass;
+        run.later_pass = self.later_pass;
         let (out, parents, tagged) = run.run(judge);
         let mut report = run.report;
         let tags = sharp_tags(&mut report, &out, &tagged);
@@ -462,6 +463,7 @@ impl EdgeSharpener {
             welded: w,
         });
         run.input_may_be_sharp = self.options.keep_sharp_parts && !self.later_pass;
+        run.later_pass = self.later_pass;
         // Parents come out named by their input triangles (the output pass maps them).
         let (mut out, mut parents, mut tagged) = run.run(judge.as_deref_mut());
         let mut report = run.report;
@@ -587,6 +589,9 @@ pub(crate) struct Run<'a> {
     /// Whether the extended method looks for already sharp parts (the first pass only:
     /// `crate::extended::already_sharp_parts`).
     pub input_may_be_sharp: bool,
+    /// Whether this run is a later pass (`SharpenOptions::passes`) on the sharpener's own
+    /// output: `crate::extended::is_surface_sampling` then goes by the thin triangles alone.
+    pub later_pass: bool,
     pub limits: SnapLimits,
     /// The smooth threshold, radians (`smooth_factor` times the mean normal angle).
     pub smooth_threshold: f64,
@@ -650,6 +655,7 @@ impl<'a> Run<'a> {
             mean_edge: 0.0,
             weld_patch: None,
             input_may_be_sharp: true,
+            later_pass: false,
             limits: SnapLimits::new(0.0),
             smooth_threshold: 0.0,
             ref_normals: Vec::new(),
