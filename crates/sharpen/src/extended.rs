@@ -343,7 +343,8 @@ pub(crate) const GRIDLESS_THIN_FRACTION: f64 = 0.10;
 /// ends that agree, to the bit, in exactly one coordinate. Marching cubes puts each vertex on
 /// a grid edge and two of the three edges of each of its triangles in a cell face, so their
 /// ends share that face's coordinate: 0.667 on every synth sampling measured (cube, pyramid
-/// and fandisk at 32 and 64 cells, generic and near-axis rotations); the organic originals
+/// and fandisk at 32 and 64 cells turned generically, fandisk at 48 turned near an axis, 6.4 %
+/// thin); the organic originals
 /// 0-0.04, the CAD originals up to 0.30 (cad_cyl_fillet), exact-mode decodings (every
 /// coordinate on the quantization lattice) 0.02-0.46 (rocker_arm at 8 bits the highest).
 pub(crate) const GRID_EDGE_FRACTION: f64 = 0.55;
@@ -2317,8 +2318,9 @@ mod tests {
         assert!(is_surface_sampling(&spot, true));
         // A later pass goes by the thin triangles alone.
         assert!(!is_surface_sampling(&spot, false));
-        // The same triangles with the vertices on a coarse lattice on every axis (an
-        // exact-mode decoding): three shared coordinates or none, not one.
+        // The same triangles with every coordinate on a lattice (as an exact-mode decoding's,
+        // about 10 bits here): neighbours share a coordinate now and then, on any axis, but
+        // not one in two of three edges as on a grid.
         let mut snapped = spot.clone();
         for p in &mut snapped.positions {
             *p = (*p * 1024.0).round() / 1024.0;
