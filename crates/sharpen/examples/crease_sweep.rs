@@ -4,10 +4,11 @@
 //! ones as the stream states them), then with `project_creases_onto_local_quadrics` at the
 //! given move limit (mean edge lengths), reach (mean edge lengths) and crease angle, both
 //! measured with Metro against the original (symmetric RMS and max, 300 000 samples a
-//! direction).
+//! direction). With `corners` after the three numbers, the baseline is the projection
+//! without its corner moves instead, and the last column counts corners.
 //!
 //! ```text
-//! cargo run --release -p whet-sharpen --example crease_sweep -- [max move 0.5] [rings 3] [degrees 30]
+//! cargo run --release -p whet-sharpen --example crease_sweep -- [max move 0.5] [rings 3] [degrees 30] [corners]
 //! ```
 
 mod support;
@@ -26,6 +27,8 @@ fn main() {
         .with_max_move(arg(1, 0.5))
         .with_rings(arg(2, 3.0) as usize)
         .with_crease_angle_degrees(arg(3, 30.0));
+    // `corners`: the projection without its corner moves is the baseline.
+    let corners = args.get(4).is_some_and(|a| a == "corners");
     println!("| stream | input RMS % | without: RMS %, max % (RMS gain) | with the projection | moved / crease vertices |");
     println!("|---|---|---|---|---|");
     let (mut log_gain, mut rows, mut max_worse) = (0.0, 0, 0);
@@ -33,8 +36,13 @@ fn main() {
         if s.sharpen_hint == Some(whet_codec::SharpenHint::Unsharpened) {
             continue;
         }
-        let base = s.decode_sharpen_through(swing_inputs::Projections::Beside);
-        let mut fitted = base.clone();
+        let before = s.decode_sharpen_through(swing_inputs::Projections::Beside);
+        let mut fitted = before.clone();
+        let mut base = before;
+        if corners {
+            project_creases_onto_local_quadrics(&mut base, &opts.with_corners(false))
+                .unwrap_or_else(|e| panic!("{name}: {e}"));
+        }
         let report = project_creases_onto_local_quadrics(&mut fitted, &opts)
             .unwrap_or_else(|e| panic!("{name}: {e}"));
         let e = |m| support::error(&s.original, m, Some(300_000));
@@ -51,8 +59,8 @@ fn main() {
             f.rms_pct,
             f.max_pct,
             input / f.rms_pct,
-            report.moved_vertices,
-            report.crease_vertices
+            if corners { report.moved_corners } else { report.moved_vertices },
+            if corners { report.corner_vertices } else { report.crease_vertices }
         );
     }
     println!(
