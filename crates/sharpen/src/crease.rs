@@ -13,7 +13,7 @@
 use glam::DVec3;
 use whet_mesh::{CornerId, Mesh, VertexId};
 
-use crate::planar::{add_height_sample, checked_table, solve6};
+use crate::planar::{add_height_sample, checked_table, pin_quadratic_terms, solve6};
 use crate::Error;
 
 /// Most triangles one side's gathering takes, per square of the ring count (144 for three
@@ -114,7 +114,8 @@ impl Default for CreaseOptions {
 pub struct CreaseReport {
     /// Interior vertices with exactly two crease edges.
     pub crease_vertices: usize,
-    /// Of those, the ones whose two sides were both fitted and turn enough.
+    /// Of those and the corners, the ones whose sides were all fitted and turn enough (a
+    /// corner's also independent enough).
     pub fitted_vertices: usize,
     /// Vertices moved onto their sides' intersection.
     pub moved_vertices: usize,
@@ -427,14 +428,7 @@ pub fn project_creases_onto_local_quadrics(
             // A corner's wedge of a face holds few vertices off its creases within the
             // reach: under twelve, its plane (three unknowns, at least six points).
             if k == 3 && (6..12).contains(&points) {
-                for i in 0..3 {
-                    for (j, x) in m[i].iter_mut().enumerate() {
-                        *x = if i == j { 1.0 } else { 0.0 };
-                    }
-                    for row in m.iter_mut().skip(3) {
-                        row[i] = 0.0;
-                    }
-                }
+                pin_quadratic_terms(&mut m);
             } else if points < 12 {
                 continue 'vertices;
             }

@@ -304,14 +304,7 @@ fn fit_plane(pts: &[DVec3], normal: DVec3) -> Option<PlaneFit> {
     let coef = solve6(m)?;
     // The plane: the same system with the quadratic terms pinned to zero.
     let mut m_plane = m;
-    for i in 0..3 {
-        for (j, x) in m_plane[i].iter_mut().enumerate() {
-            *x = if i == j { 1.0 } else { 0.0 };
-        }
-        for row in m_plane.iter_mut().skip(3) {
-            row[i] = 0.0;
-        }
-    }
+    pin_quadratic_terms(&mut m_plane);
     let lin = solve6(m_plane)?;
     let (mut sq, mut sq_plane, mut max) = (0.0f64, 0.0f64, 0.0f64);
     for &(u, v, h) in &local {
@@ -365,6 +358,19 @@ pub(crate) fn add_height_sample(m: &mut [[f64; 7]; 6], b: [f64; 6], h: f64) {
             m[i][j] += b[i] * b[j];
         }
         m[i][6] += b[i] * h;
+    }
+}
+
+/// Pins the quadratic terms of the normal equations `m` (as [`add_height_sample`] builds
+/// them) to zero, so that [`solve6`] gives the least-squares plane `h = d u + e v + f`.
+pub(crate) fn pin_quadratic_terms(m: &mut [[f64; 7]; 6]) {
+    for i in 0..3 {
+        for (j, x) in m[i].iter_mut().enumerate() {
+            *x = if i == j { 1.0 } else { 0.0 };
+        }
+        for row in m.iter_mut().skip(3) {
+            row[i] = 0.0;
+        }
     }
 }
 
