@@ -650,6 +650,54 @@ mod tests {
     }
 
     #[test]
+    fn corner_moves_past_the_limit_are_refused() {
+        // Each corner a fifth of an edge off its box corner (the box's edge is 0.1): the
+        // point its three planes share is farther than a limit of a tenth of an edge, so it
+        // stays.
+        let size = DVec3::new(2.0, 3.0, 2.5);
+        let mut m = noisy_box(10, 0.0, 0.0);
+        let offset = DVec3::new(0.3, -0.2, 0.25).normalize() * 0.02;
+        for q in &mut m.positions {
+            let at = |x: f64, s: f64| x == 0.0 || x == s;
+            if at(q.x, size.x) && at(q.y, size.y) && at(q.z, size.z) {
+                *q += offset;
+            }
+        }
+        let before = m.clone();
+        let limit = 0.1;
+        let rep = project_creases_onto_local_quadrics(
+            &mut m,
+            &CreaseOptions::DEFAULT.with_max_move(limit),
+        )
+        .expect("a manifold");
+        assert_eq!(rep.corner_vertices, 8, "{rep:?}");
+        assert_eq!(rep.moved_corners, 0, "{rep:?}");
+        assert!(rep.refused_moves >= 8, "{rep:?}");
+        // With the default limit, half an edge, they move, onto their box corners.
+        let mut m = before.clone();
+        let rep = project_creases_onto_local_quadrics(&mut m, &CreaseOptions::DEFAULT)
+            .expect("a manifold");
+        assert_eq!(rep.moved_corners, 8, "{rep:?}");
+        // The faces are exact planes: each box corner gets a vertex back on it.
+        for corner in 0..8 {
+            let c = DVec3::new(
+                if corner & 1 == 0 { 0.0 } else { size.x },
+                if corner & 2 == 0 { 0.0 } else { size.y },
+                if corner & 4 == 0 { 0.0 } else { size.z },
+            );
+            let nearest = m
+                .positions
+                .iter()
+                .map(|q| q.distance(c))
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                nearest < 1e-9,
+                "box corner {c}: nearest vertex {nearest} away"
+            );
+        }
+    }
+
+    #[test]
     fn an_exact_box_stays_on_itself_and_its_faces_do_not_move() {
         let before = noisy_box(8, 0.0, 0.0);
         let mut m = before.clone();
