@@ -609,13 +609,11 @@ mod tests {
         assert!(after * 3.0 < before, "{before} -> {after}");
     }
 
-    #[test]
-    fn corners_come_closer_to_the_corners_of_a_noisy_box() {
-        // As above, and each corner 5 % of an edge off along a fixed slant (where a
-        // sharpener's three-plane point lands from three noisy planes).
+    /// Moves the 8 corners of a [`noisy_box`] by `distance` along one fixed slant; returns
+    /// each corner's vertex and its box corner.
+    fn shift_corners(m: &mut Mesh, distance: f64) -> Vec<(usize, DVec3)> {
         let size = DVec3::new(2.0, 3.0, 2.5);
-        let mut m = noisy_box(10, 0.001, 0.005);
-        let offset = DVec3::new(0.3, -0.2, 0.25).normalize() * 0.005;
+        let offset = DVec3::new(0.3, -0.2, 0.25).normalize() * distance;
         let mut corners = Vec::new();
         for (v, q) in m.positions.iter_mut().enumerate() {
             let at = |x: f64, s: f64| x == 0.0 || x == s;
@@ -624,6 +622,15 @@ mod tests {
                 *q += offset;
             }
         }
+        corners
+    }
+
+    #[test]
+    fn corners_come_closer_to_the_corners_of_a_noisy_box() {
+        // As above, and each corner 5 % of an edge off along a fixed slant (where a
+        // sharpener's three-plane point lands from three noisy planes).
+        let mut m = noisy_box(10, 0.001, 0.005);
+        let corners = shift_corners(&mut m, 0.005);
         assert_eq!(corners.len(), 8);
         let corner_rms = |m: &Mesh| {
             let sum: f64 = corners
@@ -656,13 +663,7 @@ mod tests {
         // stays.
         let size = DVec3::new(2.0, 3.0, 2.5);
         let mut m = noisy_box(10, 0.0, 0.0);
-        let offset = DVec3::new(0.3, -0.2, 0.25).normalize() * 0.02;
-        for q in &mut m.positions {
-            let at = |x: f64, s: f64| x == 0.0 || x == s;
-            if at(q.x, size.x) && at(q.y, size.y) && at(q.z, size.z) {
-                *q += offset;
-            }
-        }
+        shift_corners(&mut m, 0.02);
         let before = m.clone();
         let limit = 0.1;
         let rep = project_creases_onto_local_quadrics(
