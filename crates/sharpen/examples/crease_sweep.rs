@@ -5,10 +5,12 @@
 //! given move limit (mean edge lengths), reach (mean edge lengths) and crease angle, both
 //! measured with Metro against the original (symmetric RMS and max, 300 000 samples a
 //! direction). With `corners` after the three numbers, the baseline is the projection
-//! without its corner moves instead, and the last column counts corners.
+//! without its corner moves instead, and the last column counts corners; with `strips`, the
+//! baseline is the projection that does not leave strips of chamfer out of corners, and the
+//! last column counts the corners moved and the strips left out.
 //!
 //! ```text
-//! cargo run --release -p whet-sharpen --example crease_sweep -- [max move 0.5] [rings 3] [degrees 30] [corners]
+//! cargo run --release -p whet-sharpen --example crease_sweep -- [max move 0.5] [rings 3] [degrees 30] [corners|strips]
 //! ```
 
 mod support;
@@ -29,6 +31,8 @@ fn main() {
         .with_crease_angle_degrees(arg(3, 30.0));
     // `corners`: the projection without its corner moves is the baseline.
     let corners = args.get(4).is_some_and(|a| a == "corners");
+    // `strips`: the projection that keeps every arc of a corner is the baseline.
+    let strips = args.get(4).is_some_and(|a| a == "strips");
     println!("| stream | input RMS % | without: RMS %, max % (RMS gain) | with the projection | moved / crease vertices |");
     println!("|---|---|---|---|---|");
     let (mut log_gain, mut rows, mut max_worse) = (0.0, 0, 0);
@@ -41,6 +45,9 @@ fn main() {
         let mut base = before;
         if corners {
             project_creases_onto_local_quadrics(&mut base, &opts.with_corners(false))
+                .unwrap_or_else(|e| panic!("{name}: {e}"));
+        } else if strips {
+            project_creases_onto_local_quadrics(&mut base, &opts.with_strips(false))
                 .unwrap_or_else(|e| panic!("{name}: {e}"));
         }
         let report = project_creases_onto_local_quadrics(&mut fitted, &opts)
@@ -59,8 +66,14 @@ fn main() {
             f.rms_pct,
             f.max_pct,
             input / f.rms_pct,
-            if corners { report.moved_corners } else { report.moved_vertices },
-            if corners { report.corner_vertices } else { report.crease_vertices }
+            if corners || strips { report.moved_corners } else { report.moved_vertices },
+            if strips {
+                report.strips_left_out
+            } else if corners {
+                report.corner_vertices
+            } else {
+                report.crease_vertices
+            }
         );
     }
     println!(

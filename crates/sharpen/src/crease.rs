@@ -7,7 +7,10 @@
 //! point of the two surfaces' intersection. On swing-decoded CAD meshes these vertices carry
 //! most of the remaining squared error; the fits average dozens of samples each. A corner
 //! (three crease edges) moves onto the point where its three sides' fits meet, each side
-//! fitted by its plane when its wedge holds too few points for a quadric.
+//! fitted by its plane when its wedge holds too few points for a quadric. Where the
+//! sharpener left a strip of chamfer between two creases, the vertex at the strip's end has
+//! an arc with no vertex off the creases; that arc is left out and the vertex (of three to
+//! six crease edges) moves onto the line or point of its two or three other sides.
 //! docs/sharpen.md, "Crease projection".
 
 use glam::DVec3;
@@ -33,6 +36,10 @@ const NEWTON_STEPS: usize = 8;
 /// where the three fits meet is ill determined (the sharpener's corner snaps ask the same).
 const MIN_CORNER_TRIPLE_PRODUCT: f64 = 0.1;
 
+/// Most crease edges a vertex may have to move: up to six, of which all but two or three
+/// must be strips of chamfer left between two creases (arcs with no vertex off the creases).
+const MAX_CORNER_SIDES: usize = 6;
+
 /// Options of [`project_creases_onto_local_quadrics`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
@@ -48,6 +55,10 @@ pub struct CreaseOptions {
     /// Whether corners (interior vertices with three crease edges) move too, onto the
     /// point where their three sides' fits meet.
     pub corners: bool,
+    /// Whether, at a vertex of three to six crease edges, an arc with no vertex off the
+    /// creases (a strip of chamfer the sharpener left between two creases) is left out, so
+    /// the vertex moves onto the line or point of its two or three other sides.
+    pub strips: bool,
 }
 
 impl CreaseOptions {
@@ -59,6 +70,7 @@ impl CreaseOptions {
         crease_angle_degrees: 30.0,
         max_move: 0.5,
         corners: true,
+        strips: true,
     };
 
     /// The options with moves of at most `max_move` mean edge lengths.
@@ -69,6 +81,11 @@ impl CreaseOptions {
     /// The options with corners moved or not.
     pub const fn with_corners(self, corners: bool) -> CreaseOptions {
         CreaseOptions { corners, ..self }
+    }
+
+    /// The options with strips of chamfer left out of corners or not.
+    pub const fn with_strips(self, strips: bool) -> CreaseOptions {
+        CreaseOptions { strips, ..self }
     }
 
     /// The options with a reach of `rings` mean edge lengths.
@@ -122,10 +139,14 @@ pub struct CreaseReport {
     /// Fitted vertices that stayed because the intersection was farther than the limit
     /// (or none was found).
     pub refused_moves: usize,
-    /// Interior vertices with exactly three crease edges (corners).
+    /// Interior vertices with exactly three crease edges (corners) and, with
+    /// [`CreaseOptions::strips`], those with four to six.
     pub corner_vertices: usize,
-    /// Of those, the ones moved onto the point where their three sides' fits meet.
+    /// Of those, the ones moved onto the point where their sides' fits meet (or, with a
+    /// strip left out of three, onto the line of the other two).
     pub moved_corners: usize,
+    /// Arcs left out of fitted corners as strips of chamfer (no vertex off the creases).
+    pub strips_left_out: usize,
 }
 
 /// A side's quadratic height field `h = a u^2 + b uv + c v^2 + d u + e v + f` in the frame
@@ -302,8 +323,10 @@ fn onto_three(f0: &SideFit, f1: &SideFit, f2: &SideFit) -> Option<DVec3> {
 /// creases) onto the intersection of the quadratic height fields fitted to its two sides,
 /// when the two sides turn by at least 20 degrees and the move is at most `max_move` mean
 /// edge lengths, and (`opts.corners`) every corner, a vertex with exactly three crease
-/// edges, onto the point where its three sides' fits meet, under the same limit (module
-/// docs). Every fit reads the input positions, so the result does not
+/// edges, onto the point where its three sides' fits meet, under the same limit; with
+/// `opts.strips`, a vertex of three to six crease edges whose arcs without a vertex off the
+/// creases (strips of chamfer) leave two or three fitted sides moves onto their line or
+/// point (module docs). Every fit reads the input positions, so the result does not
 /// depend on the vertex order. Fails with [`Error::InvalidInput`] when `mesh` is not an
 /// oriented manifold with finite coordinates, [`Error::Parameter`] for options out of range.
 pub fn project_creases_onto_local_quadrics(
@@ -332,12 +355,9 @@ pub fn project_creases_onto_local_quadrics(
     let mut tri_stamp = vec![NONE; nt];
     let mut vert_stamp = vec![NONE; nv];
     let mut stamp = 0u32;
-    let (mut fan, mut sides, mut gathered, mut stack) = (
-        Vec::new(),
-        [Vec::new(), Vec::new(), Vec::new()],
-        Vec::new(),
-        Vec::new(),
-    );
+    let (mut fan, mut gathered, mut stack, mut points) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut sides: [Vec<usize>; MAX_CORNER_SIDES] = Default::default();
     let min_triple = MIN_CORNER_TRIPLE_PRODUCT;
     let mut moves: Vec<(usize, DVec3)> = Vec::new();
     'vertices: for v in 0..nv {
@@ -356,8 +376,11 @@ pub fn project_creases_onto_local_quadrics(
         match k {
             2 => report.crease_vertices += 1,
             3 if opts.corners => report.corner_vertices += 1,
+            4..=MAX_CORNER_SIDES if opts.corners && opts.strips => report.corner_vertices += 1,
             _ => continue,
         }
+        // Whether arcs with no vertex off the creases are left out (else they fail the fit).
+        let strips = k >= 3 && opts.strips;
         // A cut at i lies between fan[i] and fan[i + 1] (cyclically); each side is the arc
         // from the corner after one cut up to and including the corner at the next.
         for (s, side) in sides.iter_mut().enumerate().take(k) {
@@ -372,7 +395,10 @@ pub fn project_creases_onto_local_quadrics(
                 i = (i + 1) % fan.len();
             }
         }
-        let mut fits: [Option<SideFit>; 3] = [None, None, None];
+        let mut fits: [Option<SideFit>; MAX_CORNER_SIDES] = Default::default();
+        // Per arc, a bit for each other arc its gathering reached; and a bit per strip.
+        let mut reached = [0u32; MAX_CORNER_SIDES];
+        let mut strip_bits = 0u32;
         for s in 0..k {
             // Gather the side across non-crease edges, triangles whose centroid is within
             // the reach; meeting another arc means a crease ends within it.
@@ -398,8 +424,29 @@ pub fn project_creases_onto_local_quadrics(
             if !side.gather(stamp, &mut tri_stamp, &mut stack, &mut gathered) {
                 continue 'vertices;
             }
-            if (0..k).any(|o| o != s && sides[o].iter().any(|&t| tri_stamp[t] == stamp)) {
+            for o in (0..k).filter(|&o| o != s) {
+                if sides[o].iter().any(|&t| tri_stamp[t] == stamp) {
+                    reached[s] |= 1 << o;
+                }
+            }
+            // Without strips every meeting counts; with them, only meetings between arcs
+            // that are kept, known once every arc is gathered.
+            if reached[s] != 0 && !strips {
                 continue 'vertices;
+            }
+            points.clear();
+            for &t in &gathered {
+                for w in mesh.triangles[t] {
+                    let w = w as usize;
+                    if !on_crease[w] && vert_stamp[w] != stamp {
+                        vert_stamp[w] = stamp;
+                        points.push(w);
+                    }
+                }
+            }
+            if points.is_empty() && strips {
+                strip_bits |= 1 << s;
+                continue;
             }
             let n = sides[s]
                 .iter()
@@ -411,25 +458,16 @@ pub fn project_creases_onto_local_quadrics(
             }
             let (eu, ev) = n.any_orthonormal_pair();
             let mut m = [[0.0f64; 7]; 6];
-            let mut points = 0usize;
-            for &t in &gathered {
-                for w in mesh.triangles[t] {
-                    let w = w as usize;
-                    if on_crease[w] || vert_stamp[w] == stamp {
-                        continue;
-                    }
-                    vert_stamp[w] = stamp;
-                    points += 1;
-                    let d = (p[w] - p[v]) / reach;
-                    let (a, b, h) = (d.dot(eu), d.dot(ev), d.dot(n));
-                    add_height_sample(&mut m, [a * a, a * b, b * b, a, b, 1.0], h);
-                }
+            for &w in &points {
+                let d = (p[w] - p[v]) / reach;
+                let (a, b, h) = (d.dot(eu), d.dot(ev), d.dot(n));
+                add_height_sample(&mut m, [a * a, a * b, b * b, a, b, 1.0], h);
             }
             // A corner's wedge of a face holds few vertices off its creases within the
             // reach: under twelve, its plane (three unknowns, at least six points).
-            if k == 3 && (6..12).contains(&points) {
+            if k >= 3 && (6..12).contains(&points.len()) {
                 pin_quadratic_terms(&mut m);
-            } else if points < 12 {
+            } else if points.len() < 12 {
                 continue 'vertices;
             }
             let Some(coef) = solve6(m) else {
@@ -437,32 +475,36 @@ pub fn project_creases_onto_local_quadrics(
             };
             fits[s] = Some(SideFit { eu, ev, n, coef });
         }
-        let solved = if k == 2 {
-            let [Some(f0), Some(f1), _] = &fits else {
-                continue;
-            };
-            if f0.n.cross(f1.n).length() < min_sin {
-                continue;
+        let kept_bits = ((1u32 << k) - 1) & !strip_bits;
+        if (0..k).any(|s| kept_bits >> s & 1 != 0 && reached[s] & kept_bits != 0) {
+            continue;
+        }
+        // Every kept arc has its fit (an arc without one left the vertex above).
+        let kept: Vec<&SideFit> = fits[..k].iter().flatten().collect();
+        let solved = match kept[..] {
+            [f0, f1] => {
+                if f0.n.cross(f1.n).length() < min_sin {
+                    continue;
+                }
+                onto_two(f0, f1)
             }
-            report.fitted_vertices += 1;
-            onto_two(f0, f1)
-        } else {
-            let [Some(f0), Some(f1), Some(f2)] = &fits else {
-                continue;
-            };
-            let turns = [(f0, f1), (f1, f2), (f2, f0)];
-            if turns.iter().any(|(a, b)| a.n.cross(b.n).length() < min_sin)
-                || f0.n.dot(f1.n.cross(f2.n)).abs() < min_triple
-            {
-                continue;
+            [f0, f1, f2] => {
+                let turns = [(f0, f1), (f1, f2), (f2, f0)];
+                if turns.iter().any(|(a, b)| a.n.cross(b.n).length() < min_sin)
+                    || f0.n.dot(f1.n.cross(f2.n)).abs() < min_triple
+                {
+                    continue;
+                }
+                onto_three(f0, f1, f2)
             }
-            report.fitted_vertices += 1;
-            onto_three(f0, f1, f2)
+            _ => continue,
         };
+        report.fitted_vertices += 1;
+        report.strips_left_out += strip_bits.count_ones() as usize;
         let q = solved.map(|d| p[v] + d * reach);
         match q {
             Some(q) if q.is_finite() && q.distance(p[v]) <= max_move => {
-                if k == 3 {
+                if k >= 3 {
                     report.moved_corners += 1;
                 }
                 moves.push((v, q));
@@ -654,6 +696,89 @@ mod tests {
         let after = corner_rms(&m);
         // Measured 0.0050 -> 0.00067 (7.4x); bound at 3x.
         assert!(after * 3.0 < before, "{before} -> {after}");
+    }
+
+    /// Two faces at a right angle, the top `z = 0` (`y >= 0`) and the side `y = 0` (`z <= 0`),
+    /// grids of `h = 0.1` cells `n` wide on either side of `x = 0`: for `x >= 0` they meet at a
+    /// sharp edge along the x axis; for `x <= 0` a strip of chamfer one cell wide joins them
+    /// (the rows `y = h` of the top and `z = -h` of the side), ending at the edge vertex at the
+    /// origin in a tip triangle. The origin thus has three crease edges: the sharp edge and
+    /// the strip's two sides. Returns the mesh and the origin's index.
+    fn edge_with_a_chamfer_strip_ending(n: i32) -> (Mesh, usize) {
+        let h = 0.1;
+        let mut positions: Vec<DVec3> = Vec::new();
+        let mut index = std::collections::HashMap::new();
+        // (face, x, row): face 0 the top, 1 the side; row 0 is the shared edge.
+        let mut id = |face: u8, x: i32, row: i32| -> u32 {
+            let key = if row == 0 { (0, x, 0) } else { (face, x, row) };
+            *index.entry(key).or_insert_with(|| {
+                let (x, r) = (f64::from(x) * h, f64::from(row) * h);
+                positions.push(if key.0 == 0 {
+                    DVec3::new(x, r, 0.0)
+                } else {
+                    DVec3::new(x, 0.0, -r)
+                });
+                (positions.len() - 1) as u32
+            })
+        };
+        let (t, s) = (0u8, 1u8);
+        let mut triangles = Vec::new();
+        for x in -n..n {
+            for row in 0..n {
+                // Below the first row, left of the origin, is the strip.
+                if row == 0 && x < 0 {
+                    continue;
+                }
+                let top = [(x, row), (x + 1, row), (x + 1, row + 1), (x, row + 1)]
+                    .map(|(x, r)| id(t, x, r));
+                triangles.push([top[0], top[1], top[2]]);
+                triangles.push([top[0], top[2], top[3]]);
+                let side = [(x, row), (x + 1, row), (x + 1, row + 1), (x, row + 1)]
+                    .map(|(x, r)| id(s, x, r));
+                triangles.push([side[0], side[2], side[1]]);
+                triangles.push([side[0], side[3], side[2]]);
+            }
+        }
+        for x in -n..-1 {
+            let (t0, t1, s0, s1) = (id(t, x, 1), id(t, x + 1, 1), id(s, x, 1), id(s, x + 1, 1));
+            triangles.push([t0, s0, s1]);
+            triangles.push([t0, s1, t1]);
+        }
+        let origin = id(t, 0, 0);
+        let (t0, t1, s0, s1) = (id(t, -1, 1), id(t, 0, 1), id(s, -1, 1), id(s, 0, 1));
+        // The strip's tip, and the two triangles that fill the faces beside it.
+        triangles.push([t0, s0, origin]);
+        triangles.push([origin, t1, t0]);
+        triangles.push([origin, s0, s1]);
+        (Mesh::new(positions, triangles), origin as usize)
+    }
+
+    #[test]
+    fn a_vertex_where_a_chamfer_strip_ends_moves_onto_the_edge_of_its_faces() {
+        let (mut m, origin) = edge_with_a_chamfer_strip_ending(6);
+        // The origin a tenth of an edge off the sharp edge, where a sharpener's snap might
+        // leave it.
+        m.positions[origin] = DVec3::new(0.003, 0.01, -0.008);
+        let kept = project_creases_onto_local_quadrics(
+            &mut m.clone(),
+            &CreaseOptions::DEFAULT.with_strips(false),
+        )
+        .expect("a manifold");
+        let rep = project_creases_onto_local_quadrics(&mut m, &CreaseOptions::DEFAULT)
+            .expect("a manifold");
+        // Keeping the strip, the origin's three arcs include one without a vertex off the
+        // creases: no fit, the origin stays where it is.
+        assert_eq!(kept.moved_corners, 0, "{kept:?}");
+        assert_eq!(kept.strips_left_out, 0, "{kept:?}");
+        assert!(rep.moved_corners >= 1, "{rep:?}");
+        assert!(rep.strips_left_out >= 1, "{rep:?}");
+        // Leaving the strip out, the origin moves onto the line of its two exact faces, at
+        // the nearest point.
+        let q = m.positions[origin];
+        assert!(
+            q.distance(DVec3::new(0.003, 0.0, 0.0)) < 1e-9,
+            "the origin went to {q}"
+        );
     }
 
     #[test]
