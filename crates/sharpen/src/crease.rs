@@ -475,6 +475,8 @@ pub fn project_creases_onto_local_quadrics(
             };
             fits[s] = Some(SideFit { eu, ev, n, coef });
         }
+        // A strip cannot reach a kept arc: both would gather one component of triangles,
+        // and the kept arc's holds vertices off the creases. So only kept pairs are asked.
         let kept_bits = ((1u32 << k) - 1) & !strip_bits;
         if (0..k).any(|s| kept_bits >> s & 1 != 0 && reached[s] & kept_bits != 0) {
             continue;
