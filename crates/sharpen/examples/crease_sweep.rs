@@ -7,10 +7,13 @@
 //! direction). With `corners` after the three numbers, the baseline is the projection
 //! without its corner moves instead, and the last column counts corners; with `strips`, the
 //! baseline is the projection that does not leave strips of chamfer out of corners, and the
-//! last column counts the corners moved and the strips left out.
+//! last column counts the corners moved and the strips left out; with `meeting`, the
+//! baseline is the projection that leaves a corner whose arcs meet, and the last column
+//! counts the corners moved and the sides merged from meeting arcs. A further `synth` runs
+//! on the swing-synth table's streams (shapes no constant was tuned on) instead.
 //!
 //! ```text
-//! cargo run --release -p whet-sharpen --example crease_sweep -- [max move 0.5] [rings 3] [degrees 30] [corners|strips]
+//! cargo run --release -p whet-sharpen --example crease_sweep -- [max move 0.5] [rings 3] [degrees 30] [corners|strips|meeting|-] [synth]
 //! ```
 
 mod support;
@@ -29,25 +32,40 @@ fn main() {
         .with_max_move(arg(1, 0.5))
         .with_rings(arg(2, 3.0) as usize)
         .with_crease_angle_degrees(arg(3, 30.0));
-    // `corners`: the projection without its corner moves is the baseline.
-    let corners = args.get(4).is_some_and(|a| a == "corners");
-    // `strips`: the projection that keeps every arc of a corner is the baseline.
-    let strips = args.get(4).is_some_and(|a| a == "strips");
+    // The baseline: no crease projection, or with `corners`, `strips` or `meeting` the
+    // projection without that step.
+    let mode = args.get(4).map_or("", String::as_str);
+    let baseline = match mode {
+        "corners" => Some(opts.with_corners(false)),
+        "strips" => Some(opts.with_strips(false)),
+        "meeting" => Some(opts.with_meeting_arcs(false)),
+        _ => None,
+    };
     println!("| stream | input RMS % | without: RMS %, max % (RMS gain) | with the projection | moved / crease vertices |");
     println!("|---|---|---|---|---|");
     let (mut log_gain, mut rows, mut max_worse) = (0.0, 0, 0);
-    for (name, bpv, angles, s) in swing_inputs::every_swing_input() {
+    // `synth` after the mode: the swing-synth table's streams instead of the fixtures'.
+    let synth = args.get(5).is_some_and(|a| a == "synth");
+    let inputs: Box<dyn Iterator<Item = (String, f64, swing_inputs::Angles, _)>> = if synth {
+        Box::new(
+            swing_inputs::every_synth_swing_input(support::rotations()[0])
+                .map(|(kind, l, angles, s)| (kind.name().to_string(), l, angles, s)),
+        )
+    } else {
+        Box::new(
+            swing_inputs::every_swing_input()
+                .map(|(name, bpv, angles, s)| (name.to_string(), bpv, angles, s)),
+        )
+    };
+    for (name, bpv, angles, s) in inputs {
         if s.sharpen_hint == Some(whet_codec::SharpenHint::Unsharpened) {
             continue;
         }
         let before = s.decode_sharpen_through(swing_inputs::Projections::Beside);
         let mut fitted = before.clone();
         let mut base = before;
-        if corners {
-            project_creases_onto_local_quadrics(&mut base, &opts.with_corners(false))
-                .unwrap_or_else(|e| panic!("{name}: {e}"));
-        } else if strips {
-            project_creases_onto_local_quadrics(&mut base, &opts.with_strips(false))
+        if let Some(b) = baseline {
+            project_creases_onto_local_quadrics(&mut base, &b)
                 .unwrap_or_else(|e| panic!("{name}: {e}"));
         }
         let report = project_creases_onto_local_quadrics(&mut fitted, &opts)
@@ -66,13 +84,15 @@ fn main() {
             f.rms_pct,
             f.max_pct,
             input / f.rms_pct,
-            if corners || strips { report.moved_corners } else { report.moved_vertices },
-            if strips {
-                report.strips_left_out
-            } else if corners {
-                report.corner_vertices
-            } else {
-                report.crease_vertices
+            match mode {
+                "corners" | "strips" | "meeting" => report.moved_corners,
+                _ => report.moved_vertices,
+            },
+            match mode {
+                "strips" => report.strips_left_out,
+                "meeting" => report.merged_sides,
+                "corners" => report.corner_vertices,
+                _ => report.crease_vertices,
             }
         );
     }

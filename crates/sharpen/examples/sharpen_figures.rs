@@ -41,7 +41,7 @@ use whet_sharpen::{sharpen, Method, SharpenOptions};
 use whet_synth::{add_noise, marching_cubes, Shape, ShapeKind, ShapeParams};
 
 use support::{cached_stand_in, check, error, rotations};
-use swing_inputs::{swing_input, swing_input_of, Angles};
+use swing_inputs::{swing_input, Angles};
 
 /// Face samples per Metro direction: the default rule unless `SHARPEN_FIGURES_SAMPLES` is set
 /// (for quick iterations; the tables in docs/results.md use the default).
@@ -225,67 +225,36 @@ fn swing_synth() {
          | gain over unfiltered, RMS / max | gain over `whet decode`, RMS / max |"
     );
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
-    let rotation = rotations()[0];
-    for kind in [
-        ShapeKind::Box,
-        ShapeKind::Pyramid,
-        ShapeKind::Octahedron,
-        ShapeKind::Cylinder,
-        ShapeKind::Cone,
-        ShapeKind::Fandisk,
-        ShapeKind::ThinFace,
-        ShapeKind::TorusBox,
-        ShapeKind::Blend,
-        ShapeKind::Sphere,
-    ] {
-        let shape = Shape::new(kind, &ShapeParams::default().with_rotation(rotation))
-            .unwrap_or_else(|e| panic!("{e}"));
-        // Automatic angle bits need a size target: the 6-bit stream's size at each length.
-        let mut sizes = Vec::new();
-        for angles in [Angles::Fixed(6), Angles::AutoSharpened] {
-            for (i, l) in [0.01, 0.015, 0.02].into_iter().enumerate() {
-                let rate = match angles {
-                    Angles::Fixed(_) => whet_swing::Rate::EdgeLength(l),
-                    Angles::AutoSharpened => whet_swing::Rate::TargetBytes(sizes[i]),
-                };
-                let s = swing_input_of(
-                    shape.truth_mesh_ref().clone(),
-                    &format!("synth-{}-r0-{l}", kind.name()),
-                    rate,
-                    angles,
-                );
-                sizes.push(s.bytes.len());
-                let bits = match angles {
-                    Angles::Fixed(b) => b.to_string(),
-                    Angles::AutoSharpened => format!("auto {}", s.angle_bits),
-                };
-                let u = error(&s.original, &s.decoded, samples());
-                let p = error(&s.original, &s.plain(), samples());
-                let extended =
-                    sharpen(&s.decoded, &SharpenOptions::DEFAULT).unwrap_or_else(|e| panic!("{e}"));
-                let x = error(&s.original, &extended.mesh, samples());
-                let d = error(&s.original, &s.decode_sharpen(), samples());
-                println!(
-                    "| {} {l} {bits} | {} | {:.4} | {:.3} | {:.4} | {:.3} | {:.4} | {:.3} | {} \
-                     | {:.4} | {:.3} | {:.2}x / {:.2}x | {:.2}x / {:.2}x |",
-                    kind.name(),
-                    s.decoded.positions.len(),
-                    u.rms_pct,
-                    u.max_pct,
-                    p.rms_pct,
-                    p.max_pct,
-                    x.rms_pct,
-                    x.max_pct,
-                    stated_name(&s),
-                    d.rms_pct,
-                    d.max_pct,
-                    u.rms_pct / d.rms_pct,
-                    u.max_pct / d.max_pct,
-                    p.rms_pct / d.rms_pct,
-                    p.max_pct / d.max_pct,
-                );
-            }
-        }
+    for (kind, l, angles, s) in swing_inputs::every_synth_swing_input(rotations()[0]) {
+        let bits = match angles {
+            Angles::Fixed(b) => b.to_string(),
+            Angles::AutoSharpened => format!("auto {}", s.angle_bits),
+        };
+        let u = error(&s.original, &s.decoded, samples());
+        let p = error(&s.original, &s.plain(), samples());
+        let extended =
+            sharpen(&s.decoded, &SharpenOptions::DEFAULT).unwrap_or_else(|e| panic!("{e}"));
+        let x = error(&s.original, &extended.mesh, samples());
+        let d = error(&s.original, &s.decode_sharpen(), samples());
+        println!(
+            "| {} {l} {bits} | {} | {:.4} | {:.3} | {:.4} | {:.3} | {:.4} | {:.3} | {} \
+             | {:.4} | {:.3} | {:.2}x / {:.2}x | {:.2}x / {:.2}x |",
+            kind.name(),
+            s.decoded.positions.len(),
+            u.rms_pct,
+            u.max_pct,
+            p.rms_pct,
+            p.max_pct,
+            x.rms_pct,
+            x.max_pct,
+            stated_name(&s),
+            d.rms_pct,
+            d.max_pct,
+            u.rms_pct / d.rms_pct,
+            u.max_pct / d.max_pct,
+            p.rms_pct / d.rms_pct,
+            p.max_pct / d.max_pct,
+        );
     }
 }
 

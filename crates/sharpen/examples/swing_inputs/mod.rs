@@ -185,6 +185,49 @@ pub fn every_swing_input() -> impl Iterator<Item = (&'static str, f64, Angles, S
     })
 }
 
+/// The synth shapes of the swing-synth table (shapes no constant was tuned on), in its order.
+pub const SYNTH_SHAPES: [whet_synth::ShapeKind; 10] = {
+    use whet_synth::ShapeKind::*;
+    [
+        Box, Pyramid, Octahedron, Cylinder, Cone, Fandisk, ThinFace, TorusBox, Blend, Sphere,
+    ]
+};
+
+/// Every input of the swing-synth table, in its order: each of [`SYNTH_SHAPES`] turned by
+/// `rotation`, at edge lengths 1, 1.5 and 2 % with 6 angle bits, then at those streams'
+/// sizes with automatic angle bits; as (shape, edge length, angles, input).
+pub fn every_synth_swing_input(
+    rotation: glam::DQuat,
+) -> impl Iterator<Item = (whet_synth::ShapeKind, f64, Angles, SwingInput)> {
+    SYNTH_SHAPES.into_iter().flat_map(move |kind| {
+        let shape = whet_synth::Shape::new(
+            kind,
+            &whet_synth::ShapeParams::default().with_rotation(rotation),
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
+        // Automatic angle bits need a size target: the 6-bit stream's size at each length.
+        let mut sizes = Vec::new();
+        let mut rows = Vec::new();
+        for angles in [Angles::Fixed(6), Angles::AutoSharpened] {
+            for (i, l) in [0.01, 0.015, 0.02].into_iter().enumerate() {
+                let rate = match angles {
+                    Angles::Fixed(_) => Rate::EdgeLength(l),
+                    Angles::AutoSharpened => Rate::TargetBytes(sizes[i]),
+                };
+                let s = swing_input_of(
+                    shape.truth_mesh_ref().clone(),
+                    &format!("synth-{}-r0-{l}", kind.name()),
+                    rate,
+                    angles,
+                );
+                sizes.push(s.bytes.len());
+                rows.push((kind, l, angles, s));
+            }
+        }
+        rows
+    })
+}
+
 /// Encodes the shared fixture `name` at `bpv` bits per original vertex and decodes it.
 pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
     let original = whet_io::read_path(&whet_testkit::shared_fixture(name), None)
@@ -198,11 +241,11 @@ pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
 }
 
 /// Encodes `original` at `rate` and decodes it; `key` names the stream in the cache
-/// (`target/sharpen-swing/v41-<key>-<angles>.whet`).
+/// (`target/sharpen-swing/v42-<key>-<angles>.whet`).
 pub fn swing_input_of(original: Mesh, key: &str, rate: Rate, angles: Angles) -> SwingInput {
     let dir = whet_testkit::workspace_root().join("target/sharpen-swing");
     let _ = std::fs::create_dir_all(&dir);
-    let path = dir.join(format!("v41-{key}-{}.whet", angles.tag()));
+    let path = dir.join(format!("v42-{key}-{}.whet", angles.tag()));
     let bytes = match std::fs::read(&path) {
         Ok(b) => b,
         Err(_) => {
