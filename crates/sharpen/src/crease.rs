@@ -300,7 +300,6 @@ fn crease_edges_of(
 /// The quadratic height field over `n` fitted to `points` around vertex `v` (coordinates
 /// over `reach`), with its spread in `edge` lengths; from 6 to 11 points its plane when
 /// `few` (a corner's wedge of a face), else None under 12 points or a singular system.
-#[allow(clippy::too_many_arguments)]
 fn fit_side(
     p: &[DVec3],
     v: usize,
@@ -403,8 +402,8 @@ fn onto_three(f0: &SideFit, f1: &SideFit, f2: &SideFit) -> Option<DVec3> {
 /// `opts.strips`, a vertex of three to six crease edges whose arcs without a vertex off the
 /// creases (strips of chamfer) leave two or three fitted sides moves onto their line or
 /// point; with `opts.meeting_arcs`, arcs of such a vertex that meet within the reach are
-/// one side when one surface fits them (module docs). Every fit reads the input positions, so the result does not
-/// depend on the vertex order. Fails with [`Error::InvalidInput`] when `mesh` is not an
+/// one side when one surface fits them (module docs). Every fit reads the input positions,
+/// so the result does not depend on the vertex order. Fails with [`Error::InvalidInput`] when `mesh` is not an
 /// oriented manifold with finite coordinates, [`Error::Parameter`] for options out of range.
 pub fn project_creases_onto_local_quadrics(
     mesh: &mut Mesh,
