@@ -26,8 +26,7 @@ fn main() {
         Some(kind) => {
             let (res, rot): (usize, usize) = (args[1].parse().unwrap(), args[2].parse().unwrap());
             let rotation = support::rotations()[rot];
-            let shape =
-                Shape::new(kind, &ShapeParams::default().with_rotation(rotation)).unwrap();
+            let shape = Shape::new(kind, &ShapeParams::default().with_rotation(rotation)).unwrap();
             let input = marching_cubes(&shape, res).unwrap();
             (shape.truth_mesh_ref().clone(), input)
         }
@@ -51,7 +50,11 @@ fn main() {
         format!("RMS {:.4} % max {:.3} %", r.rms_pct, r.max_pct)
     };
     let (d, s, o) = (figures(&input), figures(&sharp.mesh), figures(&oracle));
-    let what = if synth.is_some() { "every vertex" } else { "untouched vertices" };
+    let what = if synth.is_some() {
+        "every vertex"
+    } else {
+        "untouched vertices"
+    };
     println!("input {d} | sharpened {s} | {what} on the original {o}");
     let count = moved.iter().filter(|&&f| f).count();
     println!("({count} of {} vertices moved by the oracle)", moved.len());
