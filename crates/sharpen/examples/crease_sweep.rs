@@ -48,7 +48,7 @@ fn main() {
     let synth = args.get(5).is_some_and(|a| a == "synth");
     let inputs: Box<dyn Iterator<Item = (String, f64, swing_inputs::Angles, _)>> = if synth {
         Box::new(
-            swing_inputs::every_synth_swing_input(support::rotations()[0])
+            swing_inputs::every_synth_swing_input(support::rotations()[0], "r0")
                 .map(|(kind, l, angles, s)| (kind.name().to_string(), l, angles, s)),
         )
     } else {

@@ -225,7 +225,7 @@ fn swing_synth() {
          | gain over unfiltered, RMS / max | gain over `whet decode`, RMS / max |"
     );
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
-    for (kind, l, angles, s) in swing_inputs::every_synth_swing_input(rotations()[0]) {
+    for (kind, l, angles, s) in swing_inputs::every_synth_swing_input(rotations()[0], "r0") {
         let bits = match angles {
             Angles::Fixed(b) => b.to_string(),
             Angles::AutoSharpened => format!("auto {}", s.angle_bits),

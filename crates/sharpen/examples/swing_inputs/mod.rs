@@ -194,10 +194,12 @@ pub const SYNTH_SHAPES: [whet_synth::ShapeKind; 10] = {
 };
 
 /// Every input of the swing-synth table, in its order: each of [`SYNTH_SHAPES`] turned by
-/// `rotation`, at edge lengths 1, 1.5 and 2 % with 6 angle bits, then at those streams'
-/// sizes with automatic angle bits; as (shape, edge length, angles, input).
+/// `rotation` (named `rotation_name` in the cache: the table's is the first of
+/// `support::rotations`, "r0"), at edge lengths 1, 1.5 and 2 % with 6 angle bits, then at
+/// those streams' sizes with automatic angle bits; as (shape, edge length, angles, input).
 pub fn every_synth_swing_input(
     rotation: glam::DQuat,
+    rotation_name: &'static str,
 ) -> impl Iterator<Item = (whet_synth::ShapeKind, f64, Angles, SwingInput)> {
     SYNTH_SHAPES.into_iter().flat_map(move |kind| {
         let shape = whet_synth::Shape::new(
@@ -216,7 +218,7 @@ pub fn every_synth_swing_input(
                 };
                 let s = swing_input_of(
                     shape.truth_mesh_ref().clone(),
-                    &format!("synth-{}-r0-{l}", kind.name()),
+                    &format!("synth-{}-{rotation_name}-{l}", kind.name()),
                     rate,
                     angles,
                 );
