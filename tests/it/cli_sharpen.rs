@@ -49,9 +49,13 @@ fn sharpen_then_bend_on_a_chamfered_cube() {
         "time_ms",
         "unmoved",
         "welded_vertices",
+        "dropped_chamfer_edges",
+        "dropped_corner_triangles",
     ] {
         assert!(!j[key].is_null(), "missing {key}: {j}");
     }
+    assert!(j["dropped_chamfer_edges"]["idle"].is_u64(), "{j}");
+    assert!(j["dropped_corner_triangles"]["curved"].is_u64(), "{j}");
     assert!(j["chamfer_edges"].as_u64().unwrap() > 0);
     // Marching cubes' clusters are welded (92 vertices here, measured 2026-12-02); the welded
     // vertices stay in the file, used by no triangle, and the command says so.

@@ -531,10 +531,7 @@ fn compose_passes(first: Sharpened, next: Sharpened) -> Sharpened {
     }
     let tags = SharpTags::from_vertex_flags(&next.mesh, &flags);
     let (a, b) = (&first.report, &next.report);
-    let mut unmoved = a.unmoved_by_reason;
-    for (u, n) in unmoved.iter_mut().zip(b.unmoved_by_reason) {
-        *u += n;
-    }
+    let add = |x: [usize; 8], y: [usize; 8]| std::array::from_fn(|i| x[i] + y[i]);
     let report = SharpenReport {
         output_vertices: b.output_vertices,
         output_triangles: b.output_triangles,
@@ -547,7 +544,10 @@ fn compose_passes(first: Sharpened, next: Sharpened) -> Sharpened {
         inserted_vertices: a.inserted_vertices + b.inserted_vertices,
         new_vertices: a.new_vertices + b.new_vertices,
         snapped_vertices: a.snapped_vertices + b.snapped_vertices,
-        unmoved_by_reason: unmoved,
+        unmoved_by_reason: add(a.unmoved_by_reason, b.unmoved_by_reason),
+        dropped_edges_by_reason: add(a.dropped_edges_by_reason, b.dropped_edges_by_reason),
+        idle_splits: a.idle_splits + b.idle_splits,
+        dropped_corners_by_reason: add(a.dropped_corners_by_reason, b.dropped_corners_by_reason),
         moved_input_vertices: a.moved_input_vertices + b.moved_input_vertices,
         collapsed_triangles: a.collapsed_triangles + b.collapsed_triangles,
         welded_vertices: a.welded_vertices + b.welded_vertices,
@@ -1223,8 +1223,15 @@ impl<'a> Run<'a> {
             let mid = (pa + pb) * 0.5;
             let snapped = self.edge_snap(a, b, mid);
             let idle = match &snapped {
-                Ok((p, _)) => p.distance(mid) <= IDLE_SPLIT * pa.distance(pb),
-                Err(_) => true,
+                Ok((p, _)) => {
+                    let idle = p.distance(mid) <= IDLE_SPLIT * pa.distance(pb);
+                    self.report.idle_splits += usize::from(idle);
+                    idle
+                }
+                Err(reason) => {
+                    self.report.dropped_edges_by_reason[reason.index()] += 1;
+                    true
+                }
             };
             if !idle {
                 self.snap_cache.push((c as u32, snapped));
@@ -1256,6 +1263,9 @@ impl<'a> Run<'a> {
             } else {
                 let snapped = self.corner_snap(tri, anchor);
                 let ok = snapped.is_ok();
+                if let Err(reason) = &snapped {
+                    self.report.dropped_corners_by_reason[reason.index()] += 1;
+                }
                 self.corner_cache.push((t as u32, anchor, snapped));
                 Some(ok)
             };

@@ -107,6 +107,17 @@ pub struct SharpenReport {
     /// New vertices of the output left at their midpoint or centroid, by reason (indexed like
     /// [`UnmovedReason::ALL`]; see [`SharpenReport::unmoved`]).
     pub unmoved_by_reason: [usize; 8],
+    /// Extended method: chamfer edges found and then left unsplit because their new vertex
+    /// could not move, by reason (indexed like [`UnmovedReason::ALL`]): no vertex was
+    /// inserted for them, so they are in no count of `unmoved_by_reason`; the chamfer stays
+    /// there.
+    pub dropped_edges_by_reason: [usize; 8],
+    /// Extended method: chamfer edges left unsplit because their new vertex would move by
+    /// under a thousandth of the edge (an already sharp crease).
+    pub idle_splits: usize,
+    /// Extended method: corner triangles found and then left without a centre because it
+    /// could not move, by reason (indexed like [`UnmovedReason::ALL`]).
+    pub dropped_corners_by_reason: [usize; 8],
     /// Input vertices moved (extended mode only; always chamfer vertices).
     pub moved_input_vertices: usize,
     /// Triangles removed by the sliver pass's edge collapses.
@@ -189,6 +200,18 @@ impl SharpenReport {
         self.unmoved_by_reason.iter().sum()
     }
 
+    /// Extended method: chamfer edges left unsplit because their new vertex could not move
+    /// for `reason` (no vertex inserted, so not in [`SharpenReport::unmoved`]).
+    pub fn dropped_edges(&self, reason: UnmovedReason) -> usize {
+        self.dropped_edges_by_reason[reason.index()]
+    }
+
+    /// Extended method: corner triangles left without a centre because it could not move
+    /// for `reason`.
+    pub fn dropped_corners(&self, reason: UnmovedReason) -> usize {
+        self.dropped_corners_by_reason[reason.index()]
+    }
+
     /// The report as one JSON object (no whitespace), for `whet sharpen --json`: `method`,
     /// `smooth_factor`, `mean_angle_degrees`, `smooth_threshold_degrees`, the input and output
     /// counts, `smooth_edges`, `chamfer_edges`, `corner_triangles`, `chamfer_vertices`,
@@ -200,7 +223,9 @@ impl SharpenReport {
     /// `rectified_normals`, `update_iterations`, `flips_avoided`, `swaps`, `collapses`,
     /// `detection_ms`, `filtering_ms` and `updating_ms` (zeros for the other methods), then
     /// `curved_wall_factor`, `curved_wall_edges`, `passes`, `twin_corners`,
-    /// `already_sharp_components` and `direct_crease_fraction`.
+    /// `already_sharp_components`, `direct_crease_fraction`, and the extended method's
+    /// `dropped_chamfer_edges` (an object like `unmoved`, plus `idle`) and
+    /// `dropped_corner_triangles` (like `unmoved`).
     pub fn to_json(&self) -> String {
         let mut s = String::with_capacity(768);
         // Writing to a String cannot fail.
@@ -252,7 +277,7 @@ impl SharpenReport {
              \"rectified_normals\":{},\"update_iterations\":{},\"flips_avoided\":{},\"swaps\":{},\
              \"collapses\":{},\"detection_ms\":{},\"filtering_ms\":{},\"updating_ms\":{},\
              \"curved_wall_factor\":{},\"curved_wall_edges\":{},\"passes\":{},\
-             \"twin_corners\":{},\"already_sharp_components\":{},\"direct_crease_fraction\":{}}}",
+             \"twin_corners\":{},\"already_sharp_components\":{},\"direct_crease_fraction\":{},",
             json_num(self.rho),
             json_num(self.eta),
             json_num(self.lambda),
@@ -276,6 +301,23 @@ impl SharpenReport {
             self.already_sharp_components,
             json_num(self.direct_crease_fraction),
         );
+        let reasons = |s: &mut String, counts: &[usize; 8]| {
+            for (i, r) in UnmovedReason::ALL.iter().enumerate() {
+                if i > 0 {
+                    s.push(',');
+                }
+                let _ = write!(s, "\"{}\":{}", r.name(), counts[i]);
+            }
+        };
+        s.push_str("\"dropped_chamfer_edges\":{");
+        reasons(&mut s, &self.dropped_edges_by_reason);
+        let _ = write!(
+            s,
+            ",\"idle\":{}}},\"dropped_corner_triangles\":{{",
+            self.idle_splits
+        );
+        reasons(&mut s, &self.dropped_corners_by_reason);
+        s.push_str("}}");
         s
     }
 }
@@ -308,7 +350,6 @@ mod tests {
             "corner_triangles",
             "new_vertices",
             "unmoved",
-            "too_long",
             "collapsed_triangles",
             "time_ms",
             "feature_faces",
@@ -323,10 +364,20 @@ mod tests {
             "twin_corners",
             "already_sharp_components",
             "direct_crease_fraction",
+            "dropped_chamfer_edges",
+            "idle",
+            "dropped_corner_triangles",
         ] {
             assert_eq!(j.matches(&format!("\"{key}\":")).count(), 1, "{key} in {j}");
         }
-        assert!(j.contains("\"too_long\":3"));
+        // Each reason once in each of the three objects that count by reason.
+        for r in UnmovedReason::ALL {
+            assert_eq!(j.matches(&format!("\"{}\":", r.name())).count(), 3, "{j}");
+        }
+        assert!(j.contains(
+            "\"unmoved\":{\"parallel\":0,\"dependent\":0,\"mixed_convexity\":0,\"too_long\":3"
+        ));
+        assert!(j.contains("\"idle\":0},\"dropped_corner_triangles\":{\"parallel\":0"));
         assert!(j.starts_with("{\"method\":\"extended\"") && j.ends_with('}'));
         assert_eq!(r.unmoved_total(), 3);
     }

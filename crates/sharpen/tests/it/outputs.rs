@@ -211,6 +211,38 @@ fn report_counts_and_json() {
 }
 
 #[test]
+fn chamfer_edges_left_uncut_are_counted() {
+    // Fandisk at 32 cells, the marching-cubes table's r0: where its max sits, two chamfer
+    // edges are found but every snap there fails the consistency test, and the extended
+    // method inserts no vertex that cannot move, so `unmoved` cannot count them (measured
+    // 2026-12-06: `unmoved` all zero, 348 chamfer edges cut, 55 left uncut: 31 curved, 24
+    // mixed convexity; docs/results.md, "Not reached").
+    let (_, input) = sampled(ShapeKind::Fandisk, 32, 0);
+    let r = sharpen(&input, &SharpenOptions::DEFAULT).unwrap().report;
+    assert!(r.dropped_edges(UnmovedReason::Curved) > 0, "{r:?}");
+    let dropped: usize = r.dropped_edges_by_reason.iter().sum();
+    assert!(dropped > 0 && dropped < r.chamfer_edges, "{r:?}");
+    let json = r.to_json();
+    let curved = r.dropped_edges(UnmovedReason::Curved);
+    assert!(
+        json.contains(&format!(
+            "\"dropped_chamfer_edges\":{{\"parallel\":{}",
+            r.dropped_edges(UnmovedReason::Parallel)
+        )),
+        "{json}"
+    );
+    assert!(
+        json.contains(&format!("\"curved\":{curved},\"vetoed\":")),
+        "{json}"
+    );
+    // The papers' method inserts every split, moved or not: nothing is dropped.
+    let p = sharpen(&input, &SharpenOptions::PAPERS).unwrap().report;
+    assert_eq!(p.dropped_edges_by_reason, [0; 8]);
+    assert_eq!(p.dropped_corners_by_reason, [0; 8]);
+    assert_eq!(p.idle_splits, 0);
+}
+
+#[test]
 fn smooth_factor_changes_detection() {
     let (_, input) = sampled(ShapeKind::Cube, 24, 1);
     let loose = sharpen(&input, &SharpenOptions::PAPERS.with_smooth_factor(4.0)).unwrap();
