@@ -252,12 +252,7 @@ impl SharpenReport {
             self.new_vertices,
             self.snapped_vertices,
         );
-        for (i, r) in UnmovedReason::ALL.iter().enumerate() {
-            if i > 0 {
-                s.push(',');
-            }
-            let _ = write!(s, "\"{}\":{}", r.name(), self.unmoved_by_reason[i]);
-        }
+        write_reasons(&mut s, &self.unmoved_by_reason);
         let _ = write!(
             s,
             "}},\"moved_input_vertices\":{},\"collapsed_triangles\":{},\"restored_triangles\":{},\
@@ -301,24 +296,26 @@ impl SharpenReport {
             self.already_sharp_components,
             json_num(self.direct_crease_fraction),
         );
-        let reasons = |s: &mut String, counts: &[usize; 8]| {
-            for (i, r) in UnmovedReason::ALL.iter().enumerate() {
-                if i > 0 {
-                    s.push(',');
-                }
-                let _ = write!(s, "\"{}\":{}", r.name(), counts[i]);
-            }
-        };
         s.push_str("\"dropped_chamfer_edges\":{");
-        reasons(&mut s, &self.dropped_edges_by_reason);
+        write_reasons(&mut s, &self.dropped_edges_by_reason);
         let _ = write!(
             s,
             ",\"idle\":{}}},\"dropped_corner_triangles\":{{",
             self.idle_splits
         );
-        reasons(&mut s, &self.dropped_corners_by_reason);
+        write_reasons(&mut s, &self.dropped_corners_by_reason);
         s.push_str("}}");
         s
+    }
+}
+
+/// One count per [`UnmovedReason`], by its name, comma separated (an object's members).
+fn write_reasons(s: &mut String, counts: &[usize; 8]) {
+    for (i, r) in UnmovedReason::ALL.iter().enumerate() {
+        if i > 0 {
+            s.push(',');
+        }
+        let _ = write!(s, "\"{}\":{}", r.name(), counts[i]);
     }
 }
 
