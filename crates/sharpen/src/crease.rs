@@ -186,8 +186,6 @@ struct SideFit {
     ev: DVec3,
     n: DVec3,
     coef: [f64; 6],
-    /// Largest distance of a fitted point from the surface, in mean edge lengths.
-    spread: f64,
 }
 
 impl SideFit {
@@ -298,13 +296,12 @@ fn crease_edges_of(
 }
 
 /// The quadratic height field over `n` fitted to `points` around vertex `v` (coordinates
-/// over `reach`), with its spread in `edge` lengths; from 6 to 11 points its plane when
-/// `few` (a corner's wedge of a face), else None under 12 points or a singular system.
+/// over `reach`); from 6 to 11 points its plane when `few` (a corner's wedge of a face),
+/// else None under 12 points or a singular system.
 fn fit_side(
     p: &[DVec3],
     v: usize,
     reach: f64,
-    edge: f64,
     points: &[usize],
     n: DVec3,
     few: bool,
@@ -324,20 +321,18 @@ fn fit_side(
         return None;
     }
     let coef = solve6(m)?;
-    let mut fit = SideFit {
-        eu,
-        ev,
-        n,
-        coef,
-        spread: 0.0,
-    };
-    fit.spread = points
+    Some(SideFit { eu, ev, n, coef })
+}
+
+/// The largest distance of `points` from `fit` (around vertex `v`, coordinates over
+/// `reach`), in `edge` lengths.
+fn spread(fit: &SideFit, p: &[DVec3], v: usize, reach: f64, edge: f64, points: &[usize]) -> f64 {
+    points
         .iter()
         .map(|&w| fit.residual((p[w] - p[v]) / reach).0.abs())
         .fold(0.0, f64::max)
         * reach
-        / edge;
-    Some(fit)
+        / edge
 }
 
 /// Newton's steps of least length from the vertex (`d = 0`, scaled coordinates) onto both
@@ -534,12 +529,15 @@ pub fn project_creases_onto_local_quadrics(
             if n == DVec3::ZERO {
                 continue 'vertices;
             }
-            let Some(fit) = fit_side(p, v, reach, edge, &points, n, k >= 3) else {
+            let Some(fit) = fit_side(p, v, reach, &points, n, k >= 3) else {
                 continue 'vertices;
             };
             fits[s] = Some(fit);
-            arc_points[s].clear();
-            arc_points[s].extend_from_slice(&points);
+            // Kept for a merge of meeting arcs (only vertices of three or more crease edges).
+            if k >= 3 && opts.meeting_arcs {
+                arc_points[s].clear();
+                arc_points[s].extend_from_slice(&points);
+            }
         }
         // A strip cannot reach a kept arc: both would gather one component of triangles,
         // and the kept arc's holds vertices off the creases. So only kept pairs are asked.
@@ -585,9 +583,9 @@ pub fn project_creases_onto_local_quadrics(
                 points.dedup();
                 let n = n.normalize_or_zero();
                 let Some(fit) = (n != DVec3::ZERO)
-                    .then(|| fit_side(p, v, reach, edge, &points, n, true))
+                    .then(|| fit_side(p, v, reach, &points, n, true))
                     .flatten()
-                    .filter(|f| f.spread <= MAX_MERGED_SPREAD)
+                    .filter(|f| spread(f, p, v, reach, edge, &points) <= MAX_MERGED_SPREAD)
                 else {
                     continue 'vertices;
                 };
