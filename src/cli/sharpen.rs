@@ -35,6 +35,11 @@ pub struct SharpenArgs {
     /// facets then get taken for chamfers.
     #[arg(long)]
     no_sharp_parts: bool,
+    /// extended: sharpen every part of a surface sampling, also those where most chamfer
+    /// edges found are refused as curved (a surface that bends everywhere: an organic model),
+    /// which are otherwise left alone; their few chamfer edges that pass get cut.
+    #[arg(long)]
+    no_curved_parts: bool,
     /// extended and papers: where two rings of triangles lie outside every smooth region, an
     /// edge turning by under this factor times the smooth threshold counts as smooth, so a
     /// face curved at the sampling's scale (a small hole's wall) gets its chamfers found.
@@ -150,6 +155,7 @@ pub fn run(args: &SharpenArgs) -> CliResult {
         .with_lambda(args.lambda)
         .with_weld_clusters(!args.no_weld)
         .with_keep_sharp_parts(!args.no_sharp_parts)
+        .with_keep_curved_parts(!args.no_curved_parts)
         .with_passes(args.passes);
     let opts = match args.curved_walls {
         Some(w) => opts.with_curved_wall_factor(w),
@@ -199,6 +205,13 @@ pub fn run(args: &SharpenArgs) -> CliResult {
             "whet: left {} already sharp part(s) unchanged (their creases run along edges, \
              not across chamfers; --no-sharp-parts sharpens them anyway)",
             out.report.already_sharp_components
+        );
+    }
+    if out.report.curved_parts > 0 {
+        eprintln!(
+            "whet: left {} curved part(s) unchanged (most chamfer edges found there were \
+             refused as curved; --no-curved-parts sharpens them anyway)",
+            out.report.curved_parts
         );
     }
     if args.json {

@@ -935,6 +935,56 @@ fn sharpen_leaves_an_already_sharp_original_alone_unless_told() {
     assert!(j["new_vertices"].as_u64().unwrap() > 0);
 }
 
+#[test]
+fn sharpen_leaves_a_curved_part_alone_unless_told() {
+    // spot's exact decoding at 10 bits: nearly every chamfer edge found is refused as curved,
+    // and the one that passes is a bump. The default run gives the mesh back and says why;
+    // `--no-curved-parts` cuts that edge.
+    let dir = scratch_dir("cli-sharpen-curved-parts");
+    let stream = dir.join("spot10.whet");
+    let decoded = dir.join("spot10.off");
+    let input = shared_fixture("spot.off");
+    let o = whet(&[
+        "encode",
+        s(&input),
+        "-o",
+        s(&stream),
+        "--mode",
+        "exact",
+        "--quant-bits",
+        "10",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = whet(&["decode", s(&stream), "-o", s(&decoded)]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (kept, forced) = (dir.join("kept.off"), dir.join("forced.off"));
+    let o = whet(&["sharpen", s(&decoded), "-o", s(&kept), "--json"]);
+    assert!(o.status.success());
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("curved part"),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(j["curved_parts"], 1);
+    assert!(j["curved_part_splits"].as_u64().unwrap() > 0);
+    assert_eq!(j["new_vertices"], 0);
+    assert_eq!(
+        std::fs::read(&kept).unwrap(),
+        std::fs::read(&decoded).unwrap()
+    );
+    let j = whet_json(&[
+        "sharpen",
+        s(&decoded),
+        "-o",
+        s(&forced),
+        "--no-curved-parts",
+        "--json",
+    ]);
+    assert_eq!(j["curved_parts"], 0);
+    assert!(j["new_vertices"].as_u64().unwrap() > 0);
+}
+
 /// A chamfered cube encoded at 3 bits per vertex (no sharpening fields), its stream's path
 /// and its parsed container.
 fn plain_cube_stream(dir: &std::path::Path) -> (std::path::PathBuf, whet_format::Container) {

@@ -424,6 +424,7 @@ impl EdgeSharpener {
         }
         let mut run = Run::new(mesh, table, &self.options, &mut self.scratch, report);
         run.input_may_be_sharp = self.options.keep_sharp_parts && !self.later_pass;
+        run.input_may_be_curved = self.options.keep_curved_parts && !self.later_pass;
         run.later_pass = self.later_pass;
         let (out, parents, tagged) = run.run(judge);
         let mut report = run.report;
@@ -463,6 +464,7 @@ impl EdgeSharpener {
             welded: w,
         });
         run.input_may_be_sharp = self.options.keep_sharp_parts && !self.later_pass;
+        run.input_may_be_curved = self.options.keep_curved_parts && !self.later_pass;
         run.later_pass = self.later_pass;
         // Parents come out named by their input triangles (the output pass maps them).
         let (mut out, mut parents, mut tagged) = run.run(judge.as_deref_mut());
@@ -539,6 +541,8 @@ fn compose_passes(first: Sharpened, next: Sharpened) -> Sharpened {
         corner_triangles: a.corner_triangles + b.corner_triangles,
         twin_corners: a.twin_corners + b.twin_corners,
         already_sharp_components: a.already_sharp_components + b.already_sharp_components,
+        curved_parts: a.curved_parts + b.curved_parts,
+        curved_part_splits: a.curved_part_splits + b.curved_part_splits,
         direct_crease_fraction: a.direct_crease_fraction,
         chamfer_vertices: a.chamfer_vertices + b.chamfer_vertices,
         inserted_vertices: a.inserted_vertices + b.inserted_vertices,
@@ -589,6 +593,10 @@ pub(crate) struct Run<'a> {
     /// Whether the extended method looks for already sharp parts (the first pass only:
     /// `crate::extended::already_sharp_parts`).
     pub input_may_be_sharp: bool,
+    /// Whether the extended method leaves alone the parts of a surface sampling whose chamfer
+    /// edges are mostly refused as curved (the first pass only:
+    /// `crate::extended::leave_curved_parts`).
+    pub input_may_be_curved: bool,
     /// Whether this run is a later pass (`SharpenOptions::passes`) on the sharpener's own
     /// output: `crate::extended::is_surface_sampling` then goes by the thin triangles alone.
     pub later_pass: bool,
@@ -655,6 +663,7 @@ impl<'a> Run<'a> {
             mean_edge: 0.0,
             weld_patch: None,
             input_may_be_sharp: true,
+            input_may_be_curved: true,
             later_pass: false,
             limits: SnapLimits::new(0.0),
             smooth_threshold: 0.0,
@@ -1203,6 +1212,10 @@ impl<'a> Run<'a> {
     #[inline(never)] // one call per run; kept out of line so profiles show it
     fn drop_idle_splits(&mut self) {
         let mut blue = 0;
+        // The chamfer edges found, by lower corner, and whether each is cut (else refused as
+        // curved; the other refusals are left out), for `leave_curved_parts`.
+        let judge_curved = self.surface_samples && self.input_may_be_curved;
+        let mut found: Vec<(u32, bool)> = Vec::new();
         // Blue edges lie between gray triangles (they are not red).
         let corners = (0..self.s.gray.len())
             .flat_map(|i| {
@@ -1230,10 +1243,16 @@ impl<'a> Run<'a> {
                 }
                 Err(reason) => {
                     self.report.dropped_edges_by_reason[reason.index()] += 1;
+                    if judge_curved && *reason == UnmovedReason::Curved {
+                        found.push((c as u32, false));
+                    }
                     true
                 }
             };
             if !idle {
+                if judge_curved {
+                    found.push((c as u32, true));
+                }
                 self.snap_cache.push((c as u32, snapped));
             }
             if idle {
@@ -1242,6 +1261,9 @@ impl<'a> Run<'a> {
             } else {
                 blue += 1;
             }
+        }
+        if judge_curved {
+            blue -= crate::extended::leave_curved_parts(self, &found);
         }
         self.report.chamfer_edges = blue;
         let mut green = 0;

@@ -2269,6 +2269,77 @@ fn already_sharp_parts(run: &Run) -> (f64, Option<(Vec<bool>, Vec<u32>)>) {
     (fraction, sharp.contains(&true).then_some((sharp, part)))
 }
 
+/// A part of a surface sampling whose found chamfer edges are cut at under this fraction of
+/// those cut or refused as curved bends everywhere: it is left as it went in
+/// ([`leave_curved_parts`]). Measured (`whet sharpen --json`, cut / (cut + curved)): the 42
+/// swing-decoded CAD rows of `sharpen_figures -- swing` 0.70-1.00 at the default smooth
+/// factor (cad_cyl_fillet the lowest) and 0.67-0.96 at factor 1 (the encoder's lowest
+/// candidate); rocker_arm's six swing-decoded rows 0.04-0.21 (0.5-0.6 at factor 1), spot's
+/// exact decodings at 8 and 10 bits 0.04 and 0.006, rocker_arm's at 12 bits 0.002.
+pub(crate) const MIN_CUT_FRACTION: f64 = 0.4;
+
+/// Fewer chamfer edges found (cut or refused as curved) than this in a part say nothing
+/// either way: the part is sharpened.
+pub(crate) const MIN_JUDGED_EDGES: usize = 8;
+
+/// Drops every split of the parts whose chamfer edges `found` (lower corner, cut or refused
+/// as curved) are mostly refused ([`MIN_CUT_FRACTION`]), and puts back any of their vertices
+/// a corner move took: returns the number of splits dropped (chamfer edges that were to be
+/// cut).
+///
+/// A chamfered crease is cut along its length: on a swing-decoded CAD part nearly all the
+/// chamfer edges found snap, and the few refused sit where a crease meets a curved face. A
+/// surface that bends everywhere (an organic model, a part of blends) gives the filters many
+/// strips whose planes the consistency and curvature tests refuse; the one or two that pass
+/// are bumps of the surface, not creases, and cutting them only adds error: spot's exact
+/// decoding at 10 bits had one chamfer edge cut out of 179 found, and its max error went
+/// from 0.048 to 0.367 % of the diagonal. Parts are looked at one by one only when the whole
+/// mesh is under the fraction (a chamfered mesh pays for no labelling of its parts).
+pub(crate) fn leave_curved_parts(run: &mut Run, found: &[(u32, bool)]) -> usize {
+    let judged = |cut: usize, all: usize| {
+        all >= MIN_JUDGED_EDGES && (cut as f64) < MIN_CUT_FRACTION * all as f64
+    };
+    let cut = found.iter().filter(|e| e.1).count();
+    if !judged(cut, found.len()) {
+        return 0;
+    }
+    // Per part (named by one of its triangles): edges cut, edges found.
+    let part = run.table.triangle_components();
+    let mut counts: std::collections::HashMap<u32, (usize, usize)> =
+        std::collections::HashMap::new();
+    for &(c, is_cut) in found {
+        let e = counts.entry(part[c as usize / 3]).or_default();
+        e.0 += usize::from(is_cut);
+        e.1 += 1;
+    }
+    let curved = |t: usize| counts.get(&part[t]).is_some_and(|&(c, a)| judged(c, a));
+    let mut dropped = 0;
+    for &(c, is_cut) in found {
+        let c = c as usize;
+        if !is_cut || !curved(c / 3) {
+            continue;
+        }
+        let o = run.table.opposites()[c] as usize;
+        run.s.cflags[c] &= !crate::edge_sharpener::C_BLUE;
+        run.s.cflags[o] &= !crate::edge_sharpener::C_BLUE;
+        dropped += 1;
+    }
+    run.snap_cache.retain(|&(c, _)| !curved(c as usize / 3));
+    for t in 0..run.mesh.triangles.len() {
+        if !curved(t) {
+            continue;
+        }
+        run.s.tflags[t] &= !(crate::edge_sharpener::T_GREEN | T_TOUCHED);
+        for v in run.mesh.triangles[t] {
+            run.positions[v as usize] = run.mesh.positions[v as usize];
+            run.s.vflags[v as usize] &= !V_MOVED;
+        }
+    }
+    run.report.curved_parts += counts.values().filter(|&&(c, a)| judged(c, a)).count();
+    run.report.curved_part_splits += dropped;
+    dropped
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -107,6 +107,12 @@ pub struct SharpenOptions {
     /// part is taken for a chamfered sampling, as before. Later passes never look (their
     /// input is the previous pass's output).
     pub keep_sharp_parts: bool,
+    /// Extended method: leave alone the connected parts of a surface sampling where fewer
+    /// than 40 % of the chamfer edges found can be cut, the rest refused as curved (a
+    /// surface that bends everywhere, whose few snaps left are bumps: docs/sharpen.md, "What
+    /// we extend", step 19). Default on; off, they are sharpened as before. Later passes
+    /// never look.
+    pub keep_curved_parts: bool,
     /// Curved walls (docs/sharpen.md): where two rings of triangles lie outside every smooth
     /// region, an edge turning by under this factor times the smooth threshold counts as
     /// smooth too, so that a face curved at the sampling's scale (a hole's cylinder a few
@@ -136,6 +142,7 @@ impl SharpenOptions {
         lambda: 0.0,
         weld_clusters: true,
         keep_sharp_parts: true,
+        keep_curved_parts: true,
         curved_wall_factor: None,
         passes: 1,
         pass_budget_triangles: None,
@@ -189,6 +196,13 @@ impl SharpenOptions {
     /// Sets whether the extended method leaves already sharp parts alone.
     pub const fn with_keep_sharp_parts(mut self, keep: bool) -> Self {
         self.keep_sharp_parts = keep;
+        self
+    }
+
+    /// Sets whether the extended method leaves alone the parts whose chamfers are mostly
+    /// refused as curved.
+    pub const fn with_keep_curved_parts(mut self, keep: bool) -> Self {
+        self.keep_curved_parts = keep;
         self
     }
 

@@ -147,6 +147,12 @@ pub struct SharpenReport {
     /// runs along edges between smooth regions (`already_sharp_components`' measure; 0 without
     /// strong creases or in later passes).
     pub direct_crease_fraction: f64,
+    /// Extended method, first pass on a surface sampling: connected parts left as they went
+    /// in because most of the chamfer edges found there were refused as curved (a surface
+    /// that bends everywhere; docs/sharpen.md, "What we extend", step 19).
+    pub curved_parts: usize,
+    /// Chamfer edges that would have been cut in those parts (left unsplit with them).
+    pub curved_part_splits: usize,
     /// Vertices tagged sharp (filter 3bis plus the new vertices).
     pub tagged_vertices: usize,
     /// Edges tagged sharp.
@@ -225,7 +231,7 @@ impl SharpenReport {
     /// `curved_wall_factor`, `curved_wall_edges`, `passes`, `twin_corners`,
     /// `already_sharp_components`, `direct_crease_fraction`, and the extended method's
     /// `dropped_chamfer_edges` (an object like `unmoved`, plus `idle`) and
-    /// `dropped_corner_triangles` (like `unmoved`).
+    /// `dropped_corner_triangles` (like `unmoved`), `curved_parts` and `curved_part_splits`.
     pub fn to_json(&self) -> String {
         let mut s = String::with_capacity(768);
         // Writing to a String cannot fail.
@@ -304,7 +310,11 @@ impl SharpenReport {
             self.idle_splits
         );
         write_reasons(&mut s, &self.dropped_corners_by_reason);
-        s.push_str("}}");
+        let _ = write!(
+            s,
+            "}},\"curved_parts\":{},\"curved_part_splits\":{}}}",
+            self.curved_parts, self.curved_part_splits
+        );
         s
     }
 }
@@ -364,6 +374,8 @@ mod tests {
             "dropped_chamfer_edges",
             "idle",
             "dropped_corner_triangles",
+            "curved_parts",
+            "curved_part_splits",
         ] {
             assert_eq!(j.matches(&format!("\"{key}\":")).count(), 1, "{key} in {j}");
         }

@@ -146,3 +146,42 @@ fn acute_wedges_of_a_retiled_cad_part_are_sharpened() {
         "{before:?} -> {after:?}"
     );
 }
+
+#[test]
+fn a_curved_part_is_left_alone_beside_a_chamfered_one() {
+    // One mesh of two parts: rocker_arm's exact decoding at 12 bits (one chamfer edge of
+    // about 460 found passes the curvature tests) and a swing-decoded cube (every chamfer
+    // edge cut). The whole mesh is under the cut fraction, so each part is judged on its
+    // own: the cube is sharpened, rocker_arm comes out as it went in.
+    let original =
+        whet_io::read_path(&whet_testkit::shared_fixture("rocker_arm.off"), None).unwrap();
+    let opts = whet_codec::EncodeOptions::DEFAULT.with_quant_bits(12);
+    let bytes = whet_codec::encode(&original, &opts).unwrap().bytes;
+    let curved = whet_codec::decode(&bytes, &whet_codec::DecodeOptions::DEFAULT).unwrap();
+    let cube = whet_synth::Shape::new(
+        whet_synth::ShapeKind::Cube,
+        &whet_synth::ShapeParams::default(),
+    )
+    .unwrap();
+    let cube = swing_decoded_mesh(cube.truth_mesh_ref(), Rate::EdgeLength(0.05));
+    let both = whet_testkit::meshes::union(curved.clone(), &cube, 100.0);
+    let out = sharpen(&both, &SharpenOptions::DEFAULT).unwrap();
+    assert_eq!(out.report.curved_parts, 1, "{}", out.report.to_json());
+    let nv = curved.positions.len();
+    assert!(out.report.new_vertices > 0);
+    let new = &out.mesh.positions[both.positions.len()..];
+    assert!(new.iter().all(|p| p.x > 50.0), "a new vertex off the cube");
+    assert_eq!(out.mesh.positions[..nv], curved.positions[..]);
+    let kept: Vec<[u32; 3]> = out
+        .mesh
+        .triangles
+        .iter()
+        .filter(|t| t.iter().all(|&v| (v as usize) < nv))
+        .copied()
+        .collect();
+    assert_eq!(kept, curved.triangles);
+    // The cube alone is cut as it is beside rocker_arm.
+    let alone = sharpen(&cube, &SharpenOptions::DEFAULT).unwrap();
+    assert_eq!(alone.report.curved_parts, 0);
+    assert!(alone.report.chamfer_edges > 0);
+}
