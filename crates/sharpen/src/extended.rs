@@ -2275,7 +2275,7 @@ fn already_sharp_parts(run: &Run) -> (f64, Option<(Vec<bool>, Vec<u32>)>) {
 /// swing-decoded CAD streams of `sharpen_figures -- swing` at least 0.70 at the default
 /// smooth factor (counting every refusal, not only `curved`), and the three sampled at
 /// factors 1 and 1.25 (the encoder's lowest candidates) at least 0.67 (cad_cyl_fillet);
-/// rocker_arm's six swing-decoded rows 0.04-0.21 (0.5-0.6 at factor 1), spot's exact
+/// rocker_arm's six swing-decoded rows 0.04-0.20 (0.56-0.60 at factor 1), spot's exact
 /// decodings at 8 and 10 bits 0.04 and 0.006, rocker_arm's at 12 bits 0.002.
 pub(crate) const MIN_CUT_FRACTION: f64 = 0.4;
 
