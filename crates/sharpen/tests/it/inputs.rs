@@ -240,19 +240,8 @@ fn an_already_sharp_part_is_left_alone_beside_a_chamfered_one() {
     assert_eq!(out.report.already_sharp_components, 1);
     // Every new vertex is the cube's (the smooth threshold is the whole mesh's, so the
     // counts differ from the cube's alone).
-    let nv = sharp.positions.len();
     assert!(out.report.new_vertices > 0);
-    let new = &out.mesh.positions[both.positions.len()..];
-    assert!(new.iter().all(|p| p.x > 50.0), "a new vertex off the cube");
-    assert_eq!(out.mesh.positions[..nv], sharp.positions[..]);
-    let kept: Vec<[u32; 3]> = out
-        .mesh
-        .triangles
-        .iter()
-        .filter(|t| t.iter().all(|&v| (v as usize) < nv))
-        .copied()
-        .collect();
-    assert_eq!(kept, sharp.triangles);
+    crate::assert_first_part_unchanged(&out.mesh, &sharp, both.positions.len());
     // Alone, the original is one already sharp part; a later pass, whose input is the
     // previous pass's output, does not look for sharp parts (its creases are the ones the
     // first pass sharpened).

@@ -18,6 +18,30 @@ mod support;
 pub const EDGE_SHARPENER: [whet_sharpen::Method; 2] =
     [whet_sharpen::Method::Papers, whet_sharpen::Method::Extended];
 
+/// Asserts that `out`, the sharpened union of `first` and a second part shifted 100 along x
+/// (`whet_testkit::meshes::union`, `union_vertices` vertices in all), holds `first`'s vertices
+/// and triangles as they were, and that every new vertex is the second part's.
+pub fn assert_first_part_unchanged(
+    out: &whet_mesh::Mesh,
+    first: &whet_mesh::Mesh,
+    union_vertices: usize,
+) {
+    let nv = first.positions.len();
+    let new = &out.positions[union_vertices..];
+    assert!(
+        new.iter().all(|p| p.x > 50.0),
+        "a new vertex off the second part"
+    );
+    assert_eq!(out.positions[..nv], first.positions[..]);
+    let kept: Vec<[u32; 3]> = out
+        .triangles
+        .iter()
+        .filter(|t| t.iter().all(|&v| (v as usize) < nv))
+        .copied()
+        .collect();
+    assert_eq!(kept, first.triangles);
+}
+
 mod inputs;
 mod issue6;
 mod judge;
