@@ -403,6 +403,7 @@ impl Output {
         }
         let mut arrays = std::mem::take(&mut run.s.slots);
         let mut local = self.build_local(run, &mut arrays);
+        let mut retreats: Vec<u8> = Vec::new();
         while let Some(Reverse((_, s))) = heap.pop() {
             let s = s as usize;
             if !self.alive[s] || !self.is_new[s] || self.badness(run, s).is_none() {
@@ -422,7 +423,9 @@ impl Output {
                 .collect();
             if !snapped.is_empty() {
                 for &v in &snapped {
-                    run.unsnap(v, UnmovedReason::Sliver);
+                    if !run.retreat(v, UnmovedReason::Sliver, &mut retreats) {
+                        run.unsnap(v, UnmovedReason::Sliver);
+                    }
                 }
                 for v in snapped {
                     let around: Vec<usize> = self.slots_at(&local, v).collect();

@@ -243,11 +243,11 @@ pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
 }
 
 /// Encodes `original` at `rate` and decodes it; `key` names the stream in the cache
-/// (`target/sharpen-swing/v43-<key>-<angles>.whet`).
+/// (`target/sharpen-swing/v44-<key>-<angles>.whet`).
 pub fn swing_input_of(original: Mesh, key: &str, rate: Rate, angles: Angles) -> SwingInput {
     let dir = whet_testkit::workspace_root().join("target/sharpen-swing");
     let _ = std::fs::create_dir_all(&dir);
-    let path = dir.join(format!("v43-{key}-{}.whet", angles.tag()));
+    let path = dir.join(format!("v44-{key}-{}.whet", angles.tag()));
     let bytes = match std::fs::read(&path) {
         Ok(b) => b,
         Err(_) => {
