@@ -1095,6 +1095,7 @@ fn border_planes(run: &mut Run) {
     // Per label around the vertex: the angle-weighted normal sum and the fan triangles.
     let mut acc: Vec<(u32, DVec3, u32)> = Vec::new();
     let mut ring: Vec<u32> = Vec::new();
+    let ring_planes = !run.surface_samples && on_grid_edges(run.mesh);
     for v in candidates {
         let v = v as usize;
         if run.s.vflags[v] & V_RED == 0 {
@@ -1132,17 +1133,18 @@ fn border_planes(run: &mut Run) {
                 None => {}
             }
         }
-        // Marching cubes, first pass: a label holding a single triangle of the fan takes its
+        // Marching cubes on its grid: a label holding a single triangle of the fan takes its
         // plane from all of its triangles around the one-ring instead. That lone triangle is
         // the last before the crease, whose vertex marching cubes interpolates on a grid
         // edge that cuts the crease, so it is tilted, and its normal alone tilts the line or
         // point the vertex's chamfer is snapped onto. A surface sampling's vertices lie on
-        // the surface, and so do those a pass snapped (a later pass's input is the
-        // sharpener's output, which goes down this path): there the lone triangle is as flat
-        // as its face and the ring's farther triangles only add curvature (measured: the
-        // swing table's fandisk 1x stream, max 0.425 -> 0.594 % after `decode --sharpen`,
-        // two passes, with the ring everywhere).
-        if !run.surface_samples && !run.later_pass {
+        // the surface, and so do those a pass snapped (a later pass over a sharpened
+        // sampling goes down the marching-cubes path, but is off any grid): there the lone
+        // triangle is as flat as its face and the ring's farther triangles only add
+        // curvature (measured: the swing table's fandisk 1x stream, max 0.425 -> 0.594 %
+        // after `decode --sharpen`, two passes, with the ring everywhere). The test is on
+        // the mesh alone, so a later pass does what a run on the earlier output does.
+        if ring_planes {
             for (label, n, in_fan) in &mut acc {
                 if *in_fan == 1 {
                     *n = ring_label_normal(run, v as u32, *label, &mut ring);
