@@ -618,6 +618,10 @@ pub(crate) struct Run<'a> {
     /// Extended method: the input is a regular tiling whose vertices are surface samples
     /// (`crate::extended::is_surface_sampling`).
     pub surface_samples: bool,
+    /// Extended method: whether the vertices lie on a grid's edges
+    /// (`crate::extended::on_grid_edges`), once a step has asked (the surface-sampling test
+    /// and the label planes both may; the answer depends on the mesh alone).
+    pub grid_edges: Option<bool>,
 }
 
 /// Per corner position `j` in a triangle, the positions of the corners after and before it.
@@ -672,6 +676,7 @@ impl<'a> Run<'a> {
             corner_cache: Vec::new(),
             twins: Vec::new(),
             surface_samples: false,
+            grid_edges: None,
         }
     }
 

@@ -77,7 +77,8 @@ pub(crate) struct LabelPlane {
 
 /// Labels regions and border vertices, then classifies the gray vertices.
 pub(crate) fn classify(run: &mut Run) {
-    run.surface_samples = is_surface_sampling(run.mesh, !run.later_pass);
+    run.grid_edges = None;
+    run.surface_samples = is_surface_sampling(run.mesh, !run.later_pass, &mut run.grid_edges);
     // Regions with a deep vertex (marching cubes only: the corridors and `tube_creases`).
     let mut thick: Vec<bool> = Vec::new();
     if !run.surface_samples {
@@ -376,7 +377,14 @@ const GRID_SAMPLE: usize = 4096;
 /// strip that holds a vertex on neither plane ([`STRIP_TOLERANCE`]). Everything else, and
 /// marching-cubes input, is unchanged.
 #[inline(never)] // one call per run; kept out of line so profiles show it
-pub(crate) fn is_surface_sampling(mesh: &whet_mesh::Mesh, grid_test: bool) -> bool {
+///
+/// `grid` keeps the answer of [`on_grid_edges`] when the test looks at it (or gives it, when
+/// known), so that a later step of the run does not sample the mesh again.
+pub(crate) fn is_surface_sampling(
+    mesh: &whet_mesh::Mesh,
+    grid_test: bool,
+    grid: &mut Option<bool>,
+) -> bool {
     let nt = mesh.triangles.len();
     if nt == 0 {
         return false;
@@ -388,7 +396,6 @@ pub(crate) fn is_surface_sampling(mesh: &whet_mesh::Mesh, grid_test: bool) -> bo
     let allowed = (SURFACE_SAMPLING_THIN_FRACTION * nt as f64).ceil() as usize;
     let allowed_off_grid = (GRIDLESS_THIN_FRACTION * nt as f64).ceil() as usize;
     // Whether the vertices are on grid edges, looked at once the thin count reaches `allowed`.
-    let mut grid: Option<bool> = None;
     let mut thin = 0usize;
     for t in 0..nt {
         let p = mesh.triangle_positions(t);
@@ -1095,7 +1102,9 @@ fn border_planes(run: &mut Run) {
     // Per label around the vertex: the angle-weighted normal sum and the fan triangles.
     let mut acc: Vec<(u32, DVec3, u32)> = Vec::new();
     let mut ring: Vec<u32> = Vec::new();
-    let ring_planes = !run.surface_samples && on_grid_edges(run.mesh);
+    let mesh = run.mesh;
+    let ring_planes =
+        !run.surface_samples && *run.grid_edges.get_or_insert_with(|| on_grid_edges(mesh));
     for v in candidates {
         let v = v as usize;
         if run.s.vflags[v] & V_RED == 0 {
@@ -2406,7 +2415,10 @@ mod tests {
     fn marching_cubes_vertices_are_on_grid_edges_until_the_mesh_is_turned() {
         let mc = sampled_fandisk(40);
         assert!(on_grid_edges(&mc));
-        assert!(!is_surface_sampling(&mc, true));
+        // The test keeps the grid answer it looked at for later steps of the run.
+        let mut grid = None;
+        assert!(!is_surface_sampling(&mc, true, &mut grid));
+        assert_eq!(grid, Some(true));
         // Moved and scaled: equal coordinates stay equal.
         let mut moved = mc.clone();
         for p in &mut moved.positions {
@@ -2421,7 +2433,9 @@ mod tests {
             *p = turn * *p;
         }
         assert!(!on_grid_edges(&turned));
-        assert!(!is_surface_sampling(&turned, true));
+        let mut grid = None;
+        assert!(!is_surface_sampling(&turned, true, &mut grid));
+        assert_eq!(grid, Some(false));
     }
 
     #[test]
@@ -2431,9 +2445,11 @@ mod tests {
         // the diagonal).
         let spot = whet_io::read_path(&whet_testkit::shared_fixture("spot.off"), None).unwrap();
         assert!(!on_grid_edges(&spot));
-        assert!(is_surface_sampling(&spot, true));
-        // A later pass goes by the thin triangles alone.
-        assert!(!is_surface_sampling(&spot, false));
+        assert!(is_surface_sampling(&spot, true, &mut None));
+        // A later pass goes by the thin triangles alone, and never looks at the grid.
+        let mut grid = None;
+        assert!(!is_surface_sampling(&spot, false, &mut grid));
+        assert_eq!(grid, None);
         // The same triangles with every coordinate on a lattice (as an exact-mode decoding's,
         // about 10 bits here): neighbours share a coordinate now and then, on any axis, but
         // not one in two of three edges as on a grid.
