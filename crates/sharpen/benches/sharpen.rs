@@ -6,6 +6,9 @@
 //!
 //! The sharpener itself is single-threaded; marching cubes (setup only) uses rayon.
 //!
+//! `extended_*_recycled`: the extended method with each output given back to the engine
+//! before the next run (`EdgeSharpener::recycle`).
+//!
 //! Also the real input: fandisk and joint encoded by whet-swing (6 angle bits, at about 2x
 //! their vertex count: 28k and 77k triangles) and decoded by whet-codec, named `*_swing_*`.
 
@@ -40,6 +43,15 @@ fn bench(c: &mut Criterion) {
                 b.iter(|| sharpener.sharpen(&mesh))
             });
         }
+        // Each output given back before the next run (`EdgeSharpener::recycle`), as a server
+        // sharpening mesh after mesh: no memory mapped afresh per run.
+        let mut sharpener = EdgeSharpener::new(SharpenOptions::DEFAULT);
+        group.bench_function(format!("extended_{name}_recycled"), |b| {
+            b.iter(|| match sharpener.sharpen(&mesh) {
+                Ok(out) => sharpener.recycle(out),
+                Err(e) => panic!("sharpening failed: {e}"),
+            })
+        });
     }
     for (name, fixture, bpv) in [
         ("swing_fandisk_28k", "fandisk.off", 6.4),

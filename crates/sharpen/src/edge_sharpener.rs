@@ -205,6 +205,47 @@ pub(crate) struct Scratch {
     /// On a welded input: the output triangles holding a cluster's kept vertex, ascending
     /// (`crate::slivers::Output::finish`).
     pub around_roots: Vec<u32>,
+    /// The output's arrays given back ([`EdgeSharpener::recycle`], and an earlier pass's
+    /// output once the next is composed with it), which the next runs' outputs fill: on a
+    /// million triangles some 28 MB a run that the kernel otherwise faults in afresh. Up to
+    /// [`SPARE_OUTPUTS`] of each, so that every pass of a two-pass run finds one.
+    pub spare_positions: Vec<Vec<DVec3>>,
+    pub spare_triangles: Vec<Vec<[u32; 3]>>,
+    pub spare_parents: Vec<Vec<FaceId>>,
+}
+
+/// Output arrays of each kind an engine keeps ([`Scratch::keep_output`]).
+const SPARE_OUTPUTS: usize = 2;
+
+impl Scratch {
+    /// Keeps `out`'s big arrays for the next runs' outputs (the largest [`SPARE_OUTPUTS`] of
+    /// each kind).
+    fn keep_output(&mut self, out: Sharpened) {
+        keep_spare(&mut self.spare_positions, out.mesh.positions);
+        keep_spare(&mut self.spare_triangles, out.mesh.triangles);
+        keep_spare(&mut self.spare_parents, out.parents);
+    }
+}
+
+/// Adds `v` to the spare arrays `held`, dropping the smallest past [`SPARE_OUTPUTS`].
+fn keep_spare<T>(held: &mut Vec<Vec<T>>, v: Vec<T>) {
+    if v.capacity() == 0 {
+        return;
+    }
+    held.push(v);
+    if held.len() > SPARE_OUTPUTS {
+        if let Some(i) = (0..held.len()).min_by_key(|&i| held[i].capacity()) {
+            held.swap_remove(i);
+        }
+    }
+}
+
+/// The largest of the spare arrays `held`, emptied (a new vector when there is none).
+pub(crate) fn take_spare<T>(held: &mut Vec<Vec<T>>) -> Vec<T> {
+    let largest = (0..held.len()).max_by_key(|&i| held[i].capacity());
+    let mut v = largest.map_or_else(Vec::new, |i| held.swap_remove(i));
+    v.clear();
+    v
 }
 
 fn reset<T: Clone>(v: &mut Vec<T>, n: usize, x: T) {
@@ -214,9 +255,10 @@ fn reset<T: Clone>(v: &mut Vec<T>, n: usize, x: T) {
 
 /// The EdgeSharpener engine: options plus scratch buffers kept between calls (the run's
 /// arrays, the input's corner table, the welded mesh and its table, the sliver pass's slots),
-/// so that sharpening mesh after mesh works in memory already mapped. It holds that memory,
-/// sized by the largest mesh it has sharpened, until it is dropped; a clone starts with the
-/// run's arrays copied and the tables' pool empty.
+/// so that sharpening mesh after mesh works in memory already mapped, and an output given
+/// back ([`EdgeSharpener::recycle`]) holds the next one. It holds that memory, sized by the
+/// largest mesh it has sharpened, until it is dropped; a clone starts with the run's arrays
+/// copied and the tables' pool empty.
 ///
 /// ```
 /// use whet_sharpen::{EdgeSharpener, SharpenOptions};
@@ -227,6 +269,8 @@ fn reset<T: Clone>(v: &mut Vec<T>, n: usize, x: T) {
 ///     let shape = Shape::new(kind, &ShapeParams::default()).unwrap();
 ///     let out = sharpener.sharpen(&marching_cubes(&shape, 12).unwrap()).unwrap();
 ///     assert!(out.report.chamfer_edges > 0);
+///     // Done with it: the next output is written into its memory.
+///     sharpener.recycle(out);
 /// }
 /// ```
 #[derive(Clone, Debug)]
@@ -285,6 +329,14 @@ impl EdgeSharpener {
         self.sharpen_with(mesh, None)
     }
 
+    /// Gives back an output this engine (or another) returned, once the caller is done with
+    /// it: the next run writes its mesh and parents into that memory instead of memory the
+    /// kernel maps afresh (a server that sharpens mesh after mesh; on a million triangles
+    /// some 28 MB a run). The output does not change.
+    pub fn recycle(&mut self, out: Sharpened) {
+        self.scratch.keep_output(out);
+    }
+
     /// Sharpens `mesh` with every pass's snaps put to `judge`; see [`crate::sharpen_judged`].
     pub fn sharpen_judged(
         &mut self,
@@ -332,8 +384,12 @@ impl EdgeSharpener {
                 break;
             };
             unchanged = next.mesh == out.mesh;
-            if !unchanged {
-                out = compose_passes(out, next);
+            if unchanged {
+                self.scratch.keep_output(next);
+            } else {
+                let composed = compose_passes(&out, next);
+                self.scratch
+                    .keep_output(std::mem::replace(&mut out, composed));
             }
         }
         out.report.time = start.elapsed();
@@ -472,6 +528,10 @@ impl EdgeSharpener {
         // A run that sharpened nothing gives the input back, as it would unwelded (the
         // clusters of an already sharp or smooth mesh are not the sharpener's business).
         if report.new_vertices == 0 && report.moved_input_vertices == 0 {
+            // Its arrays serve the run on the input instead.
+            keep_spare(&mut self.scratch.spare_positions, out.positions);
+            keep_spare(&mut self.scratch.spare_triangles, out.triangles);
+            keep_spare(&mut self.scratch.spare_parents, parents);
             return None;
         }
         let restored = crate::weld::restore_untouched(
@@ -513,7 +573,7 @@ fn sharp_tags(report: &mut SharpenReport, mesh: &Mesh, tagged: &[bool]) -> Sharp
 /// pass, so a vertex tagged by either stays tagged, unless the later pass welded it away),
 /// and the counts of events added up (the smooth threshold, the mean angle, `smooth_edges`,
 /// `curved_wall_edges` and the input counts are the first pass's).
-fn compose_passes(first: Sharpened, next: Sharpened) -> Sharpened {
+fn compose_passes(first: &Sharpened, next: Sharpened) -> Sharpened {
     // `next`'s parents index `first.mesh`'s triangles, which `first.parents` covers.
     debug_assert!(next.parents.iter().all(|p| p.index() < first.parents.len()));
     let parents = next
@@ -656,13 +716,15 @@ impl<'a> Run<'a> {
         s: &'a mut Scratch,
         report: SharpenReport,
     ) -> Run<'a> {
+        // The output's positions in the memory of an output given back, if any.
+        let positions = take_spare(&mut s.spare_positions);
         Run {
             mesh,
             table,
             opts,
             s,
             report,
-            positions: Vec::new(),
+            positions,
             max_edge: 0.0,
             mean_edge: 0.0,
             weld_patch: None,
@@ -2728,6 +2790,67 @@ mod tests {
             moved_somewhere,
             "no corner vertex moved: the test tests nothing"
         );
+    }
+
+    /// An output given back is where the next run writes its mesh and parents (no fresh
+    /// memory), and the output is the same bit for bit; so is a two-pass run, whose first
+    /// pass's arrays are kept once the second is composed with it.
+    #[test]
+    fn a_recycled_output_holds_the_next_one_unchanged() {
+        use glam::DQuat;
+        use whet_synth::{marching_cubes, Shape, ShapeKind, ShapeParams};
+        let rotation = DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.5);
+        let shape = Shape::new(
+            ShapeKind::Fandisk,
+            &ShapeParams::default().with_rotation(rotation),
+        )
+        .unwrap();
+        let mesh = marching_cubes(&shape, 40).unwrap();
+        for passes in [1, 2] {
+            let opts = SharpenOptions::DEFAULT.with_passes(passes);
+            let fresh = EdgeSharpener::new(opts).sharpen(&mesh).unwrap();
+            assert!(fresh.report.new_vertices > 0, "nothing sharpened");
+            let mut engine = EdgeSharpener::new(opts);
+            let first = engine.sharpen(&mesh).unwrap();
+            let (positions, triangles, parents) = (
+                first.mesh.positions.as_ptr(),
+                first.mesh.triangles.as_ptr(),
+                first.parents.as_ptr(),
+            );
+            engine.recycle(first);
+            let second = engine.sharpen(&mesh).unwrap();
+            let bits = |m: &Mesh| -> Vec<[u64; 3]> {
+                m.positions
+                    .iter()
+                    .map(|p| p.to_array().map(f64::to_bits))
+                    .collect()
+            };
+            assert_eq!(bits(&second.mesh), bits(&fresh.mesh), "{passes} passes");
+            assert_eq!(second.mesh.triangles, fresh.mesh.triangles);
+            assert_eq!(second.parents, fresh.parents);
+            assert_eq!(second.tags, fresh.tags);
+            if passes == 1 {
+                assert_eq!(second.mesh.positions.as_ptr(), positions);
+                assert_eq!(second.mesh.triangles.as_ptr(), triangles);
+                assert_eq!(second.parents.as_ptr(), parents);
+            } else {
+                // A two-pass run keeps its first pass's arrays once it has composed the
+                // second with them; given its output back, the engine holds an array of
+                // each kind for each pass, and the next run's output is in one of them.
+                assert_eq!(engine.scratch.spare_positions.len(), 1);
+                engine.recycle(second);
+                assert_eq!(engine.scratch.spare_positions.len(), SPARE_OUTPUTS);
+                let held: Vec<*const DVec3> = engine
+                    .scratch
+                    .spare_positions
+                    .iter()
+                    .map(|v| v.as_ptr())
+                    .collect();
+                let third = engine.sharpen(&mesh).unwrap();
+                assert!(held.contains(&third.mesh.positions.as_ptr()));
+                assert_eq!(bits(&third.mesh), bits(&fresh.mesh));
+            }
+        }
     }
 
     /// On marching cubes a label holding a single triangle of a vertex's fan takes its plane

@@ -995,8 +995,11 @@ impl Output {
                 .len()
                 .saturating_sub(p.welded.mesh.triangles.len())
         });
-        let mut tris = Vec::with_capacity(self.tris.len() + spare);
-        let mut parents = Vec::with_capacity(self.tris.len() + spare);
+        // In the memory of an output given back, if any (`EdgeSharpener::recycle`).
+        let mut tris = crate::edge_sharpener::take_spare(&mut run.s.spare_triangles);
+        tris.reserve(self.tris.len() + spare);
+        let mut parents = crate::edge_sharpener::take_spare(&mut run.s.spare_parents);
+        parents.reserve(self.tris.len() + spare);
         // The output triangles holding a new vertex (the pieces: a few percent), renumbered
         // below without a second pass over all of them.
         let mut pieces: Vec<u32> = Vec::new();
