@@ -2730,6 +2730,18 @@ mod tests {
     use super::*;
     use whet_mesh::angle_between;
 
+    /// The tables' first generic rotation (`examples/support`).
+    fn turn() -> glam::DQuat {
+        glam::DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.5)
+    }
+
+    /// Marching cubes of the synth shape `kind` turned by [`turn`], at `res` cells.
+    fn turned_sampling(kind: whet_synth::ShapeKind, res: usize) -> Mesh {
+        use whet_synth::{marching_cubes, Shape, ShapeParams};
+        let shape = Shape::new(kind, &ShapeParams::default().with_rotation(turn())).unwrap();
+        marching_cubes(&shape, res).unwrap()
+    }
+
     /// A run's state over `mesh`, with its own scratch.
     fn with_run<R>(mesh: &Mesh, opts: &SharpenOptions, f: impl FnOnce(&mut Run) -> R) -> R {
         let table = CornerTable::new(mesh).unwrap();
@@ -2742,17 +2754,14 @@ mod tests {
     /// them gives the flags and counts that recomputing them over the whole mesh gives.
     #[test]
     fn the_chamfer_update_around_corner_vertices_matches_a_full_pass() {
-        use glam::DQuat;
-        use whet_synth::{marching_cubes, Shape, ShapeKind, ShapeParams};
-        let rotation = DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.5);
+        use whet_synth::ShapeKind;
         let mut moved_somewhere = false;
         for (kind, res) in [
             (ShapeKind::Cube, 16),
             (ShapeKind::Fandisk, 40),
             (ShapeKind::Pyramid, 24),
         ] {
-            let shape = Shape::new(kind, &ShapeParams::default().with_rotation(rotation)).unwrap();
-            let mesh = marching_cubes(&shape, res).unwrap();
+            let mesh = turned_sampling(kind, res);
             let opts = SharpenOptions::DEFAULT;
             with_run(&mesh, &opts, |run| {
                 let nt = run.mesh.triangles.len();
@@ -2797,15 +2806,7 @@ mod tests {
     /// pass's arrays are kept once the second is composed with it.
     #[test]
     fn a_recycled_output_holds_the_next_one_unchanged() {
-        use glam::DQuat;
-        use whet_synth::{marching_cubes, Shape, ShapeKind, ShapeParams};
-        let rotation = DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.5);
-        let shape = Shape::new(
-            ShapeKind::Fandisk,
-            &ShapeParams::default().with_rotation(rotation),
-        )
-        .unwrap();
-        let mesh = marching_cubes(&shape, 40).unwrap();
+        let mesh = turned_sampling(whet_synth::ShapeKind::Fandisk, 40);
         for passes in [1, 2] {
             let opts = SharpenOptions::DEFAULT.with_passes(passes);
             let fresh = EdgeSharpener::new(opts).sharpen(&mesh).unwrap();
@@ -2858,15 +2859,8 @@ mod tests {
     /// the true face than the lone triangle, which marching cubes tilts at the crease.
     #[test]
     fn lone_triangle_labels_take_a_plane_nearer_their_face() {
-        use glam::DQuat;
-        use whet_synth::{marching_cubes, Shape, ShapeKind, ShapeParams};
-        let rotation = DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.5);
-        let shape = Shape::new(
-            ShapeKind::Cube,
-            &ShapeParams::default().with_rotation(rotation),
-        )
-        .unwrap();
-        let mesh = marching_cubes(&shape, 32).unwrap();
+        let rotation = turn();
+        let mesh = turned_sampling(whet_synth::ShapeKind::Cube, 32);
         // The cube's six face normals, turned with it.
         let faces: Vec<DVec3> = [DVec3::X, DVec3::Y, DVec3::Z]
             .into_iter()
