@@ -163,6 +163,40 @@ impl DecodedSharpened {
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn decode_sharpened(bytes: &[u8], opts: &DecodeOptions) -> Result<DecodedSharpened, Error> {
+    decode_sharpened_with(
+        bytes,
+        opts,
+        &mut whet_sharpen::EdgeSharpener::new(whet_sharpen::SharpenOptions::DEFAULT),
+    )
+}
+
+/// [`decode_sharpened`] with `sharpener`, an engine kept from stream to stream by a server
+/// that decodes many: its working memory (the tables, the run's arrays) serves every call,
+/// and an output given back to it (`sharpener.recycle(out.sharpened)` once done with a
+/// [`DecodedSharpened::Sharpened`]) holds the next one. Each stream's own sharpening
+/// options are set on it. The output is [`decode_sharpened`]'s.
+///
+/// ```
+/// let mesh = whet::io::read_path(&whet_testkit::shared_fixture("fandisk.off"), None)?;
+/// let opts = whet_swing::SwingOptions::DEFAULT.with_rate(whet_swing::Rate::BitsPerVertex(2.0));
+/// let stream = whet_swing::encode(&mesh, &opts)?.bytes;
+/// let mut sharpener = whet::sharpen::EdgeSharpener::new(whet::sharpen::SharpenOptions::DEFAULT);
+/// for _ in 0..2 {
+///     match whet::decode_sharpened_with(&stream, &whet::DecodeOptions::DEFAULT, &mut sharpener)? {
+///         whet::DecodedSharpened::Sharpened(out) => {
+///             assert!(out.sharpened.mesh.triangles.len() > 1000);
+///             sharpener.recycle(out.sharpened);
+///         }
+///         whet::DecodedSharpened::Unsharpened(mesh) => assert!(mesh.triangles.len() > 1000),
+///     }
+/// }
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn decode_sharpened_with(
+    bytes: &[u8],
+    opts: &DecodeOptions,
+    sharpener: &mut whet_sharpen::EdgeSharpener,
+) -> Result<DecodedSharpened, Error> {
     let container = whet_format::parse(bytes, &opts.limits).map_err(whet_codec::Error::from)?;
     let stated = StatedSharpening::of(&container.header)?;
     // The container parsed above, decoded without parsing (and checking) it again; a subdiv
@@ -178,7 +212,7 @@ pub fn decode_sharpened(bytes: &[u8], opts: &DecodeOptions) -> Result<DecodedSha
         return Ok(DecodedSharpened::Unsharpened(decode_parsed(opts)?));
     }
     let raw = decode_parsed(&opts.with_surface_filter(false))?;
-    Ok(match stated.apply(&raw)? {
+    Ok(match stated.apply_with(&raw, sharpener)? {
         Some(out) => DecodedSharpened::Sharpened(Box::new(out)),
         // `apply` sharpens every stream that does not state "none" (handled above).
         None => DecodedSharpened::Unsharpened(raw),

@@ -1147,6 +1147,63 @@ fn the_library_decodes_and_sharpens_as_the_cli_does() {
     );
 }
 
+/// One engine kept from stream to stream (`whet::decode_sharpened_with`, each output given
+/// back to it) decodes every stream as a fresh engine does, in any order: a stream stating
+/// its own sharpening and projections, one stating none (EdgeSharpener's defaults) and one
+/// stating the papers' method at another smooth factor in two passes.
+#[test]
+fn a_kept_engine_decodes_stream_after_stream_as_fresh_ones_do() {
+    let dir = scratch_dir("cli-decode-sharpened-kept-engine");
+    // Read before the next encode, which writes the same path.
+    let stated = std::fs::read(cube_encoded_for_sharpening(&dir).1).unwrap();
+    let (plain_path, container) = plain_cube_stream(&dir);
+    let plain = std::fs::read(plain_path).unwrap();
+    // The plain stream stating the papers' method at smooth factor 1.5, in two passes.
+    let mut papers = container.clone();
+    papers.header = papers
+        .header
+        .clone()
+        .with(
+            whet_format::tag::SHARPEN_METHOD,
+            whet_codec::SharpenHint::Papers.code(),
+        )
+        .with(whet_format::tag::SHARPEN_SMOOTH_FACTOR, 150u64)
+        .with(whet_format::tag::SHARPEN_PASSES, 2u64);
+    let papers = papers.to_bytes().unwrap();
+    let options_of = |bytes: &[u8]| {
+        let header = whet_format::parse(bytes, &whet_format::Limits::DEFAULT)
+            .unwrap()
+            .header;
+        whet::StatedSharpening::of(&header).unwrap().options()
+    };
+    assert_eq!(options_of(&plain), whet::sharpen::SharpenOptions::DEFAULT);
+    assert_ne!(options_of(&papers), options_of(&plain));
+    let streams = [stated, plain, papers];
+    let opts = whet::DecodeOptions::DEFAULT;
+    let mut engine = whet::sharpen::EdgeSharpener::new(whet::sharpen::SharpenOptions::DEFAULT);
+    let bits = |m: &whet_mesh::Mesh| -> Vec<[u64; 3]> {
+        m.positions
+            .iter()
+            .map(|p| p.to_array().map(f64::to_bits))
+            .collect()
+    };
+    let order = [0, 2, 1, 2, 0];
+    for (round, bytes) in order.iter().map(|&i| &streams[i]).enumerate() {
+        let fresh = whet::decode_sharpened(bytes, &opts).unwrap();
+        let kept = whet::decode_sharpened_with(bytes, &opts, &mut engine).unwrap();
+        assert_eq!(
+            kept.mesh().triangles,
+            fresh.mesh().triangles,
+            "round {round}"
+        );
+        assert_eq!(bits(kept.mesh()), bits(fresh.mesh()), "round {round}");
+        let whet::DecodedSharpened::Sharpened(out) = kept else {
+            panic!("round {round}: both streams are sharpened");
+        };
+        engine.recycle(out.sharpened);
+    }
+}
+
 /// `whet::decode_sharpened` on bad streams: a truncated stream and a malformed snap-veto
 /// field (header field 33) are input errors, never a panic or a mesh.
 #[test]

@@ -324,6 +324,13 @@ impl EdgeSharpener {
         &self.options
     }
 
+    /// Runs from now on with `options`, keeping the memory of the runs before: a server whose
+    /// meshes each come with their own options (a swing stream states its sharpening) keeps
+    /// one engine.
+    pub fn set_options(&mut self, options: SharpenOptions) {
+        self.options = options;
+    }
+
     /// Sharpens `mesh`; see [`crate::sharpen`].
     pub fn sharpen(&mut self, mesh: &Mesh) -> Result<Sharpened, Error> {
         self.sharpen_with(mesh, None)

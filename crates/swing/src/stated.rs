@@ -8,7 +8,7 @@
 
 use whet_codec::{SharpenHint, SnapVetoes, SurfaceFilter};
 use whet_mesh::Mesh;
-use whet_sharpen::{Method, SharpenOptions, Sharpened, VetoReplay};
+use whet_sharpen::{EdgeSharpener, Method, SharpenOptions, Sharpened, VetoReplay};
 
 /// One of the projections a swing stream may state after sharpening, in the order they run.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -203,14 +203,25 @@ impl StatedSharpening {
     /// refuses as structurally broken is sharpened after `Mesh::make_manifold` (a swing
     /// stream always decodes to a manifold).
     pub fn apply(&self, decoded: &Mesh) -> Result<Option<StatedOutput>, whet_sharpen::Error> {
+        self.apply_with(decoded, &mut EdgeSharpener::new(self.options()))
+    }
+
+    /// [`Self::apply`] with `engine` (its options set to the stream's), whose memory serves
+    /// stream after stream: a server gives each output back to it
+    /// (`EdgeSharpener::recycle`) once done. The output is [`Self::apply`]'s.
+    pub fn apply_with(
+        &self,
+        decoded: &Mesh,
+        engine: &mut EdgeSharpener,
+    ) -> Result<Option<StatedOutput>, whet_sharpen::Error> {
         if self.is_unsharpened() {
             return Ok(None);
         }
-        let opts = self.options();
+        engine.set_options(self.options());
         let mut replay = self.veto_replay();
         let mut run = |m: &Mesh| match replay.as_mut() {
-            Some(r) => whet_sharpen::sharpen_judged(m, &opts, r),
-            None => whet_sharpen::sharpen(m, &opts),
+            Some(r) => engine.sharpen_judged(m, r),
+            None => engine.sharpen(m),
         };
         let mut sharpened = match run(decoded) {
             Err(whet_sharpen::Error::InvalidInput(e)) if e.is_structural() => {
