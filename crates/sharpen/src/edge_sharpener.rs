@@ -221,9 +221,14 @@ impl Scratch {
     /// Keeps `out`'s big arrays for the next runs' outputs (the largest [`SPARE_OUTPUTS`] of
     /// each kind).
     fn keep_output(&mut self, out: Sharpened) {
-        keep_spare(&mut self.spare_positions, out.mesh.positions);
-        keep_spare(&mut self.spare_triangles, out.mesh.triangles);
-        keep_spare(&mut self.spare_parents, out.parents);
+        self.keep_arrays(out.mesh, out.parents);
+    }
+
+    /// [`Self::keep_output`] for a mesh and its parents.
+    fn keep_arrays(&mut self, mesh: Mesh, parents: Vec<FaceId>) {
+        keep_spare(&mut self.spare_positions, mesh.positions);
+        keep_spare(&mut self.spare_triangles, mesh.triangles);
+        keep_spare(&mut self.spare_parents, parents);
     }
 }
 
@@ -536,9 +541,7 @@ impl EdgeSharpener {
         // clusters of an already sharp or smooth mesh are not the sharpener's business).
         if report.new_vertices == 0 && report.moved_input_vertices == 0 {
             // Its arrays serve the run on the input instead.
-            keep_spare(&mut self.scratch.spare_positions, out.positions);
-            keep_spare(&mut self.scratch.spare_triangles, out.triangles);
-            keep_spare(&mut self.scratch.spare_parents, parents);
+            self.scratch.keep_arrays(out, parents);
             return None;
         }
         let restored = crate::weld::restore_untouched(
