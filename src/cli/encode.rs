@@ -400,6 +400,7 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh, skipped: &whet::io::ReadRepor
                 "quadric": t.quadric,
                 "beside": t.beside,
                 "crease": t.crease,
+                "apex": t.apex,
                 "sharpened_filter": t.sharpened_filter,
             })
         })
@@ -474,6 +475,7 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh, skipped: &whet::io::ReadRepor
             "quadric_projection": out.quadric_factor,
             "beside_projection": out.beside_factor,
             "crease_projection": out.crease_factor,
+            "apex_projection": out.apex_factor,
             "sharpen_input_max_error_pct": out.sharpen_input_max_pct,
             "search": out.search.iter().map(|&(f, b)| json!([f, b])).collect::<Vec<_>>(),
             "angle_trials": out.angle_trials.iter().map(|t| json!({

@@ -1058,6 +1058,70 @@ fn decode_sharpen_applies_a_stated_crease_projection() {
     assert_eq!(projected.positions, expected.positions);
 }
 
+/// `whet decode --sharpen` applies the apex restoration a swing stream states (optional
+/// header field 39, in hundredths of the mean edge length) last: its output is the
+/// restoration of what the same stream decodes to without the field, and on a retiled cone
+/// it brings the vertex the retiling left under the apex up to it.
+#[test]
+fn decode_sharpen_restores_a_cut_cone_apex_when_the_stream_states_it() {
+    let dir = scratch_dir("cli-apex-projection");
+    let truth = dir.join("cone.off");
+    let o = whet(&[
+        "synth",
+        "cone",
+        "--truth",
+        s(&truth),
+        "-o",
+        s(&dir.join("mc.off")),
+        "--resolution",
+        "8",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stream = dir.join("cone.whet");
+    let o = whet(&[
+        "encode",
+        s(&truth),
+        "-o",
+        s(&stream),
+        "--edge-length",
+        "0.02",
+        "--angle-bits",
+        "6",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let container = whet_format::parse(
+        &std::fs::read(&stream).unwrap(),
+        &whet_format::Limits::DEFAULT,
+    )
+    .unwrap();
+    assert!(whet_codec::SharpenHint::apex_of(&container.header).is_none());
+    let plain = decode_sharpened_file(&dir, &stream, "plain.off");
+    let header = container
+        .header
+        .clone()
+        .with(whet_format::tag::APEX_PROJECTION, 150u64);
+    let stated = write_stating(&dir, &container, header);
+    let restored = decode_sharpened_file(&dir, &stated, "restored.off");
+    let mut expected = plain.clone();
+    let opts = whet_sharpen::ApexOptions::DEFAULT.with_max_move(1.5);
+    let report = whet_sharpen::restore_apexes(&mut expected, &opts).unwrap();
+    assert!(report.moved_vertices >= 1, "{report:?}");
+    assert_eq!(restored.triangles, expected.triangles);
+    assert_eq!(restored.positions, expected.positions);
+    // The synth cone's apex (radius 0.5, height 1, axis y): the retiling leaves its
+    // nearest vertex over half an edge (about 0.035) below it.
+    let apex = glam::DVec3::new(0.0, 0.5, 0.0);
+    let nearest = |m: &whet_mesh::Mesh| {
+        m.positions
+            .iter()
+            .map(|p| p.distance(apex))
+            .fold(f64::INFINITY, f64::min)
+    };
+    let (before, after) = (nearest(&plain), nearest(&restored));
+    assert!(before > 0.01, "the cut is {before} deep");
+    assert!(after < 0.3 * before, "{before} -> {after} from the apex");
+}
+
 /// `whet decode --sharpen` applies a stated one-sided quadric projection (header field 37,
 /// in hundredths of the angle step) after the other face projections and before the crease
 /// projection (field 35), whatever the fields' order in the header: its output is what the

@@ -167,6 +167,20 @@ impl SharpenHint {
             .map(|h| h as f64 / 100.0)
     }
 
+    /// The apex restoration a swing stream's header states for after sharpening and every
+    /// other projection (field 39): its move limit in mean edge lengths (the field's
+    /// hundredths over 100), for `whet_sharpen::ApexOptions::with_max_move`. `None` as for
+    /// [`Self::crease_of`].
+    pub fn apex_of(header: &whet_format::Header) -> Option<f64> {
+        if header.mode != whet_format::Mode::Swing {
+            return None;
+        }
+        header
+            .get_u64(whet_format::tag::APEX_PROJECTION)
+            .filter(|h| Self::SMOOTH_FACTOR_HUNDREDTHS.contains(h))
+            .map(|h| h as f64 / 100.0)
+    }
+
     /// A swing header's field `tag` as a factor in hundredths of the angle step, with the
     /// stream's angle bits.
     fn angle_step_factor(header: &whet_format::Header, tag: u64) -> Option<(f64, u32)> {
@@ -233,6 +247,23 @@ mod tests {
         let exact = whet_format::Header::new(whet_format::Mode::Exact, 3, 1)
             .with(whet_format::tag::CREASE_PROJECTION, 25u64);
         assert_eq!(SharpenHint::crease_of(&exact), None);
+    }
+
+    #[test]
+    fn apex_projection_is_read_from_swing_headers_only_and_in_range() {
+        let swing = whet_format::Header::new(whet_format::Mode::Swing, 3, 1);
+        assert_eq!(SharpenHint::apex_of(&swing), None);
+        let on = swing
+            .clone()
+            .with(whet_format::tag::APEX_PROJECTION, 150u64);
+        assert_eq!(SharpenHint::apex_of(&on), Some(1.5));
+        for bad in [0u64, 1001] {
+            let h = swing.clone().with(whet_format::tag::APEX_PROJECTION, bad);
+            assert_eq!(SharpenHint::apex_of(&h), None);
+        }
+        let exact = whet_format::Header::new(whet_format::Mode::Exact, 3, 1)
+            .with(whet_format::tag::APEX_PROJECTION, 150u64);
+        assert_eq!(SharpenHint::apex_of(&exact), None);
     }
 
     #[test]

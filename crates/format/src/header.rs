@@ -196,6 +196,10 @@ pub mod tag {
     /// projections and before the crease projection, its move limit in hundredths of the
     /// angle step (swing; absent, or outside 1..=1000: none).
     pub const BESIDE_PROJECTION: u64 = 37;
+    /// u64 (optional, added 2026-12-07): the apex restoration a decoder applies after
+    /// sharpening and every other projection, its move limit in hundredths of the mean edge
+    /// length (swing; absent, or outside 1..=1000: none).
+    pub const APEX_PROJECTION: u64 = 39;
     /// i64 (format 1.4): factor of `s2`, the one-ring mean of the filter's smoothed field,
     /// in the swing decoder's extended surface filter, in units of 1/1024 (swing; absent:
     /// 0). Required: a stream with it decodes to another mesh.
@@ -214,7 +218,7 @@ pub mod tag {
     pub const EXACT_PREDICTION: u64 = 40;
 
     /// Every tag this crate knows, with its name and value type.
-    pub const KNOWN: [(u64, &str, ValueType); 25] = [
+    pub const KNOWN: [(u64, &str, ValueType); 26] = [
         (ENCODER, "encoder", ValueType::Bytes),
         (COMPONENT_COUNT, "component_count", ValueType::U64),
         (QUANT_BITS, "quant_bits", ValueType::U64),
@@ -251,6 +255,7 @@ pub mod tag {
         (FILTER_QUADRATIC, "filter_quadratic", ValueType::I64),
         (BESIDE_PROJECTION, "beside_projection", ValueType::U64),
         (FILTER_TANGENTIAL, "filter_tangential", ValueType::I64),
+        (APEX_PROJECTION, "apex_projection", ValueType::U64),
         (EXACT_PREDICTION, "exact_prediction", ValueType::U64),
     ];
 

@@ -188,7 +188,7 @@ fn stated_name(s: &swing_inputs::SwingInput) -> String {
     match s.sharpen_hint {
         Some(SharpenHint::Unsharpened) => "none".to_string(),
         h => format!(
-            "{} {}{}{}{}{}{}{}{}",
+            "{} {}{}{}{}{}{}{}{}{}",
             h.map_or("extended", SharpenHint::name),
             s.smooth_factor,
             match s.curved_walls {
@@ -204,6 +204,7 @@ fn stated_name(s: &swing_inputs::SwingInput) -> String {
             if s.quadric { " + quadrics" } else { "" },
             if s.beside { " + beside" } else { "" },
             if s.crease { " + creases" } else { "" },
+            if s.apex { " + apexes" } else { "" },
             if s.after_filter { "" } else { " − filter" }
         ),
     }

@@ -13,7 +13,9 @@
 //! [`project_onto_local_quadrics`] does the same for curved faces, vertex by vertex,
 //! [`project_beside_creases_onto_local_quadrics`] for the face vertices beside a crease
 //! (from their own side only), and [`project_creases_onto_local_quadrics`] moves the vertices on crease lines onto the
-//! intersection of the quadrics fitted to their two sides.
+//! intersection of the quadrics fitted to their two sides; [`restore_apexes`] moves the
+//! vertex nearest a cut cone tip or corner onto the point where the tangent planes around
+//! it meet.
 //! See `docs/sharpen.md` for the rules and the degenerate cases.
 //!
 //! ```
@@ -33,6 +35,7 @@
 //! ```
 #![forbid(unsafe_code)]
 
+mod apex;
 mod beside;
 mod crease;
 mod edge_sharpener;
@@ -49,6 +52,7 @@ mod snap;
 mod tags;
 mod weld;
 
+pub use apex::{restore_apexes, ApexOptions, ApexReport};
 pub use beside::{project_beside_creases_onto_local_quadrics, BesideOptions, BesideReport};
 pub use crease::{project_creases_onto_local_quadrics, CreaseOptions, CreaseReport};
 pub use edge_sharpener::EdgeSharpener;

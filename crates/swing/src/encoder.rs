@@ -82,8 +82,11 @@ pub struct SharpenTrial {
     /// before it.
     pub beside: bool,
     /// With the crease projection after those (optional header field 35, at
-    /// [`CREASE_MOVE`]): tried last, with the projections kept before it.
+    /// [`CREASE_MOVE`]): tried with the projections kept before it.
     pub crease: bool,
+    /// With the apex restoration after those (optional header field 39, at [`APEX_MOVE`]):
+    /// tried last, with the projections kept before it.
+    pub apex: bool,
     /// With the stream's surface filter for after sharpening (header fields 17 and 19)
     /// applied: true but for the chosen sharpening tried without it (a stream whose filter
     /// the encoder fitted to zero counts as with it).
@@ -142,6 +145,12 @@ pub const BESIDE_FACTOR: f64 = 0.25;
 /// whet-sharpen), 0.5 gained the most and raised no row's max (docs/results.md, "Crease
 /// projection").
 pub const CREASE_MOVE: f64 = 0.5;
+
+/// The apex restoration's move limit, in mean edge lengths, that the encoder tries after
+/// every other projection (`whet_sharpen::ApexOptions`; docs/swing.md section 2): a uniform
+/// retiling cuts a cone's tip or a corner by under an edge (0.6-1.1 edges on the synth
+/// cone's swing streams), so 1.5 takes every cut and refuses fits gone far.
+pub const APEX_MOVE: f64 = 1.5;
 
 /// Options of [`SwingEncoder`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -343,6 +352,9 @@ pub struct SwingOutput {
     /// The crease projection after those the stream states (optional header field 35: its
     /// move limit in mean edge lengths), when the encoder measured it better.
     pub crease_factor: Option<f64>,
+    /// The apex restoration after those the stream states (optional header field 39: its
+    /// move limit in mean edge lengths), when the encoder measured it better.
+    pub apex_factor: Option<f64>,
     /// The candidates of that choice with their measured symmetric RMS error (% of the
     /// diagonal; empty when no choice was made).
     pub sharpen_trials: Vec<SharpenTrial>,
@@ -674,6 +686,7 @@ impl SwingEncoder {
             quadric: false,
             beside: false,
             crease: false,
+            apex: false,
             sharpened_filter: true,
         };
         // Candidates whose output is the same mesh (curved walls that turn no edge smooth, a
@@ -893,8 +906,9 @@ impl SwingEncoder {
     /// its measured trial), each kept when it beats what it refines by the margin within
     /// `bounds`: first the planar one (the flat faces' quantization noise, which the
     /// sharpener leaves), then the local quadric one (that of the curved faces), the
-    /// one-sided one (that of the faces beside creases) and the crease one (docs/swing.md
-    /// section 2). Every trial goes to `trials`; returns the stream and trial that stand.
+    /// one-sided one (that of the faces beside creases), the crease one and the apex
+    /// restoration (docs/swing.md section 2). Every trial goes to `trials`; returns the
+    /// stream and trial that stand.
     #[allow(clippy::too_many_arguments)]
     fn project_after_sharpening(
         &self,
@@ -907,11 +921,12 @@ impl SwingEncoder {
         trials: &mut Vec<SharpenTrial>,
     ) -> Result<(SwingOutput, SharpenTrial), Error> {
         let (mut chosen, mut current) = start;
-        let restated: [fn(SwingOutput) -> Result<SwingOutput, Error>; 4] = [
+        let restated: [fn(SwingOutput) -> Result<SwingOutput, Error>; 5] = [
             |o| restate_planar(o, PLANAR_FACTOR),
             |o| restate_quadric(o, QUADRIC_FACTOR),
             |o| restate_beside(o, BESIDE_FACTOR),
             |o| restate_crease(o, CREASE_MOVE),
+            |o| restate_apex(o, APEX_MOVE),
         ];
         for (k, restate) in restated.iter().enumerate() {
             let projected = restate(chosen.clone())?;
@@ -923,7 +938,8 @@ impl SwingEncoder {
                 planar: current.planar || k == 0,
                 quadric: current.quadric || k == 1,
                 beside: current.beside || k == 2,
-                crease: k == 3,
+                crease: current.crease || k == 3,
+                apex: k == 4,
                 ..current
             };
             trials.push(trial);
@@ -1217,6 +1233,7 @@ impl SwingEncoder {
                 quadric_factor: None,
                 beside_factor: None,
                 crease_factor: None,
+                apex_factor: None,
                 sharpen_trials: Vec::new(),
                 sharpen_input_max_pct: None,
                 snap_vetoes: None,
@@ -1473,6 +1490,8 @@ impl SwingEncoder {
                     }),
                     out.crease_factor
                         .map(|max_move| StatedProjection::Crease { max_move }),
+                    out.apex_factor
+                        .map(|max_move| StatedProjection::Apex { max_move }),
                 ];
                 for p in projections.into_iter().flatten() {
                     // The sharpened mesh is a manifold; were it refused, the decoder keeps it
@@ -1791,6 +1810,7 @@ impl Candidate {
             quadric: false,
             beside: false,
             crease: false,
+            apex: false,
             sharpened_filter: true,
         }
     }
@@ -1906,6 +1926,18 @@ fn restate_crease(mut out: SwingOutput, max_move: f64) -> Result<SwingOutput, Er
     out.bytes = with_header_field(&out.bytes, whet_format::tag::CREASE_PROJECTION, code)?;
     out.report.bytes = out.bytes.len();
     out.crease_factor = Some(code as f64 / 100.0);
+    Ok(out)
+}
+
+/// `out` with header field 39 stating the apex restoration at a move limit of `max_move`
+/// mean edge lengths (rounded to the field's hundredths). Like field 25, its bytes come
+/// after the size search.
+fn restate_apex(mut out: SwingOutput, max_move: f64) -> Result<SwingOutput, Error> {
+    let code = SharpenHint::smooth_factor_code(max_move)
+        .ok_or_else(|| Error::Internal(format!("apex move {max_move} out of range")))?;
+    out.bytes = with_header_field(&out.bytes, whet_format::tag::APEX_PROJECTION, code)?;
+    out.report.bytes = out.bytes.len();
+    out.apex_factor = Some(code as f64 / 100.0);
     Ok(out)
 }
 

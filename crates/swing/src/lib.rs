@@ -30,7 +30,7 @@ mod surface;
 
 pub use encoder::{
     encode, valence6_fraction, AngleTrial, ErrorOf, Rate, SharpenTrial, SwingEncoder, SwingOptions,
-    SwingOutput, BESIDE_FACTOR, CREASE_MOVE, CURVED_WALL_FACTOR, MAX_COVERAGE_GAP,
+    SwingOutput, APEX_MOVE, BESIDE_FACTOR, CREASE_MOVE, CURVED_WALL_FACTOR, MAX_COVERAGE_GAP,
     MAX_ERROR_WEIGHT, PLANAR_FACTOR, QUADRIC_FACTOR, TWO_PASSES,
 };
 pub use filter_fit::{fit_displacements, fit_filters, fit_surface_filter, FilterFit};

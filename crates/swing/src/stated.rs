@@ -1,7 +1,7 @@
 //! The decoder's side of what a swing stream states about its sharpening (docs/swing.md
 //! section 2): the method, smooth factor, curved walls and passes its encoder measured best
 //! (`SharpenHint`), the snaps it vetoed (field 33), its filter for after sharpening, and the
-//! projections after that (fields 25, 31, 37 and 35, in that order). `whet decode --sharpen`, `whet rd` and the
+//! projections after that (fields 25, 31, 37, 35 and 39, in that order). `whet decode --sharpen`, `whet rd` and the
 //! sharpening figures all read a header through [`StatedSharpening`], and the encoder
 //! measures its projections through [`StatedProjection`], so what the encoder measured is
 //! what every decoder writes.
@@ -27,6 +27,10 @@ pub enum StatedProjection {
     /// (`whet_sharpen::project_creases_onto_local_quadrics`), moves of at most `max_move`
     /// mean edge lengths.
     Crease { max_move: f64 },
+    /// Field 39: the vertex nearest each cut apex or corner onto the point where the
+    /// tangent planes around it meet (`whet_sharpen::restore_apexes`), moves of at most
+    /// `max_move` mean edge lengths; runs last.
+    Apex { max_move: f64 },
 }
 
 impl StatedProjection {
@@ -46,6 +50,9 @@ impl StatedProjection {
         if let Some(max_move) = SharpenHint::crease_of(header) {
             projections.push(StatedProjection::Crease { max_move });
         }
+        if let Some(max_move) = SharpenHint::apex_of(header) {
+            projections.push(StatedProjection::Apex { max_move });
+        }
         projections
     }
 
@@ -56,6 +63,7 @@ impl StatedProjection {
             StatedProjection::Quadric { .. } => "local quadric",
             StatedProjection::Beside { .. } => "beside-crease quadric",
             StatedProjection::Crease { .. } => "crease",
+            StatedProjection::Apex { .. } => "apex",
         }
     }
 
@@ -78,6 +86,10 @@ impl StatedProjection {
             StatedProjection::Crease { max_move } => {
                 let opts = whet_sharpen::CreaseOptions::DEFAULT.with_max_move(max_move);
                 whet_sharpen::project_creases_onto_local_quadrics(mesh, &opts).map(|_| ())
+            }
+            StatedProjection::Apex { max_move } => {
+                let opts = whet_sharpen::ApexOptions::DEFAULT.with_max_move(max_move);
+                whet_sharpen::restore_apexes(mesh, &opts).map(|_| ())
             }
         }
     }
@@ -247,8 +259,9 @@ mod tests {
     use whet_format::{tag, Header, Mode};
 
     #[test]
-    fn projections_run_planar_quadric_beside_then_crease_whatever_the_field_order() {
+    fn projections_run_planar_quadric_beside_crease_then_apex_whatever_the_field_order() {
         let h = Header::new(Mode::Swing, 3, 1)
+            .with(tag::APEX_PROJECTION, 150u64)
             .with(tag::ANGLE_BITS, 7u64)
             .with(tag::BESIDE_PROJECTION, 25u64)
             .with(tag::CREASE_PROJECTION, 50u64)
@@ -270,6 +283,7 @@ mod tests {
                     angle_bits: 7
                 },
                 StatedProjection::Crease { max_move: 0.5 },
+                StatedProjection::Apex { max_move: 1.5 },
             ]
         );
         let names: Vec<_> = StatedProjection::all_of(&h)
@@ -282,7 +296,8 @@ mod tests {
                 "planar-region",
                 "local quadric",
                 "beside-crease quadric",
-                "crease"
+                "crease",
+                "apex"
             ]
         );
         // An exact stream states none, whatever its fields.

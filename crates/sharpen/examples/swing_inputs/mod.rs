@@ -78,6 +78,8 @@ pub struct SwingInput {
     pub beside: bool,
     /// The stream states the crease projection (field 35).
     pub crease: bool,
+    /// The stream states the apex restoration (field 39).
+    pub apex: bool,
     /// The stream carries a filter for after sharpening (fields 17 and 19).
     pub after_filter: bool,
     /// The stream.
@@ -125,7 +127,8 @@ impl SwingInput {
             whet_swing::StatedProjection::Planar { .. } => Projections::Planar,
             whet_swing::StatedProjection::Quadric { .. } => Projections::Quadric,
             whet_swing::StatedProjection::Beside { .. } => Projections::Beside,
-            whet_swing::StatedProjection::Crease { .. } => Projections::All,
+            whet_swing::StatedProjection::Crease { .. }
+            | whet_swing::StatedProjection::Apex { .. } => Projections::All,
         };
         for p in stated.projections.iter().filter(|p| rank(p) <= last) {
             p.apply(&mut m).unwrap_or_else(|e| panic!("{e}"));
@@ -243,11 +246,11 @@ pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
 }
 
 /// Encodes `original` at `rate` and decodes it; `key` names the stream in the cache
-/// (`target/sharpen-swing/v44-<key>-<angles>.whet`).
+/// (`target/sharpen-swing/v45-<key>-<angles>.whet`).
 pub fn swing_input_of(original: Mesh, key: &str, rate: Rate, angles: Angles) -> SwingInput {
     let dir = whet_testkit::workspace_root().join("target/sharpen-swing");
     let _ = std::fs::create_dir_all(&dir);
-    let path = dir.join(format!("v44-{key}-{}.whet", angles.tag()));
+    let path = dir.join(format!("v45-{key}-{}.whet", angles.tag()));
     let bytes = match std::fs::read(&path) {
         Ok(b) => b,
         Err(_) => {
@@ -286,6 +289,7 @@ pub fn swing_input_of(original: Mesh, key: &str, rate: Rate, angles: Angles) -> 
         quadric: whet_codec::SharpenHint::quadric_of(&header).is_some(),
         beside: whet_codec::SharpenHint::beside_of(&header).is_some(),
         crease: whet_codec::SharpenHint::crease_of(&header).is_some(),
+        apex: whet_codec::SharpenHint::apex_of(&header).is_some(),
         original,
         decoded,
         bytes,

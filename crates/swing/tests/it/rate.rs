@@ -238,21 +238,24 @@ fn automatic_angle_bits_climb_on_flat_parts_and_stay_low_on_smooth_ones() {
     // them refined: 2 neighbours without curved walls, 8 with, and itself in one more
     // pass; and none), then tried the
     // chosen one with the planar-region projection, the local quadric one, the one-sided
-    // one beside creases and the crease one, and without its filter for after sharpening.
+    // one beside creases, the crease one and the apex restoration, and without its filter
+    // for after sharpening.
     let unprojected = out
         .sharpen_trials
         .iter()
-        .filter(|t| !t.planar && !t.quadric && !t.beside && !t.crease && t.sharpened_filter)
+        .filter(|t| {
+            !t.planar && !t.quadric && !t.beside && !t.crease && !t.apex && t.sharpened_filter
+        })
         .count();
     assert!(
         [25, 28, 34].contains(&unprojected),
         "{:?}",
         out.sharpen_trials
     );
-    // (Plus four projections, and the chosen sharpening without its filter for after
-    // sharpening with its four.)
+    // (Plus five projections, and the chosen sharpening without its filter for after
+    // sharpening with its five.)
     assert!(
-        out.sharpen_trials.len() <= unprojected + 9,
+        out.sharpen_trials.len() <= unprojected + 11,
         "{:?}",
         out.sharpen_trials
     );
@@ -347,14 +350,15 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
         // it), the grid's best refined (its neighbours in smooth factor and curved walls,
         // then itself in one more pass),
         // no sharpening; then the chosen sharpening refined by the planar-region projection,
-        // by the local quadric one and by the crease one (each on top of those kept before
-        // it); then, when its stream carried a filter for after sharpening, the same without
-        // that filter, and its three projections.
+        // by the local quadric one, the one beside creases, the crease one and the apex
+        // restoration (each on top of those kept before it); then, when its stream carried
+        // a filter for after sharpening, the same without that filter, and its five
+        // projections.
         use whet_swing::SharpenTrial;
-        let (trials, refined): (Vec<&SharpenTrial>, Vec<_>) = out
-            .sharpen_trials
-            .iter()
-            .partition(|t| t.sharpened_filter && !t.planar && !t.quadric && !t.beside && !t.crease);
+        let (trials, refined): (Vec<&SharpenTrial>, Vec<_>) =
+            out.sharpen_trials.iter().partition(|t| {
+                t.sharpened_filter && !t.planar && !t.quadric && !t.beside && !t.crease && !t.apex
+            });
         let input_max = out.sharpen_input_max_pct.unwrap();
         assert_eq!(
             trials.last().map(|t| t.hint),
@@ -399,8 +403,8 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
         let (with, bare): (Vec<&SharpenTrial>, Vec<_>) =
             refined.into_iter().partition(|t| t.sharpened_filter);
         let sharpened = hint != SharpenHint::Unsharpened;
-        assert_eq!(with.len(), if sharpened { 4 } else { 0 }, "{name}");
-        assert!(bare.is_empty() || (sharpened && bare.len() == 5), "{name}");
+        assert_eq!(with.len(), if sharpened { 5 } else { 0 }, "{name}");
+        assert!(bare.is_empty() || (sharpened && bare.len() == 6), "{name}");
         let h = header(&out.bytes);
         let stated = SharpenHint::planar_of(&h);
         assert_eq!(stated.map(|s| s.0), out.planar_factor, "{name}");
@@ -409,6 +413,7 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
         let stated = SharpenHint::beside_of(&h);
         assert_eq!(stated.map(|s| s.0), out.beside_factor, "{name}");
         assert_eq!(SharpenHint::crease_of(&h), out.crease_factor, "{name}");
+        assert_eq!(SharpenHint::apex_of(&h), out.apex_factor, "{name}");
         let (unprojected, chosen) = if sharpened {
             // The candidate the refinements start from: the same sharpening unprojected.
             let base = **trials
@@ -433,7 +438,8 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
                     assert_eq!(s.planar, current.planar || k == 0, "{name}: {s:?}");
                     assert_eq!(s.quadric, current.quadric || k == 1, "{name}: {s:?}");
                     assert_eq!(s.beside, current.beside || k == 2, "{name}: {s:?}");
-                    assert_eq!(s.crease, k == 3, "{name}: {s:?}");
+                    assert_eq!(s.crease, current.crease || k == 3, "{name}: {s:?}");
+                    assert_eq!(s.apex, k == 4, "{name}: {s:?}");
                     assert_eq!(s.sharpened_filter, start.sharpened_filter, "{name}");
                     if s.score() < 0.995 * current.score() && admit(s) {
                         current = **s;
@@ -444,7 +450,11 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
             let mut end = path_end(base, &with);
             if let Some((first, steps)) = bare.split_first() {
                 assert!(
-                    !first.planar && !first.quadric && !first.beside && !first.crease,
+                    !first.planar
+                        && !first.quadric
+                        && !first.beside
+                        && !first.crease
+                        && !first.apex,
                     "{name}"
                 );
                 let without = path_end(**first, steps);
@@ -457,6 +467,7 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
             assert_eq!(out.quadric_factor.is_some(), end.quadric, "{name}");
             assert_eq!(out.beside_factor.is_some(), end.beside, "{name}");
             assert_eq!(out.crease_factor.is_some(), end.crease, "{name}");
+            assert_eq!(out.apex_factor.is_some(), end.apex, "{name}");
             if let Some(f) = out.planar_factor {
                 assert_eq!(f, whet_swing::PLANAR_FACTOR);
             }
@@ -468,6 +479,9 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
             }
             if let Some(f) = out.crease_factor {
                 assert_eq!(f, whet_swing::CREASE_MOVE);
+            }
+            if let Some(f) = out.apex_factor {
+                assert_eq!(f, whet_swing::APEX_MOVE);
             }
             if !end.sharpened_filter {
                 assert!(out.sharpened_filter.is_none(), "{name}");
