@@ -10,7 +10,7 @@
 //! docs/sharpen.md, "Apex restoration".
 
 use glam::{DMat3, DVec3};
-use whet_mesh::{Mesh, VertexId};
+use whet_mesh::{CornerTable, Mesh, VertexId};
 
 use crate::planar::{checked_table, vertex_normals};
 use crate::Error;
@@ -164,7 +164,7 @@ impl PlanePoint {
     /// Adds the plane through `p` with unit normal `n`.
     fn add(&mut self, p: DVec3, n: DVec3) {
         let d = n.dot(p - self.origin);
-        self.m += DMat3::from_cols(n * n.x, n * n.y, n * n.z);
+        self.m += outer(n);
         self.b += n * d;
         self.c += d * d;
         self.count += 1;
@@ -188,6 +188,50 @@ impl PlanePoint {
         let sq = (x.dot(self.m * x) - 2.0 * self.b.dot(x) + self.c).max(0.0);
         Some((self.origin + x, (sq / k).sqrt()))
     }
+}
+
+/// `n n^T`.
+fn outer(n: DVec3) -> DMat3 {
+    DMat3::from_cols(n * n.x, n * n.y, n * n.z)
+}
+
+/// Gathers into `out`, breadth first from `v` and up to `rings` rings, the vertices that
+/// `admit` takes, reached across edges through taken vertices (`v` first, always taken);
+/// `stamp` marks the vertices seen, with `v`'s index. False, with `out` cut short, when a
+/// vertex past `max_points` would be taken.
+fn gather(
+    table: &CornerTable,
+    v: usize,
+    stamp: &mut [u32],
+    out: &mut Vec<u32>,
+    rings: usize,
+    max_points: usize,
+    mut admit: impl FnMut(usize) -> bool,
+) -> bool {
+    out.clear();
+    out.push(v as u32);
+    stamp[v] = v as u32;
+    let mut start = 0;
+    for _ in 0..rings {
+        let end = out.len();
+        if start == end {
+            break;
+        }
+        for i in start..end {
+            for c in table.vertex_corners(VertexId(out[i])) {
+                let w = table.vertex(table.next(c)).index();
+                if stamp[w] != v as u32 && admit(w) {
+                    stamp[w] = v as u32;
+                    if out.len() >= max_points {
+                        return false;
+                    }
+                    out.push(w as u32);
+                }
+            }
+        }
+        start = end;
+    }
+    true
 }
 
 /// The smallest eigenvalue of a symmetric 3x3 matrix (the trigonometric solution of its
@@ -239,7 +283,7 @@ pub fn restore_apexes(mesh: &mut Mesh, opts: &ApexOptions) -> Result<ApexReport,
     let mut median = band.clone();
     // (residual, vertex, point) of each fitted vertex.
     let mut fits: Vec<(f64, u32, DVec3)> = Vec::new();
-    'vertices: for v in 0..nv {
+    for v in 0..nv {
         let n = normals[v];
         let vid = VertexId(v as u32);
         if n == DVec3::ZERO || table.vertex_corner(vid).is_none() || table.is_boundary_vertex(vid) {
@@ -256,50 +300,29 @@ pub fn restore_apexes(mesh: &mut Mesh, opts: &ApexOptions) -> Result<ApexReport,
         // The two rings' normals must already spread over three directions: the tip of a
         // cut lies within an edge of the faces it joins, while the crease vertices that pass
         // the turn (most candidates) see two faces only. Cheaper than the band's gathering.
-        ring.clear();
-        ring.push(v as u32);
-        ring_stamp[v] = v as u32;
-        let mut start = 0;
-        for _ in 0..2 {
-            let end = ring.len();
-            for i in start..end {
-                for c in table.vertex_corners(VertexId(ring[i])) {
-                    let w = table.vertex(table.next(c)).index();
-                    if ring_stamp[w] != v as u32 {
-                        ring_stamp[w] = v as u32;
-                        ring.push(w as u32);
-                    }
-                }
-            }
-            start = end;
-        }
-        let tensor = ring.iter().fold(DMat3::ZERO, |t, &w| {
-            let m = normals[w as usize];
-            t + DMat3::from_cols(m * m.x, m * m.y, m * m.z)
+        gather(&table, v, &mut ring_stamp, &mut ring, 2, usize::MAX, |_| {
+            true
         });
+        let tensor = ring
+            .iter()
+            .fold(DMat3::ZERO, |t, &w| t + outer(normals[w as usize]));
         if smallest_eigenvalue(tensor * (1.0 / ring.len() as f64)) < MIN_RING_SPREAD {
             continue;
         }
         report.spread += 1;
         // Every vertex within the outer radius reached across edges from v through vertices
         // within it.
-        gathered.clear();
-        gathered.push(v as u32);
-        stamp[v] = v as u32;
-        let mut i = 0;
-        while i < gathered.len() {
-            let u = VertexId(gathered[i]);
-            i += 1;
-            for c in table.vertex_corners(u) {
-                let w = table.vertex(table.next(c)).index();
-                if stamp[w] != v as u32 && p[w].distance_squared(p[v]) <= outer_squared {
-                    stamp[w] = v as u32;
-                    if gathered.len() >= max_points {
-                        continue 'vertices;
-                    }
-                    gathered.push(w as u32);
-                }
-            }
+        let within = |w: usize| p[w].distance_squared(p[v]) <= outer_squared;
+        if !gather(
+            &table,
+            v,
+            &mut stamp,
+            &mut gathered,
+            usize::MAX,
+            max_points,
+            within,
+        ) {
+            continue;
         }
         // The band's point first: on most candidates (crease vertices, whose normals span
         // two directions) it is all there is to compute.
