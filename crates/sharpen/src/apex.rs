@@ -571,6 +571,23 @@ mod tests {
     }
 
     #[test]
+    fn a_cut_conical_pit_gets_its_apex_back() {
+        // The cut cone turned inside out (a countersink's or a drill point's hole): the
+        // tangent planes meet at the apex all the same.
+        let mut input = cut_cone(16, 8, 2.0, 1.0, 0.18, 0.0);
+        for t in &mut input.triangles {
+            t.swap(1, 2);
+        }
+        let edge = mean_edge(&input);
+        let apex = DVec3::new(0.0, 0.0, 2.0);
+        let mut out = input.clone();
+        let report = restore_apexes(&mut out, &ApexOptions::DEFAULT).unwrap();
+        assert_eq!(report.moved_vertices, 1, "{report:?}");
+        let after = out.positions[0].distance(apex);
+        assert!(after < 0.02 * edge, "{} edges off the apex", after / edge);
+    }
+
+    #[test]
     fn a_corner_pushed_in_goes_back_and_sharp_corners_stay() {
         use whet_synth::{midpoint_subdivide, Shape, ShapeKind, ShapeParams};
         // The pyramid's apex joins four faces, the cube's corners three.
