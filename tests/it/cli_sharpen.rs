@@ -392,9 +392,9 @@ fn decode_sharpen_follows_the_streams_hint() {
     // none, and kept the lowest
     // error; then the chosen sharpening once more with the planar-region projection, kept
     // when it beat it, once more with the local quadric projection on top, once more with
-    // the one-sided projection beside creases and once more with the crease projection on
-    // top of what was kept; then, when its stream carried a filter for after sharpening,
-    // the same five without that filter.
+    // the one-sided projection beside creases, once more with the crease projection and
+    // once more with the apex restoration on top of what was kept; then, when its stream
+    // carried a filter for after sharpening, the same six without that filter.
     let all = j["sharpen_trials"].as_array().unwrap();
     let with_filter = |t: &&serde_json::Value| t["sharpened_filter"] == true;
     let trials: Vec<_> = all
@@ -404,11 +404,12 @@ fn decode_sharpen_follows_the_streams_hint() {
                 && t["quadric"] == false
                 && t["beside"] == false
                 && t["crease"] == false
+                && t["apex"] == false
                 && with_filter(t)
         })
         .collect();
     let bare: Vec<_> = all.iter().filter(|t| !with_filter(t)).collect();
-    assert!(bare.is_empty() || bare.len() == 5, "{j}");
+    assert!(bare.is_empty() || bare.len() == 6, "{j}");
     // The stream states no filter for after sharpening when the path without it won.
     let stated_filter =
         j["sharpened_filter"]["normal"] != 0.0 || j["sharpened_filter"]["smoothed"] != 0.0;
@@ -421,22 +422,33 @@ fn decode_sharpen_follows_the_streams_hint() {
                 && t["quadric"] == false
                 && t["beside"] == false
                 && t["crease"] == false
+                && t["apex"] == false
         })
         .filter(|t| on_path(&t))
         .collect();
     let quadric: Vec<_> = all
         .iter()
-        .filter(|t| t["quadric"] == true && t["beside"] == false && t["crease"] == false)
+        .filter(|t| {
+            t["quadric"] == true
+                && t["beside"] == false
+                && t["crease"] == false
+                && t["apex"] == false
+        })
         .filter(|t| on_path(&t))
         .collect();
     let beside: Vec<_> = all
         .iter()
-        .filter(|t| t["beside"] == true && t["crease"] == false)
+        .filter(|t| t["beside"] == true && t["crease"] == false && t["apex"] == false)
         .filter(|t| on_path(&t))
         .collect();
     let crease: Vec<_> = all
         .iter()
-        .filter(|t| t["crease"] == true)
+        .filter(|t| t["crease"] == true && t["apex"] == false)
+        .filter(|t| on_path(&t))
+        .collect();
+    let apex: Vec<_> = all
+        .iter()
+        .filter(|t| t["apex"] == true)
         .filter(|t| on_path(&t))
         .collect();
     // The refined candidates: 2 around a grid best without curved walls, 8 with, and the
@@ -469,6 +481,14 @@ fn decode_sharpen_follows_the_streams_hint() {
     assert_eq!(quadric.len(), planar.len(), "{j}");
     assert_eq!(beside.len(), planar.len(), "{j}");
     assert_eq!(crease.len(), planar.len(), "{j}");
+    assert_eq!(apex.len(), planar.len(), "{j}");
+    // The apex trial, last, refines what every other decision kept.
+    if let Some(a) = apex.first() {
+        assert_eq!(a["planar"], !j["planar_tolerance"].is_null(), "{j}");
+        assert_eq!(a["quadric"], !j["quadric_projection"].is_null(), "{j}");
+        assert_eq!(a["beside"], !j["beside_projection"].is_null(), "{j}");
+        assert_eq!(a["crease"], !j["crease_projection"].is_null(), "{j}");
+    }
     // The crease trial refines what the planar, quadric and one-sided decisions kept.
     if let Some(c) = crease.first() {
         assert_eq!(c["planar"], !j["planar_tolerance"].is_null(), "{j}");
@@ -477,7 +497,7 @@ fn decode_sharpen_follows_the_streams_hint() {
     }
     // The stream states curved walls only where they are on.
     let chosen_walls = j["sharpen_curved_walls"].as_f64().unwrap_or(0.0);
-    let candidate_error = trials
+    let candidate = *trials
         .iter()
         .find(|t| {
             t["method"] == chosen
@@ -486,8 +506,8 @@ fn decode_sharpen_follows_the_streams_hint() {
                         && t["curved_walls"].as_f64() == Some(chosen_walls)
                         && t["passes"] == j["sharpen_passes"]))
         })
-        .map(|t| t["rms_error_pct"].as_f64().unwrap())
         .unwrap();
+    let candidate_error = candidate["rms_error_pct"].as_f64().unwrap();
     // What the projections refine: the chosen candidate, or the same without the filter.
     let chosen_error = if bare_won {
         assert_eq!(bare[0]["planar"], false, "{j}");
@@ -497,6 +517,29 @@ fn decode_sharpen_follows_the_streams_hint() {
         candidate_error
     };
     let mut reported = j["rms_error_pct"].as_f64().unwrap();
+    if !j["apex_projection"].is_null() {
+        // The reported error is the apex trial's; it won by the margin in score (RMS times
+        // max^0.25) over the trial it refined: the last projection trial with every other
+        // flag of it, or, when no projection was kept before it, the chosen sharpening
+        // (without its filter when that path won).
+        assert_eq!(j["apex_projection"].as_f64(), Some(1.5), "{j}");
+        let a = apex[0];
+        assert_eq!(Some(reported), a["rms_error_pct"].as_f64(), "{j}");
+        let flags = ["planar", "quadric", "beside", "crease"];
+        let refined = if flags.iter().any(|k| a[*k] == true) {
+            all.iter()
+                .filter(|t| on_path(&t) && t["apex"] == false)
+                .filter(|t| flags.iter().all(|k| t[*k] == a[*k]))
+                .last()
+                .unwrap()
+        } else if bare_won {
+            bare[0]
+        } else {
+            candidate
+        };
+        assert!(score(a) < 0.995 * score(refined), "{j}");
+        reported = refined["rms_error_pct"].as_f64().unwrap();
+    }
     // The error of what the one-sided trial refined: the last projection kept before it.
     let before_beside = match quadric.first() {
         Some(q) if !j["quadric_projection"].is_null() => q["rms_error_pct"].as_f64().unwrap(),
