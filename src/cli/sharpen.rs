@@ -66,6 +66,13 @@ pub struct SharpenArgs {
     /// whitespace (`#` starts a comment).
     #[arg(long)]
     select: Option<PathBuf>,
+    /// After sharpening, move the vertex nearest each cut cone tip or corner onto the point
+    /// where the tangent planes of the vertices 1.5 to 5 edges around it meet
+    /// (docs/sharpen.md, "Apex restoration"). Off by default: a rounded corner whose radius
+    /// is under the sampling is taken for a cut one (`whet decode --sharpen` applies it where
+    /// the stream's encoder measured a gain, header field 39).
+    #[arg(long)]
+    restore_apexes: bool,
     /// Write the sharp-edge tags (for `whet bend --tags`) to this file.
     #[arg(long)]
     tags: Option<PathBuf>,
@@ -162,7 +169,7 @@ pub fn run(args: &SharpenArgs) -> CliResult {
         None => opts,
     };
     opts.validate().map_err(Failure::input)?;
-    let out = match &args.select {
+    let mut out = match &args.select {
         None => run_sharpen(&mesh, &opts)?,
         Some(path) => {
             if opts.method != Method::NormalFilter {
@@ -178,6 +185,12 @@ pub fn run(args: &SharpenArgs) -> CliResult {
             })?;
             sharpen_region(&mesh, &opts, &region).map_err(Failure::input)?
         }
+    };
+    let apexes = if args.restore_apexes {
+        let opts = whet_sharpen::ApexOptions::DEFAULT;
+        Some(whet_sharpen::restore_apexes(&mut out.mesh, &opts).map_err(Failure::input)?)
+    } else {
+        None
     };
     write_mesh(
         &args.output,
@@ -215,8 +228,19 @@ pub fn run(args: &SharpenArgs) -> CliResult {
         );
     }
     if args.json {
-        let v: serde_json::Value = serde_json::from_str(&out.report.to_json())
+        let mut v: serde_json::Value = serde_json::from_str(&out.report.to_json())
             .map_err(|e| Failure::other(anyhow::Error::new(e)))?;
+        // null without --restore-apexes.
+        v["apex_restoration"] = match apexes {
+            Some(r) => serde_json::json!({
+                "candidates": r.candidates,
+                "spread": r.spread,
+                "fitted": r.fitted,
+                "moved_vertices": r.moved_vertices,
+                "refused_moves": r.refused_moves,
+            }),
+            None => serde_json::Value::Null,
+        };
         print_json(&v);
     } else {
         eprintln!(

@@ -1165,6 +1165,57 @@ fn decode_sharpen_restores_a_cut_cone_apex_when_the_stream_states_it() {
     assert!(after < 0.3 * before, "{before} -> {after} from the apex");
 }
 
+/// `whet sharpen --restore-apexes` brings the vertex nearest a marching-cubes cone's cut
+/// apex up to it after sharpening and reports it in the JSON (`apex_restoration`, null
+/// without the flag); the other vertices are the plain run's.
+#[test]
+fn sharpen_restores_a_cut_apex_on_request() {
+    let dir = scratch_dir("cli-sharpen-apexes");
+    let mc = dir.join("cone.off");
+    let o = whet(&[
+        "synth",
+        "cone",
+        "-o",
+        s(&mc),
+        "--resolution",
+        "48",
+        "--rotate",
+        "1,2,3,28.6479",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (plain, restored) = (dir.join("plain.off"), dir.join("restored.off"));
+    let j = whet_json(&["sharpen", s(&mc), "-o", s(&plain), "--json"]);
+    assert!(j["apex_restoration"].is_null(), "{j}");
+    let j = whet_json(&[
+        "sharpen",
+        s(&mc),
+        "-o",
+        s(&restored),
+        "--restore-apexes",
+        "--json",
+    ]);
+    assert_eq!(j["apex_restoration"]["moved_vertices"], 1, "{j}");
+    let plain = whet_io::read_path(&plain, None).unwrap();
+    let restored = whet_io::read_path(&restored, None).unwrap();
+    assert_eq!(plain.triangles, restored.triangles);
+    let moved: Vec<usize> = (0..plain.positions.len())
+        .filter(|&v| plain.positions[v] != restored.positions[v])
+        .collect();
+    assert_eq!(moved.len(), 1);
+    // The synth cone's apex (0, 0.5, 0), turned as the sampling was.
+    let turn = glam::DQuat::from_axis_angle(
+        glam::DVec3::new(1.0, 2.0, 3.0).normalize(),
+        28.6479f64.to_radians(),
+    );
+    let apex = turn * glam::DVec3::new(0.0, 0.5, 0.0);
+    let (before, after) = (
+        plain.positions[moved[0]].distance(apex),
+        restored.positions[moved[0]].distance(apex),
+    );
+    // Measured 2026-12-07: Metro max 1.316 -> 0.426 % of the diagonal at these settings.
+    assert!(after < 0.5 * before, "{before} -> {after} from the apex");
+}
+
 /// `whet decode --sharpen` applies a stated one-sided quadric projection (header field 37,
 /// in hundredths of the angle step) after the other face projections and before the crease
 /// projection (field 35), whatever the fields' order in the header: its output is what the
