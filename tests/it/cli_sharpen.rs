@@ -528,9 +528,9 @@ fn decode_sharpen_follows_the_streams_hint() {
         let flags = ["planar", "quadric", "beside", "crease"];
         let refined = if flags.iter().any(|k| a[*k] == true) {
             all.iter()
+                .rev()
                 .filter(|t| on_path(&t) && t["apex"] == false)
-                .filter(|t| flags.iter().all(|k| t[*k] == a[*k]))
-                .last()
+                .find(|t| flags.iter().all(|k| t[*k] == a[*k]))
                 .unwrap()
         } else if bare_won {
             bare[0]
