@@ -143,7 +143,7 @@ pub fn stated_vetoes(header: &whet_format::Header) -> CliResult<Option<whet_shar
 /// sharpening and of the stream's filter for after sharpening (docs/swing.md section 2).
 /// First the planar-region projection (optional header field 25), then the local quadric
 /// projection (field 31), then the one-sided quadric projection beside creases (field 37),
-/// then the crease projection (field 35). A mesh a projection refuses (it needs an oriented manifold, which
+/// then the crease projection (field 35), then the apex restoration (field 39). A mesh a projection refuses (it needs an oriented manifold, which
 /// sharpening gives) is kept as it is with a warning, as the encoder's measurement keeps
 /// it: the fields are optional refinements, not part of the decoded mesh.
 pub fn project_as_stated(header: &whet_format::Header, sharpened: &mut Mesh) {
