@@ -6,7 +6,8 @@
 //! `out.off` it also writes the sharpened mesh (a refactoring aid: a change meant to keep the
 //! output must keep the file byte for byte). With `recycle` each output is given back to the
 //! engine (`EdgeSharpener::recycle`) before the next run, as a server sharpening mesh after
-//! mesh would.
+//! mesh would. A mesh file in place of the resolution (any argument that is not a number, such
+//! as a `whet decode` output) times that input instead.
 #![allow(clippy::unwrap_used)] // a measurement tool
 
 use glam::{DQuat, DVec3};
@@ -16,20 +17,27 @@ use whet_synth::{marching_cubes, Shape, ShapeKind, ShapeParams};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let resolution: usize = args.first().and_then(|a| a.parse().ok()).unwrap_or(50);
-    let runs: usize = args.get(1).and_then(|a| a.parse().ok()).unwrap_or(20);
     let method = match args.get(2).map(String::as_str) {
         Some("papers") => Method::Papers,
         _ => Method::Extended,
     };
-    // The bench's rotation, so every crease is chamfered.
-    let rotation = DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.5);
-    let shape = Shape::new(
-        ShapeKind::Fandisk,
-        &ShapeParams::default().with_rotation(rotation),
-    )
-    .unwrap();
-    let mesh = marching_cubes(&shape, resolution).unwrap();
+    let mesh = match args.first() {
+        Some(path) if path.parse::<usize>().is_err() => {
+            whet_io::read_path(std::path::Path::new(path), None).unwrap()
+        }
+        resolution => {
+            let resolution = resolution.and_then(|a| a.parse().ok()).unwrap_or(50);
+            // The bench's rotation, so every crease is chamfered.
+            let rotation = DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.5);
+            let shape = Shape::new(
+                ShapeKind::Fandisk,
+                &ShapeParams::default().with_rotation(rotation),
+            )
+            .unwrap();
+            marching_cubes(&shape, resolution).unwrap()
+        }
+    };
+    let runs: usize = args.get(1).and_then(|a| a.parse().ok()).unwrap_or(20);
     let mut sharpener = EdgeSharpener::new(SharpenOptions::DEFAULT.with_method(method));
     let mut times = Vec::with_capacity(runs);
     let recycle = args.get(4).is_some_and(|a| a == "recycle");
