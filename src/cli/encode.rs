@@ -402,6 +402,7 @@ fn run_swing(args: &EncodeArgs, mesh: &whet::Mesh, skipped: &whet::io::ReadRepor
                 "crease": t.crease,
                 "apex": t.apex,
                 "sharpened_filter": t.sharpened_filter,
+                "runner_up": t.runner_up,
             })
         })
         .collect();

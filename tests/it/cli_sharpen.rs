@@ -394,19 +394,39 @@ fn decode_sharpen_follows_the_streams_hint() {
     // when it beat it, once more with the local quadric projection on top, once more with
     // the one-sided projection beside creases, once more with the crease projection and
     // once more with the apex restoration on top of what was kept; then, when its stream
-    // carried a filter for after sharpening, the same six without that filter.
-    let all = j["sharpen_trials"].as_array().unwrap();
+    // carried a filter for after sharpening, the same six without that filter. The best
+    // sharpening of the other method (the runner-up, `runner_up` trials) went the same way
+    // after the best's (its judged trial first when its vetoes were kept), and the stream
+    // is its path's when that ended better by the margin: the checks below follow the
+    // path the stream took, after the grid they share.
     let with_filter = |t: &&serde_json::Value| t["sharpened_filter"] == true;
-    let trials: Vec<_> = all
+    let unprojected = |t: &&serde_json::Value| {
+        t["planar"] == false
+            && t["quadric"] == false
+            && t["beside"] == false
+            && t["crease"] == false
+            && t["apex"] == false
+            && with_filter(t)
+    };
+    let everything = j["sharpen_trials"].as_array().unwrap();
+    let runner_up = |t: &serde_json::Value| t["runner_up"] == true;
+    let ru_won = everything
+        .iter()
+        .any(|t| runner_up(t) && t["method"] == j["sharpen_method"]);
+    let all: Vec<serde_json::Value> = everything
         .iter()
         .filter(|t| {
-            t["planar"] == false
-                && t["quadric"] == false
-                && t["beside"] == false
-                && t["crease"] == false
-                && t["apex"] == false
-                && with_filter(t)
+            if ru_won {
+                runner_up(t) || unprojected(t)
+            } else {
+                !runner_up(t)
+            }
         })
+        .cloned()
+        .collect();
+    let trials: Vec<_> = all
+        .iter()
+        .filter(|t| unprojected(t) && !runner_up(t))
         .collect();
     let bare: Vec<_> = all.iter().filter(|t| !with_filter(t)).collect();
     assert!(bare.is_empty() || bare.len() == 6, "{j}");
@@ -497,8 +517,14 @@ fn decode_sharpen_follows_the_streams_hint() {
     }
     // The stream states curved walls only where they are on.
     let chosen_walls = j["sharpen_curved_walls"].as_f64().unwrap_or(0.0);
-    let candidate = *trials
+    // The path's start: its grid record, or its judged trial (the runner-up's comes after
+    // its grid record).
+    let candidate = *all
         .iter()
+        .filter(unprojected)
+        .collect::<Vec<_>>()
+        .iter()
+        .rev()
         .find(|t| {
             t["method"] == chosen
                 && (chosen == "none"

@@ -246,11 +246,11 @@ pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
 }
 
 /// Encodes `original` at `rate` and decodes it; `key` names the stream in the cache
-/// (`target/sharpen-swing/v45-<key>-<angles>.whet`).
+/// (`target/sharpen-swing/v46-<key>-<angles>.whet`).
 pub fn swing_input_of(original: Mesh, key: &str, rate: Rate, angles: Angles) -> SwingInput {
     let dir = whet_testkit::workspace_root().join("target/sharpen-swing");
     let _ = std::fs::create_dir_all(&dir);
-    let path = dir.join(format!("v45-{key}-{}.whet", angles.tag()));
+    let path = dir.join(format!("v46-{key}-{}.whet", angles.tag()));
     let bytes = match std::fs::read(&path) {
         Ok(b) => b,
         Err(_) => {
