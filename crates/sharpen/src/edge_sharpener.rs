@@ -464,8 +464,6 @@ impl EdgeSharpener {
                 count: mesh.positions.len() + 2 * mesh.triangles.len(),
             }));
         }
-        // The welding scans the input's triangles and counts its thin ones for the run.
-        self.weld_scratch.thin = None;
         let welded = if self.options.method == Method::Extended && self.options.weld_clusters {
             let pool = self.pool.get();
             crate::weld::weld_clusters(
@@ -493,7 +491,6 @@ impl EdgeSharpener {
             }
         }
         let mut run = Run::new(mesh, table, &self.options, &mut self.scratch, report);
-        run.thin_triangles = self.weld_scratch.thin;
         run.input_may_be_sharp = self.options.keep_sharp_parts && !self.later_pass;
         run.input_may_be_curved = self.options.keep_curved_parts && !self.later_pass;
         run.later_pass = self.later_pass;
@@ -695,9 +692,6 @@ pub(crate) struct Run<'a> {
     /// (`crate::extended::on_grid_edges`), once a step has asked (the surface-sampling test
     /// and the label planes both may; the answer depends on the mesh alone).
     pub grid_edges: Option<bool>,
-    /// Extended method: the thin triangles of `mesh`, when the cluster welding's scan counted
-    /// them (`crate::extended::is_surface_sampling` then does not scan again).
-    pub thin_triangles: Option<usize>,
 }
 
 /// Per corner position `j` in a triangle, the positions of the corners after and before it.
@@ -755,7 +749,6 @@ impl<'a> Run<'a> {
             twins: Vec::new(),
             surface_samples: false,
             grid_edges: None,
-            thin_triangles: None,
         }
     }
 

@@ -78,12 +78,7 @@ pub(crate) struct LabelPlane {
 /// Labels regions and border vertices, then classifies the gray vertices.
 pub(crate) fn classify(run: &mut Run) {
     run.grid_edges = None;
-    run.surface_samples = is_surface_sampling(
-        run.mesh,
-        !run.later_pass,
-        &mut run.grid_edges,
-        run.thin_triangles,
-    );
+    run.surface_samples = is_surface_sampling(run.mesh, !run.later_pass, &mut run.grid_edges);
     // Regions with a deep vertex (marching cubes only: the corridors and `tube_creases`).
     let mut thick: Vec<bool> = Vec::new();
     if !run.surface_samples {
@@ -384,85 +379,42 @@ const GRID_SAMPLE: usize = 4096;
 #[inline(never)] // one call per run; kept out of line so profiles show it
 ///
 /// `grid` keeps the answer of [`on_grid_edges`] when the test looks at it (or gives it, when
-/// known), so that a later step of the run does not sample the mesh again. `thin`, when a
-/// pass before has counted them ([`ThinTest`]: the cluster welding's scan of the same mesh),
-/// is the number of thin triangles, and the mesh is not scanned again.
+/// known), so that a later step of the run does not sample the mesh again.
 pub(crate) fn is_surface_sampling(
     mesh: &whet_mesh::Mesh,
     grid_test: bool,
     grid: &mut Option<bool>,
-    thin: Option<usize>,
 ) -> bool {
     let nt = mesh.triangles.len();
     if nt == 0 {
         return false;
     }
+    // One pass without trigonometry (the smallest angle is opposite the shortest edge; it is
+    // under the limit when its cosine is above the limit's), stopping as soon as the count
+    // decides: marching cubes on its grid is decided within its first tenth.
+    let cos2 = THIN_ANGLE_DEGREES.to_radians().cos().powi(2);
     let allowed = (SURFACE_SAMPLING_THIN_FRACTION * nt as f64).ceil() as usize;
     let allowed_off_grid = (GRIDLESS_THIN_FRACTION * nt as f64).ceil() as usize;
     // Whether the vertices are on grid edges, looked at once the thin count reaches `allowed`.
-    let mut decides = |thin: usize| {
-        thin >= allowed
-            && (!grid_test
-                || *grid.get_or_insert_with(|| on_grid_edges(mesh))
-                || thin >= allowed_off_grid)
-    };
-    let test = ThinTest::new();
-    if let Some(thin) = thin {
-        // Test builds check the count handed over against a scan of their own.
-        debug_assert_eq!(
-            thin,
-            (0..nt)
-                .filter(|&t| {
-                    let p = mesh.triangle_positions(t);
-                    let (k, l) = crate::edge_sharpener::smallest_angle_corner(&p);
-                    test.is_thin(&p, k, &l)
-                })
-                .count()
-        );
-        // The scan below stops at the first count that decides; the count only grows, so
-        // the whole count decides the same way, with the grid looked at in the same case.
-        return !decides(thin);
-    }
-    // One pass, stopping as soon as the count decides: marching cubes on its grid is decided
-    // within its first tenth.
     let mut thin = 0usize;
     for t in 0..nt {
         let p = mesh.triangle_positions(t);
         let (k, l) = crate::edge_sharpener::smallest_angle_corner(&p);
-        if test.is_thin(&p, k, &l) {
+        let (a, b) = (l[(k + 2) % 3], l[(k + 1) % 3]);
+        let d = (p[(k + 1) % 3] - p[k]).dot(p[(k + 2) % 3] - p[k]);
+        // Degenerate triangles (a zero side: a * b == 0) count as thin.
+        if a * b == 0.0 || (d > 0.0 && d * d > cos2 * a * b) {
             thin += 1;
-            if decides(thin) {
+            if thin >= allowed
+                && (!grid_test
+                    || *grid.get_or_insert_with(|| on_grid_edges(mesh))
+                    || thin >= allowed_off_grid)
+            {
                 return false;
             }
         }
     }
     true
-}
-
-/// The thin-triangle test of [`is_surface_sampling`], without trigonometry: the smallest
-/// angle is opposite the shortest side, and it is under [`THIN_ANGLE_DEGREES`] when its
-/// cosine is above that angle's.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct ThinTest {
-    cos2: f64,
-}
-
-impl ThinTest {
-    pub(crate) fn new() -> Self {
-        Self {
-            cos2: THIN_ANGLE_DEGREES.to_radians().cos().powi(2),
-        }
-    }
-
-    /// Whether triangle `p`, whose smallest angle is at corner `k` and whose squared sides
-    /// are `l` ([`crate::edge_sharpener::smallest_angle_corner`]), is thin. A degenerate
-    /// triangle (a zero side) is.
-    #[inline]
-    pub(crate) fn is_thin(&self, p: &[DVec3; 3], k: usize, l: &[f64; 3]) -> bool {
-        let (a, b) = (l[(k + 2) % 3], l[(k + 1) % 3]);
-        let d = (p[(k + 1) % 3] - p[k]).dot(p[(k + 2) % 3] - p[k]);
-        a * b == 0.0 || (d > 0.0 && d * d > self.cos2 * a * b)
-    }
 }
 
 /// Whether the vertices of `mesh` lie on the edges of an axis-aligned grid, as marching cubes
@@ -2465,7 +2417,7 @@ mod tests {
         assert!(on_grid_edges(&mc));
         // The test keeps the grid answer it looked at for later steps of the run.
         let mut grid = None;
-        assert!(!is_surface_sampling(&mc, true, &mut grid, None));
+        assert!(!is_surface_sampling(&mc, true, &mut grid));
         assert_eq!(grid, Some(true));
         // Moved and scaled: equal coordinates stay equal.
         let mut moved = mc.clone();
@@ -2482,7 +2434,7 @@ mod tests {
         }
         assert!(!on_grid_edges(&turned));
         let mut grid = None;
-        assert!(!is_surface_sampling(&turned, true, &mut grid, None));
+        assert!(!is_surface_sampling(&turned, true, &mut grid));
         assert_eq!(grid, Some(false));
     }
 
@@ -2493,10 +2445,10 @@ mod tests {
         // the diagonal).
         let spot = whet_io::read_path(&whet_testkit::shared_fixture("spot.off"), None).unwrap();
         assert!(!on_grid_edges(&spot));
-        assert!(is_surface_sampling(&spot, true, &mut None, None));
+        assert!(is_surface_sampling(&spot, true, &mut None));
         // A later pass goes by the thin triangles alone, and never looks at the grid.
         let mut grid = None;
-        assert!(!is_surface_sampling(&spot, false, &mut grid, None));
+        assert!(!is_surface_sampling(&spot, false, &mut grid));
         assert_eq!(grid, None);
         // The same triangles with every coordinate on a lattice (as an exact-mode decoding's,
         // about 10 bits here): neighbours share a coordinate now and then, on any axis, but

@@ -134,10 +134,6 @@ pub(crate) struct WeldScratch {
     refused: Vec<u32>,
     refused_ends: Vec<u32>,
     merge: MergeScratch,
-    /// The thin triangles of the mesh the last [`weld_clusters`] scanned
-    /// ([`crate::extended::ThinTest`]), which the surface-sampling test of a run on that
-    /// mesh takes instead of a scan of its own; `None` before a scan.
-    pub thin: Option<usize>,
 }
 
 /// [`merge_cluster`]'s vectors.
@@ -174,12 +170,8 @@ pub(crate) fn weld_clusters(
         refused,
         refused_ends,
         merge,
-        thin,
     } = scratch;
     shortest.clear();
-    *thin = None;
-    let thin_test = crate::extended::ThinTest::new();
-    let mut thin_count = 0usize;
     let (mut sum, mut count) = (0.0f64, 0usize);
     for (t, (tri, o3)) in mesh
         .triangles
@@ -192,7 +184,6 @@ pub(crate) fn weld_clusters(
         // Rounded to f32 (relative error 6e-8; the scan allows for it); an overflow stays
         // finite so the scan's margin cannot make it pass where the exact test would not.
         shortest.push((lengths[k] as f32).min(f32::MAX));
-        thin_count += usize::from(thin_test.is_thin(&p, k, &lengths));
         for (j, &o) in o3.iter().enumerate() {
             // Each interior edge from its lower corner, each boundary edge once.
             if o == u32::MAX || o as usize > 3 * t + j {
@@ -201,7 +192,6 @@ pub(crate) fn weld_clusters(
             }
         }
     }
-    *thin = Some(thin_count);
     let mean = if count == 0 { 0.0 } else { sum / count as f64 };
     debug_assert_eq!(
         mean.to_bits(),
