@@ -804,8 +804,8 @@ impl SwingEncoder {
 
     /// The rest of [`Self::choose_sharpening`] for one sharpening (`decision`: its measured
     /// trial and its candidate stream, `None` for `out`'s own): its vetoes, then the
-    /// projections with and without the filter for after sharpening. `bounds` holds the
-    /// input's max and no sharpening's trial. Every trial goes to `trials` (flagged
+    /// projections with and without the filter for after sharpening, within the bounds of
+    /// the input's max and no sharpening's trial (`none`). Every trial goes to `trials` (flagged
     /// [`SharpenTrial::runner_up`] on the runner-up's path); returns the stream and the
     /// trial that stand.
     #[allow(clippy::too_many_arguments)]
