@@ -5,7 +5,7 @@
 //! edge length and angle bits the input picks; and `whet decode --sharpen` on arbitrary
 //! bytes.
 
-use crate::{encode, Error, Rate, RetileTuning, StatedSharpening, SwingOptions};
+use crate::{encode, Error, ErrorOf, Rate, RetileTuning, StatedSharpening, SwingOptions};
 
 /// Most triangles a decoded stream may have for [`fuzz_decode_sharpen`] to sharpen it (the
 /// decoder's fuzzing runs to a million; sharpening that many per input would starve the
@@ -53,8 +53,15 @@ fn check_mesh(mesh: &whet_mesh::Mesh, what: &str) {
     );
 }
 
+/// Metro samples a direction of [`fuzz_encode`]'s sharpened encodes: each measures some 40
+/// sharpenings, which at the encoder's default (300 000) would starve the fuzzer; the
+/// choice, not its precision, is what is fuzzed.
+const SHARPENED_METRO_SAMPLES: usize = 2_000;
+
 /// Encodes the mesh `data` describes (`whet_sharpen::fuzz_input`'s layout; byte 1 also
-/// picks the angle bits, byte 2 the edge length: 2 % to 50 % of the diagonal) and, when the
+/// picks the angle bits, byte 2 the edge length: 2 % to 50 % of the diagonal, and a last
+/// byte ending in two set bits `--optimize-for sharpened` (a quarter of the inputs), the encoder's choice of sharpening with its vetoes,
+/// projections and runner-up, measured with [`SHARPENED_METRO_SAMPLES`]) and, when the
 /// encoder accepts it, decodes the stream. Panics only on a bug: a panic inside, an
 /// internal error, or a stream that does not decode bit for bit to the encoder's retiled
 /// mesh (indices in range, finite positions).
@@ -64,10 +71,15 @@ pub fn fuzz_encode(data: &[u8]) {
     };
     let bits = 3 + u32::from(data[1]) % 12;
     let fraction = 0.02 + 0.48 * f64::from(data[2]) / 255.0;
-    let opts = SwingOptions::DEFAULT
+    let mut opts = SwingOptions::DEFAULT
         .with_rate(Rate::EdgeLength(fraction))
         .with_angle_bits(bits)
         .with_tuning(RetileTuning::DEFAULT.with_max_triangles(20_000));
+    if data.last().is_some_and(|b| b & 3 == 3) {
+        opts = opts
+            .with_error_of(ErrorOf::Sharpened)
+            .with_metro_samples(SHARPENED_METRO_SAMPLES);
+    }
     let out = match encode(&mesh, &opts) {
         Ok(out) => out,
         Err(Error::Internal(e)) => panic!("internal error: {e}"),
