@@ -40,6 +40,13 @@ pub struct SharpenArgs {
     /// which are otherwise left alone; their few chamfer edges that pass get cut.
     #[arg(long)]
     no_curved_parts: bool,
+    /// extended: on a surface sampling (a retiling, a swing-decoded mesh) give the gray
+    /// vertices, those in no smooth triangle, the plane of a neighbour they lie on, as
+    /// marching cubes always do: a chamfer two triangles wide then gets cut, but so does a
+    /// blend a few samples wide (off by default; a swing stream states it where its encoder
+    /// measured it better).
+    #[arg(long)]
+    gray_labels: bool,
     /// extended and papers: where two rings of triangles lie outside every smooth region, an
     /// edge turning by under this factor times the smooth threshold counts as smooth, so a
     /// face curved at the sampling's scale (a small hole's wall) gets its chamfers found.
@@ -163,6 +170,7 @@ pub fn run(args: &SharpenArgs) -> CliResult {
         .with_weld_clusters(!args.no_weld)
         .with_keep_sharp_parts(!args.no_sharp_parts)
         .with_keep_curved_parts(!args.no_curved_parts)
+        .with_surface_gray_labels(args.gray_labels)
         .with_passes(args.passes);
     let opts = match args.curved_walls {
         Some(w) => opts.with_curved_wall_factor(w),

@@ -424,6 +424,7 @@ impl EdgeSharpener {
             method: self.options.method,
             smooth_factor: self.options.smooth_factor,
             curved_wall_factor: self.options.curved_walls(),
+            surface_gray_labels: self.options.surface_gray_labels,
             input_vertices: mesh.positions.len(),
             input_triangles: mesh.triangles.len(),
             ..SharpenReport::default()

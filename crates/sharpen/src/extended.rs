@@ -59,8 +59,9 @@ pub(crate) const GRAY_PASSES: usize = 1;
 /// pyramid and fandisk at 32-128): from 0.3, 0.35 raises the RMS gain of 25 rows (up to 19 %,
 /// 5.7 % geometric mean) and moves the max by at most 3.2 %; 0.4 gains 9.5 % but lets two
 /// fandisk rows lose up to 43 % of their max gain (labels that place a corner vertex on three
-/// planes meeting off the part), 0.5 more so. Marching cubes only: on surface samplings no
-/// gray vertex is labelled (step 8), so this tolerance never applies there.
+/// planes meeting off the part), 0.5 more so. On surface samplings no gray vertex is labelled
+/// (step 8) unless `SharpenOptions::surface_gray_labels` asks for it (step 20), so it applies
+/// there only then.
 pub(crate) const CREASE_TOLERANCE: f64 = 0.35;
 
 /// The same for a red vertex, which never moves: only one practically on the crease takes a
@@ -115,7 +116,8 @@ pub(crate) fn classify(run: &mut Run) {
     // Both kinds of input measure their regions' typical turns: surface samplings for
     // `distinct_crease`, marching cubes for `flat_sided_crease`.
     region_turns(run, !run.surface_samples);
-    if !run.surface_samples {
+    // Surface samplings label theirs only when the options say so (step 20).
+    if !run.surface_samples || run.opts.surface_gray_labels {
         gray_vertices(run);
     }
     crease_vertices(run);

@@ -24,7 +24,8 @@ const SMOOTH_FACTORS: [f64; 8] = [2.0, 0.5, 1.0, 1.5, 2.5, 3.0, 3.5, 4.0];
 
 /// The mesh and options an input describes, or `None` when it is too short.
 ///
-/// Byte 0 picks the options (bits 0-1 the method: extended, papers, normal filter; bit 2
+/// Byte 0 picks the options (bits 0-1 the method: extended, papers, normal filter, and
+/// extended with the gray labels of surface samplings (`surface_gray_labels`); bit 2
 /// turns the welding off; bit 3 a second pass; bit 4 the curved walls; bits 5-7 the smooth
 /// factor: 2 by default, else 0.5 to 4). Byte 1 the angle bits (3 to 14) and byte 2 the
 /// move factor of the two projections after sharpening (0.01 to 10 angle steps), as a
@@ -59,7 +60,8 @@ pub fn fuzz_input(data: &[u8]) -> Option<(Mesh, SharpenOptions, PlanarOptions, Q
         .with_method(method)
         .with_smooth_factor(SMOOTH_FACTORS[usize::from(flags >> 5)])
         .with_weld_clusters(flags & 4 == 0)
-        .with_passes(1 + u32::from(flags & 8 != 0));
+        .with_passes(1 + u32::from(flags & 8 != 0))
+        .with_surface_gray_labels(flags & 3 == 3);
     if flags & 16 != 0 {
         opts = opts.with_curved_wall_factor(crate::DEFAULT_CURVED_WALL_FACTOR);
     }
@@ -318,6 +320,10 @@ mod tests {
         assert_eq!(opts.passes, 2);
         assert_eq!(opts.smooth_factor, 0.5);
         assert!(opts.curved_wall_factor.is_some());
+        assert!(!opts.surface_gray_labels);
+        let (_, gray, _, _) = fuzz_input(&tetrahedron(3)).unwrap();
+        assert_eq!(gray.method, Method::Extended);
+        assert!(gray.surface_gray_labels);
         assert!(
             fuzz_input(&tetrahedron(0)[..15]).is_none(),
             "too short for 4 vertices"

@@ -113,6 +113,14 @@ pub struct SharpenOptions {
     /// we extend", step 19). Default on; off, they are sharpened as before. Later passes
     /// never look.
     pub keep_curved_parts: bool,
+    /// Extended method: label the gray vertices of surface samplings too (step 3 of
+    /// docs/sharpen.md, "What we extend", which surface samplings skip by default: step 8).
+    /// On a chamfer two triangles wide its middle vertex lies in no smooth triangle and keeps
+    /// the chamfer whole unless it is labelled; on a blend a few samples wide the same label
+    /// sharpens the blend (rocker_arm). No local test tells the two apart, so it is off by
+    /// default and a swing stream states it where its encoder measured it better (header
+    /// field 41; step 20). Marching cubes always label their gray vertices.
+    pub surface_gray_labels: bool,
     /// Curved walls (docs/sharpen.md): where two rings of triangles lie outside every smooth
     /// region, an edge turning by under this factor times the smooth threshold counts as
     /// smooth too, so that a face curved at the sampling's scale (a hole's cylinder a few
@@ -143,6 +151,7 @@ impl SharpenOptions {
         weld_clusters: true,
         keep_sharp_parts: true,
         keep_curved_parts: true,
+        surface_gray_labels: false,
         curved_wall_factor: None,
         passes: 1,
         pass_budget_triangles: None,
@@ -203,6 +212,12 @@ impl SharpenOptions {
     /// refused as curved.
     pub const fn with_keep_curved_parts(mut self, keep: bool) -> Self {
         self.keep_curved_parts = keep;
+        self
+    }
+
+    /// Sets whether the extended method labels the gray vertices of surface samplings too.
+    pub const fn with_surface_gray_labels(mut self, on: bool) -> Self {
+        self.surface_gray_labels = on;
         self
     }
 

@@ -153,6 +153,9 @@ pub struct SharpenReport {
     pub curved_parts: usize,
     /// Chamfer edges that would have been cut in those parts (left unsplit with them).
     pub curved_part_splits: usize,
+    /// The options' `surface_gray_labels` (gray vertices of surface samplings labelled too;
+    /// those labelled are in `chamfer_vertices`).
+    pub surface_gray_labels: bool,
     /// Vertices tagged sharp (filter 3bis plus the new vertices).
     pub tagged_vertices: usize,
     /// Edges tagged sharp.
@@ -231,7 +234,8 @@ impl SharpenReport {
     /// `curved_wall_factor`, `curved_wall_edges`, `passes`, `twin_corners`,
     /// `already_sharp_components`, `direct_crease_fraction`, and the extended method's
     /// `dropped_chamfer_edges` (an object like `unmoved`, plus `idle`) and
-    /// `dropped_corner_triangles` (like `unmoved`), `curved_parts` and `curved_part_splits`.
+    /// `dropped_corner_triangles` (like `unmoved`), `curved_parts`, `curved_part_splits` and
+    /// `surface_gray_labels`.
     pub fn to_json(&self) -> String {
         let mut s = String::with_capacity(768);
         // Writing to a String cannot fail.
@@ -312,8 +316,8 @@ impl SharpenReport {
         write_reasons(&mut s, &self.dropped_corners_by_reason);
         let _ = write!(
             s,
-            "}},\"curved_parts\":{},\"curved_part_splits\":{}}}",
-            self.curved_parts, self.curved_part_splits
+            "}},\"curved_parts\":{},\"curved_part_splits\":{},\"surface_gray_labels\":{}}}",
+            self.curved_parts, self.curved_part_splits, self.surface_gray_labels
         );
         s
     }
@@ -376,6 +380,7 @@ mod tests {
             "dropped_corner_triangles",
             "curved_parts",
             "curved_part_splits",
+            "surface_gray_labels",
         ] {
             assert_eq!(j.matches(&format!("\"{key}\":")).count(), 1, "{key} in {j}");
         }

@@ -119,3 +119,69 @@ fn ridge_with_a_step_is_mixed_convexity() {
         "the extended method drops splits that change nothing"
     );
 }
+
+/// The ridge `z = -|x|` sampled with a chamfer two triangles wide: columns on the left face
+/// (x = -6..-1), one column `MIDDLE` off both faces, columns on the right face (x = 1..6).
+/// The middle column's triangles all cross the crease, so its vertices lie in no smooth
+/// triangle (gray), and no edge joins the two faces' borders: the papers' filters see no
+/// chamfer edge.
+const MIDDLE: [f64; 2] = [0.0, -0.3];
+
+fn two_wide_ridge() -> Mesh {
+    let xs: Vec<f64> = (-6..=6).map(f64::from).collect();
+    let mut p = Vec::new();
+    for &x in &xs {
+        for j in 0..NY {
+            let z = if x == 0.0 { MIDDLE[1] } else { -x.abs() };
+            let x = if x == 0.0 { MIDDLE[0] } else { x };
+            p.push(DVec3::new(x, j as f64, z));
+        }
+    }
+    let id = |i: u32, j: u32| i * NY + j;
+    let mut t = Vec::new();
+    for i in 0..xs.len() as u32 - 1 {
+        for j in 0..NY - 1 {
+            t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    Mesh::new(p, t)
+}
+
+#[test]
+fn a_chamfer_two_triangles_wide_needs_gray_labels_on_surface_samplings() {
+    // docs/sharpen.md, "What we extend", step 20. The middle column is 0.21 from both
+    // faces' planes, within the gray tolerance (0.4 of its mean edge, about 1.2) and the
+    // crease tolerance (0.35): labelled, it takes both faces and moves onto their crease.
+    let input = two_wide_ridge();
+    let middle = |i: usize| i / NY as usize == 6;
+    let by_default = sharpen(&input, &SharpenOptions::DEFAULT).unwrap();
+    assert_eq!(by_default.report.chamfer_vertices, 0);
+    assert_eq!(by_default.mesh, input, "{}", by_default.report.to_json());
+    let out = sharpen(
+        &input,
+        &SharpenOptions::DEFAULT.with_surface_gray_labels(true),
+    )
+    .unwrap();
+    assert!(out.report.surface_gray_labels);
+    // The middle column's interior vertices (the boundary ones are never labelled).
+    assert_eq!(
+        out.report.chamfer_vertices,
+        NY as usize - 2,
+        "{}",
+        out.report.to_json()
+    );
+    assert_eq!(out.mesh.triangles, input.triangles);
+    for (i, (p, q)) in out.mesh.positions.iter().zip(&input.positions).enumerate() {
+        let boundary = i % NY as usize == 0 || i % NY as usize == NY as usize - 1;
+        if middle(i) && !boundary {
+            assert!(p.x.abs() < 1e-12 && p.z.abs() < 1e-12, "{i}: {p}");
+            assert_eq!(p.y, q.y, "{i}");
+        } else {
+            assert_eq!(p, q, "{i}: only the middle column moves");
+        }
+    }
+    // The papers' method has no labels: the option changes nothing there.
+    let papers = SharpenOptions::PAPERS.with_surface_gray_labels(true);
+    assert_eq!(sharpen(&input, &papers).unwrap().mesh, input);
+}
