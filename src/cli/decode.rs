@@ -18,7 +18,8 @@ pub struct DecodeArgs {
     /// Run EdgeSharpener on the decoded mesh (restores the sharp edges and corners a uniform
     /// retiling chamfered). A swing stream's snap vetoes (the snaps its encoder measured
     /// worse against the original) are replayed unless --method, --smooth-factor,
-    /// --curved-walls or --passes changes the sharpening they were judged for.
+    /// --curved-walls, --passes or --gray-labels changes the sharpening they were judged
+    /// for.
     #[arg(long)]
     sharpen: bool,
     /// Then refine with Bender this many levels (needs --sharpen for its tags).
@@ -44,6 +45,11 @@ pub struct DecodeArgs {
     /// names with its method (see --method); otherwise 1.
     #[arg(long, requires = "sharpen")]
     passes: Option<u32>,
+    /// EdgeSharpener's gray-vertex labels on surface samplings (`whet sharpen
+    /// --gray-labels`): true or false. Without it, what a swing stream states with its
+    /// method (see --method); otherwise off.
+    #[arg(long, value_name = "BOOL", requires = "sharpen")]
+    gray_labels: Option<bool>,
     /// Subdiv streams: subdivision levels, overriding the header (0 gives the control mesh).
     #[arg(long)]
     levels: Option<u32>,
@@ -98,19 +104,21 @@ pub fn run(args: &DecodeArgs) -> CliResult {
         // The stream's choice (`SharpenHint::stated`); an explicit --method replaces it,
         // factor included.
         let stated = header.as_ref().and_then(whet_codec::SharpenHint::stated);
-        let (method, stream_factor, stream_walls, stream_passes) = match (&args.method, stated) {
-            (Some(m), _) => (m.as_str(), None, None, None),
-            (None, Some((h, f))) => {
-                let h2 = header.as_ref();
-                (
-                    h.name(),
-                    Some(f),
-                    h2.and_then(whet_codec::SharpenHint::curved_walls_of),
-                    h2.and_then(whet_codec::SharpenHint::passes_of),
-                )
-            }
-            (None, None) => ("extended", None, None, None),
-        };
+        let (method, stream_factor, stream_walls, stream_passes, stream_gray) =
+            match (&args.method, stated) {
+                (Some(m), _) => (m.as_str(), None, None, None, false),
+                (None, Some((h, f))) => {
+                    let h2 = header.as_ref();
+                    (
+                        h.name(),
+                        Some(f),
+                        h2.and_then(whet_codec::SharpenHint::curved_walls_of),
+                        h2.and_then(whet_codec::SharpenHint::passes_of),
+                        h2.is_some_and(whet_codec::SharpenHint::gray_labels_of),
+                    )
+                }
+                (None, None) => ("extended", None, None, None, false),
+            };
         // The explicit values are checked even where no sharpening runs.
         let explicit = whet_sharpen::SharpenOptions::DEFAULT
             .with_passes(args.passes.unwrap_or(1))
@@ -146,6 +154,7 @@ pub fn run(args: &DecodeArgs) -> CliResult {
         let smooth_factor = args.smooth_factor.or(stream_factor).unwrap_or(2.0);
         let mut opts = super::sharpen::sharpen_options(method, smooth_factor)?
             .with_passes(args.passes.or(stream_passes).unwrap_or(1))
+            .with_surface_gray_labels(args.gray_labels.unwrap_or(stream_gray))
             // Passes after the first run on grown meshes: each is held to the budget the
             // first was checked against.
             .with_pass_budget_triangles(args.max_memory / whet_sharpen::PEAK_BYTES_PER_TRIANGLE);
@@ -158,7 +167,8 @@ pub fn run(args: &DecodeArgs) -> CliResult {
         let own_sharpening = args.method.is_none()
             && args.smooth_factor.is_none()
             && args.curved_walls.is_none()
-            && args.passes.is_none();
+            && args.passes.is_none()
+            && args.gray_labels.is_none();
         let mut replay = match (&header, own_sharpening) {
             (Some(h), true) => super::sharpen::stated_vetoes(h)?,
             _ => None,

@@ -389,16 +389,18 @@ fn decode_sharpen_follows_the_streams_hint() {
     // curved walls, every sharpening in one pass and in two), then the best of them
     // refined (its smooth factor a quarter up and down, with curved walls each also with
     // the wall factor one up and one down, then itself in one more pass: 3 or 9 more), and
-    // none, and kept the lowest
+    // the extended method's best so far with gray labels (when there is one), and none,
+    // and kept the lowest
     // error; then the chosen sharpening once more with the planar-region projection, kept
     // when it beat it, once more with the local quadric projection on top, once more with
     // the one-sided projection beside creases, once more with the crease projection and
     // once more with the apex restoration on top of what was kept; then, when its stream
     // carried a filter for after sharpening, the same six without that filter. The best
-    // sharpening of the other method (the runner-up, `runner_up` trials) went the same way
-    // after the best's (its judged trial first when its vetoes were kept), and the stream
-    // is its path's when that ended better by the margin: the checks below follow the
-    // path the stream took, after the grid they share.
+    // sharpening of each other slot (method, and gray labels for the extended one: the
+    // runners-up, `runner_up` trials) went the same way after the best's (its judged trial
+    // first when its vetoes were kept), and the stream is a runner-up's path's when that
+    // ended better by the margin: the checks below follow the path the stream took (its
+    // method and gray labels), after the grid they share.
     let with_filter = |t: &&serde_json::Value| t["sharpened_filter"] == true;
     let unprojected = |t: &&serde_json::Value| {
         t["planar"] == false
@@ -410,14 +412,15 @@ fn decode_sharpen_follows_the_streams_hint() {
     };
     let everything = j["sharpen_trials"].as_array().unwrap();
     let runner_up = |t: &serde_json::Value| t["runner_up"] == true;
-    let ru_won = everything
-        .iter()
-        .any(|t| runner_up(t) && t["method"] == j["sharpen_method"]);
+    let stated = |t: &serde_json::Value| {
+        t["method"] == j["sharpen_method"] && t["gray_labels"] == j["sharpen_gray_labels"]
+    };
+    let ru_won = everything.iter().any(|t| runner_up(t) && stated(t));
     let all: Vec<serde_json::Value> = everything
         .iter()
         .filter(|t| {
             if ru_won {
-                runner_up(t) || unprojected(t)
+                (runner_up(t) && stated(t)) || (!runner_up(t) && unprojected(t))
             } else {
                 !runner_up(t)
             }
@@ -480,6 +483,8 @@ fn decode_sharpen_follows_the_streams_hint() {
     let score = |t: &serde_json::Value| {
         t["rms_error_pct"].as_f64().unwrap() * t["max_error_pct"].as_f64().unwrap().powf(0.25)
     };
+    // The gray-label candidate, when measured, right before none.
+    let gray = usize::from(trials[trials.len() - 2]["gray_labels"] == true);
     let grid_best = trials[..24]
         .iter()
         .filter(|t| {
@@ -495,7 +500,7 @@ fn decode_sharpen_follows_the_streams_hint() {
         Some(b) if b["curved_walls"].as_f64() == Some(0.0) => 3,
         Some(_) => 9,
     };
-    assert_eq!(trials.len(), 25 + refined, "{j}");
+    assert_eq!(trials.len(), 25 + gray + refined, "{j}");
     let chosen = j["sharpen_method"].as_str().unwrap();
     assert_eq!(planar.len(), usize::from(chosen != "none"), "{j}");
     assert_eq!(quadric.len(), planar.len(), "{j}");
@@ -529,6 +534,7 @@ fn decode_sharpen_follows_the_streams_hint() {
             t["method"] == chosen
                 && (chosen == "none"
                     || (t["smooth_factor"] == j["sharpen_smooth_factor"]
+                        && t["gray_labels"] == j["sharpen_gray_labels"]
                         && t["curved_walls"].as_f64() == Some(chosen_walls)
                         && t["passes"] == j["sharpen_passes"]))
         })
@@ -775,7 +781,7 @@ fn decode_sharpen_follows_the_streams_hint() {
 }
 
 #[test]
-fn decode_sharpen_reads_the_streams_curved_walls_and_passes() {
+fn decode_sharpen_reads_the_streams_curved_walls_passes_and_gray_labels() {
     // partLp retiled at its own vertex count: its through-holes, 2.3 edges in radius, are
     // where curved walls change the papers' method (docs/results.md, "Curved walls").
     let dir = scratch_dir("cli-decode-curved-walls");
@@ -862,6 +868,50 @@ fn decode_sharpen_reads_the_streams_curved_walls_and_passes() {
     );
     assert!(decode(&two, &["--sharpen"], "h2.off") == explicit);
     assert!(decode(&two, &["--sharpen", "--passes", "1"], "h21.off") == without);
+    // Field 41 states the gray labels of surface samplings for the extended method, and
+    // `--gray-labels` overrides it; `whet sharpen --gray-labels` on the decoded mesh
+    // without its filter writes what `--no-surface-filter` decodes (no filter before
+    // sharpening, nor the stream's filter for after it).
+    let plain_extended = decode(&stream, &extended, "e.off");
+    let gray = decode(
+        &stream,
+        &[&extended[..], &["--gray-labels", "true"]].concat(),
+        "eg.off",
+    );
+    assert!(
+        gray != plain_extended,
+        "gray labels changed nothing on partLp"
+    );
+    let mut c = container.clone();
+    c.header = c
+        .header
+        .clone()
+        .with(whet_format::tag::SHARPEN_METHOD, 0u64)
+        .with(whet_format::tag::SHARPEN_SMOOTH_FACTOR, 150u64)
+        .with(whet_format::tag::SHARPEN_GRAY_LABELS, 1u64);
+    let stated_gray = dir.join("gray.whet");
+    std::fs::write(&stated_gray, c.to_bytes().unwrap()).unwrap();
+    assert!(decode(&stated_gray, &["--sharpen"], "hg.off") == gray);
+    let off = ["--sharpen", "--gray-labels", "false"];
+    assert!(decode(&stated_gray, &off, "hg0.off") == plain_extended);
+    decode(&stream, &["--no-surface-filter"], "raw.off");
+    let sharpened = dir.join("sg.off");
+    let o = whet(&[
+        "sharpen",
+        s(&dir.join("raw.off")),
+        "-o",
+        s(&sharpened),
+        "--smooth-factor",
+        "1.5",
+        "--gray-labels",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let unfiltered = [
+        &extended[..],
+        &["--gray-labels", "true", "--no-surface-filter"],
+    ]
+    .concat();
+    assert!(std::fs::read(&sharpened).unwrap() == decode(&stream, &unfiltered, "egn.off"));
 }
 
 #[test]

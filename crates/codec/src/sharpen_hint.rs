@@ -127,6 +127,15 @@ impl SharpenHint {
     /// The pass counts field 29 can state (`whet_sharpen::MAX_PASSES` is 4).
     pub const PASSES: std::ops::RangeInclusive<u64> = 1..=4;
 
+    /// Whether a swing stream's header states gray-vertex labels on surface samplings with
+    /// its sharpening (field 41 at 1; `whet_sharpen::SharpenOptions::surface_gray_labels`):
+    /// false (the sharpener's default) without the field, with another value, for other
+    /// modes, or without a hint this whet knows.
+    pub fn gray_labels_of(header: &whet_format::Header) -> bool {
+        Self::of(header).is_some()
+            && header.get_u64(whet_format::tag::SHARPEN_GRAY_LABELS) == Some(1)
+    }
+
     /// The planar-region projection a swing stream's header states for after sharpening
     /// (field 25): its tolerance factor (the field's hundredths over 100, in angle steps)
     /// and the stream's angle bits, for `whet_sharpen::PlanarOptions::for_swing`. `None`
@@ -357,6 +366,31 @@ mod tests {
             .with(whet_format::tag::SHARPEN_METHOD, 1u64)
             .with(whet_format::tag::SHARPEN_PASSES, 2u64);
         assert_eq!(SharpenHint::passes_of(&exact), None);
+    }
+
+    #[test]
+    fn gray_labels_go_with_a_known_method_and_only_at_one() {
+        let swing = whet_format::Header::new(whet_format::Mode::Swing, 3, 1);
+        let on = swing
+            .clone()
+            .with(whet_format::tag::SHARPEN_GRAY_LABELS, 1u64);
+        assert!(!SharpenHint::gray_labels_of(&on));
+        let extended = on.with(whet_format::tag::SHARPEN_METHOD, 0u64);
+        assert!(SharpenHint::gray_labels_of(&extended));
+        for other in [0u64, 2, u64::MAX] {
+            let h = extended
+                .clone()
+                .with(whet_format::tag::SHARPEN_GRAY_LABELS, other);
+            assert!(!SharpenHint::gray_labels_of(&h), "{other}");
+        }
+        let unknown_method = swing
+            .with(whet_format::tag::SHARPEN_METHOD, 7u64)
+            .with(whet_format::tag::SHARPEN_GRAY_LABELS, 1u64);
+        assert!(!SharpenHint::gray_labels_of(&unknown_method));
+        let exact = whet_format::Header::new(whet_format::Mode::Exact, 3, 1)
+            .with(whet_format::tag::SHARPEN_METHOD, 0u64)
+            .with(whet_format::tag::SHARPEN_GRAY_LABELS, 1u64);
+        assert!(!SharpenHint::gray_labels_of(&exact));
     }
 
     #[test]

@@ -1026,6 +1026,9 @@ pub struct SwingStreamInfo<'a> {
     /// Its EdgeSharpener passes (optional header field 29, written when `Some` and the hint
     /// is).
     pub sharpen_passes: Option<u32>,
+    /// Its gray-vertex labels on surface samplings (optional header field 41, written as 1
+    /// when true and the hint is; [`crate::SharpenHint::gray_labels_of`]).
+    pub sharpen_gray_labels: bool,
 }
 
 /// Writes the swing stream of a retiled mesh, after checking that Edgebreaker reproduces the
@@ -1524,6 +1527,9 @@ fn write_stream(
         if let Some(p) = info.sharpen_passes {
             header = header.with(tag::SHARPEN_PASSES, u64::from(p));
         }
+        if info.sharpen_gray_labels {
+            header = header.with(tag::SHARPEN_GRAY_LABELS, 1u64);
+        }
     }
     // With kinds 9 and 10 (format 1.3 already) a box of binary32 coordinates, what the
     // swing encoder makes, takes 24 bytes (docs/format.md, tag 32); streams of the older
@@ -1992,6 +1998,7 @@ mod tests {
             sharpen_smooth_factor: None,
             sharpen_curved_walls: None,
             sharpen_passes: None,
+            sharpen_gray_labels: false,
         }
     }
 
@@ -2019,6 +2026,31 @@ mod tests {
                 plain.decoded
             );
         }
+        // Field 41 goes with a hint only: three bytes more with one, none without.
+        let extended = SwingStreamInfo {
+            sharpen_hint: Some(crate::SharpenHint::Extended),
+            ..info()
+        };
+        let hinted = encode_retiled(&retiled, &params, &extended).unwrap();
+        let gray = encode_retiled(
+            &retiled,
+            &params,
+            &SwingStreamInfo {
+                sharpen_gray_labels: true,
+                ..extended
+            },
+        )
+        .unwrap();
+        assert!(crate::SharpenHint::gray_labels_of(&header(&gray.bytes)));
+        assert!(!crate::SharpenHint::gray_labels_of(&header(&hinted.bytes)));
+        // Three bytes: a key of two (41 << 2 is over 127) and the value.
+        assert_eq!(gray.bytes.len(), hinted.bytes.len() + 3);
+        let unhinted = SwingStreamInfo {
+            sharpen_gray_labels: true,
+            ..info()
+        };
+        let unhinted = encode_retiled(&retiled, &params, &unhinted).unwrap();
+        assert_eq!(unhinted.bytes, plain.bytes);
     }
 
     /// Every coordinate of `m` as its bits (an exact comparison that tells -0 from +0).

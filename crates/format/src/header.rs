@@ -216,9 +216,14 @@ pub mod tag {
     /// order with one parallelogram per vertex (faster to decode, larger).
     /// Required: a reader that does not know it would misread the geometry.
     pub const EXACT_PREDICTION: u64 = 40;
+    /// u64 (optional, added 2026-12-07, twenty-seventh session): 1 when the EdgeSharpener
+    /// sharpening that goes with [`SHARPEN_METHOD`] labels the gray vertices of surface
+    /// samplings too (`whet_sharpen::SharpenOptions::surface_gray_labels`; swing; absent, or
+    /// another value: off).
+    pub const SHARPEN_GRAY_LABELS: u64 = 41;
 
     /// Every tag this crate knows, with its name and value type.
-    pub const KNOWN: [(u64, &str, ValueType); 26] = [
+    pub const KNOWN: [(u64, &str, ValueType); 27] = [
         (ENCODER, "encoder", ValueType::Bytes),
         (COMPONENT_COUNT, "component_count", ValueType::U64),
         (QUANT_BITS, "quant_bits", ValueType::U64),
@@ -257,6 +262,7 @@ pub mod tag {
         (FILTER_TANGENTIAL, "filter_tangential", ValueType::I64),
         (APEX_PROJECTION, "apex_projection", ValueType::U64),
         (EXACT_PREDICTION, "exact_prediction", ValueType::U64),
+        (SHARPEN_GRAY_LABELS, "sharpen_gray_labels", ValueType::U64),
     ];
 
     /// Name and type of a known tag.

@@ -188,9 +188,10 @@ fn stated_name(s: &swing_inputs::SwingInput) -> String {
     match s.sharpen_hint {
         Some(SharpenHint::Unsharpened) => "none".to_string(),
         h => format!(
-            "{} {}{}{}{}{}{}{}{}{}",
+            "{} {}{}{}{}{}{}{}{}{}{}",
             h.map_or("extended", SharpenHint::name),
             s.smooth_factor,
+            if s.gray_labels { " gray" } else { "" },
             match s.curved_walls {
                 Some(w) => format!(" walls {w}"),
                 None => String::new(),

@@ -64,6 +64,10 @@ pub struct SharpenTrial {
     /// EdgeSharpener passes (`SharpenOptions::passes`; irrelevant for
     /// [`SharpenHint::Unsharpened`]).
     pub passes: u32,
+    /// EdgeSharpener's gray-vertex labels on surface samplings
+    /// (`SharpenOptions::surface_gray_labels`, header field 41): tried on the extended
+    /// method's best of the grid only.
+    pub gray_labels: bool,
     /// Measured symmetric RMS error of `whet decode --sharpen`'s output, % of the diagonal.
     pub rms_pct: f64,
     /// Its measured symmetric max error, % of the diagonal: a sharpening whose max is over
@@ -91,9 +95,10 @@ pub struct SharpenTrial {
     /// applied: true but for the chosen sharpening tried without it (a stream whose filter
     /// the encoder fitted to zero counts as with it).
     pub sharpened_filter: bool,
-    /// Measured on the runner-up's path: the best sharpening of the other method, which the
-    /// encoder also takes through the vetoes, the projections and the filter's removal, and
-    /// which is chosen when it ends better than the best by the margin (docs/swing.md
+    /// Measured on a runner-up's path: the best sharpening of another method (or of the
+    /// extended method with gray labels, [`Self::gray_labels`]), which the encoder also
+    /// takes through the vetoes, the projections and the filter's removal, and which is
+    /// chosen when it ends better than the path standing by the margin (docs/swing.md
     /// section 2, "The runner-up"). False on the grid, its refinement and the best's path.
     pub runner_up: bool,
 }
@@ -344,6 +349,9 @@ pub struct SwingOutput {
     /// The EdgeSharpener passes that go with [`Self::sharpen_hint`] when more than one
     /// (optional header field 29).
     pub sharpen_passes: Option<u32>,
+    /// The gray-vertex labels on surface samplings that go with [`Self::sharpen_hint`] when
+    /// on (optional header field 41).
+    pub sharpen_gray_labels: bool,
     /// The planar-region projection after sharpening the stream states (optional header
     /// field 25: its tolerance in angle steps), when the encoder measured it better.
     pub planar_factor: Option<f64>,
@@ -646,6 +654,7 @@ impl SwingEncoder {
                     smooth_factor,
                     curved_walls,
                     passes,
+                    gray_labels: false,
                 })
             })
             .collect();
@@ -668,8 +677,9 @@ impl SwingEncoder {
         .into_iter();
         let mut trials = Vec::new();
         let mut best: Option<(SharpenTrial, Option<SwingOutput>)> = None;
-        // And the best of each method (extended, papers) by the same rule: the runner-up's.
-        let mut best_of: [Option<(SharpenTrial, Option<SwingOutput>)>; 2] = [None, None];
+        // And the best of each method (extended, papers, extended with gray labels) by the
+        // same rule: the runners-up's.
+        let mut best_of: [Option<(SharpenTrial, Option<SwingOutput>)>; 3] = [None, None, None];
         // Sharpening must not make a case worse (the issue's "no case gets worse", RMS or
         // max): the score (RMS weighted by the max, `MAX_ERROR_WEIGHT`) decides among the
         // candidates whose max stays within that of the mesh they sharpen and whose RMS stays
@@ -687,6 +697,7 @@ impl SwingEncoder {
             smooth_factor: DEFAULT_SMOOTH_FACTOR,
             curved_walls: 0.0,
             passes: 1,
+            gray_labels: false,
             rms_pct: decoded,
             max_pct: decoded_max,
             planar: false,
@@ -724,7 +735,7 @@ impl SwingEncoder {
             };
             let trial = c.trial(figures);
             trials.push(trial);
-            let slot = &mut best_of[method_slot(trial.hint)];
+            let slot = &mut best_of[method_slot(&trial)];
             if improves(&trial, slot) {
                 *slot = Some((trial, stream.clone()));
             }
@@ -749,9 +760,49 @@ impl SwingEncoder {
                     self.measure_sharpened(prep, &p, &input, &opts, &mut measured, false)?;
                 let trial = c.trial(figures);
                 trials.push(trial);
-                let slot = &mut best_of[method_slot(trial.hint)];
+                let slot = &mut best_of[method_slot(&trial)];
                 if improves(&trial, slot) {
                     *slot = Some((trial, Some(p.clone())));
+                }
+                if improves(&trial, &best) {
+                    best = Some((trial, Some(p)));
+                }
+            }
+        }
+        // Then the extended method's best with the gray vertices of surface samplings
+        // labelled too (docs/swing.md section 2, "Gray labels"): a chamfer two triangles
+        // wide is cut only so, a blend a few samples wide is sharpened so, and only the
+        // original tells which the stream holds. It has a slot of its own only when it beats
+        // the extended best by the margin (else it would hide the extended best from the
+        // runners-up). After the refinement, which it would otherwise draw away from the
+        // sharpenings it refines (a smooth factor a quarter above the grid's, missed so,
+        // cost the swing-decoded synth torus-box a max 2.7 times higher). Its field's three
+        // bytes must leave room for the projections' under a size target, as the vetoes'
+        // must.
+        if let Some((ext, _)) = best_of[EXTENDED_SLOT].as_ref() {
+            let gray = Candidate {
+                hint: Some(SharpenHint::Extended),
+                smooth_factor: ext.smooth_factor,
+                curved_walls: (ext.curved_walls > 0.0).then_some(ext.curved_walls),
+                passes: ext.passes,
+                gray_labels: true,
+            };
+            let stream = match at_bits.encode_at_for(prep, fraction, &[gray]) {
+                Ok(s) => s.into_iter().next().filter(|p| {
+                    p.retiled == out.retiled
+                        && self.below_size_ceiling(prep, p.bytes.len() + PROJECTION_FIELD_BYTES)
+                }),
+                Err(Error::Stuck(_)) => None,
+                Err(e) => return Err(e),
+            };
+            if let Some(p) = stream {
+                let opts = gray.sharpen_options();
+                let (figures, _) =
+                    self.measure_sharpened(prep, &p, &input, &opts, &mut measured, false)?;
+                let trial = gray.trial(figures);
+                trials.push(trial);
+                if improves(&trial, &best_of[EXTENDED_SLOT]) {
+                    best_of[method_slot(&trial)] = Some((trial, Some(p.clone())));
                 }
                 if improves(&trial, &best) {
                     best = Some((trial, Some(p)));
@@ -763,18 +814,25 @@ impl SwingEncoder {
             Some((b, s)) if none.score() >= SHARPEN_MARGIN * b.score() => (b, s),
             _ => (none, None),
         };
-        // The runner-up: the best sharpening of the other method. The grid measures each
-        // sharpening before the vetoes and the projections, which then change the methods'
-        // outputs differently (on the swing-decoded cad_bracket at 3.5 bpv the extended
-        // method with the papers' factors and the projections ended 49 % lower in score
-        // than the papers' chosen path), so it is taken through them too, and chosen when it
-        // ends better by the margin.
-        let runner_up = match decision.0.hint {
-            SharpenHint::Unsharpened => None,
-            hint => best_of[1 - method_slot(hint)].take(),
+        // The runners-up: the best sharpening of each other slot (method, and gray labels
+        // for the extended one). The grid measures each sharpening before the vetoes and
+        // the projections, which then change the methods' outputs differently (on the
+        // swing-decoded cad_bracket at 3.5 bpv the extended method with the papers' factors
+        // and the projections ended 49 % lower in score than the papers' chosen path), so
+        // each is taken through them too, in slot order, and chosen when it ends better
+        // than the path standing by the margin.
+        let runners_up: Vec<_> = match decision.0.hint {
+            SharpenHint::Unsharpened => Vec::new(),
+            _ => {
+                let own = method_slot(&decision.0);
+                (0..best_of.len())
+                    .filter(|&k| k != own)
+                    .filter_map(|k| best_of[k].take())
+                    .collect()
+            }
         };
-        let spare = runner_up.as_ref().map(|_| out.clone());
-        let (mut chosen, chosen_trial) = self.finish_sharpening(
+        let spares: Vec<SwingOutput> = runners_up.iter().map(|_| out.clone()).collect();
+        let (mut chosen, mut chosen_trial) = self.finish_sharpening(
             prep,
             out,
             decision,
@@ -783,7 +841,7 @@ impl SwingEncoder {
             &mut trials,
             false,
         )?;
-        if let (Some(candidate), Some(out)) = (runner_up, spare) {
+        for (candidate, out) in runners_up.into_iter().zip(spares) {
             let (other, other_trial) = self.finish_sharpening(
                 prep,
                 out,
@@ -795,6 +853,7 @@ impl SwingEncoder {
             )?;
             if other_trial.score() < SHARPEN_MARGIN * chosen_trial.score() {
                 chosen = other;
+                chosen_trial = other_trial;
             }
         }
         chosen.sharpen_trials = trials;
@@ -806,7 +865,7 @@ impl SwingEncoder {
     /// trial and its candidate stream, `None` for `out`'s own): its vetoes, then the
     /// projections with and without the filter for after sharpening, within the bounds of
     /// the input's max and no sharpening's trial (`none`). Every trial goes to `trials` (flagged
-    /// [`SharpenTrial::runner_up`] on the runner-up's path); returns the stream and the
+    /// [`SharpenTrial::runner_up`] on a runner-up's path); returns the stream and the
     /// trial that stand.
     #[allow(clippy::too_many_arguments)]
     fn finish_sharpening(
@@ -838,6 +897,7 @@ impl SwingEncoder {
             smooth_factor: chosen_trial.smooth_factor,
             curved_walls: Some(chosen_trial.curved_walls),
             passes: chosen_trial.passes,
+            gray_labels: chosen_trial.gray_labels,
         }
         .sharpen_options();
         // Then the chosen sharpening judged against the original (docs/sharpen.md, "Snap
@@ -1191,6 +1251,7 @@ impl SwingEncoder {
             smooth_factor: DEFAULT_SMOOTH_FACTOR,
             curved_walls: None,
             passes: 1,
+            gray_labels: false,
         };
         let mut outs = self.encode_at_for(prep, fraction, &[only])?;
         outs.pop()
@@ -1262,6 +1323,7 @@ impl SwingEncoder {
                 sharpen_smooth_factor: c.hint.map(|_| c.smooth_factor),
                 sharpen_curved_walls: c.hint.and(c.curved_walls),
                 sharpen_passes: c.hint.and((c.passes > 1).then_some(c.passes)),
+                sharpen_gray_labels: c.hint.is_some() && c.gray_labels,
             };
             let mut enc: SwingEncoded = encode_retiled(&retiled.mesh, &params, &info)?;
             if let (Some((ext, ratio)), None) = (ext, use_extended) {
@@ -1310,6 +1372,7 @@ impl SwingEncoder {
                 sharpen_smooth_factor: info.sharpen_smooth_factor,
                 sharpen_curved_walls: info.sharpen_curved_walls,
                 sharpen_passes: info.sharpen_passes,
+                sharpen_gray_labels: info.sharpen_gray_labels,
                 planar_factor: None,
                 quadric_factor: None,
                 beside_factor: None,
@@ -1856,6 +1919,7 @@ struct Candidate {
     smooth_factor: f64,
     curved_walls: Option<f64>,
     passes: u32,
+    gray_labels: bool,
 }
 
 impl Candidate {
@@ -1869,7 +1933,8 @@ impl Candidate {
         let opts = whet_sharpen::SharpenOptions::DEFAULT
             .with_method(method)
             .with_smooth_factor(self.smooth_factor)
-            .with_passes(self.passes);
+            .with_passes(self.passes)
+            .with_surface_gray_labels(self.gray_labels);
         match self.curved_walls {
             Some(w) => opts.with_curved_wall_factor(w),
             None => opts,
@@ -1885,6 +1950,7 @@ impl Candidate {
             smooth_factor: self.smooth_factor,
             curved_walls: opts.curved_walls(),
             passes: opts.passes,
+            gray_labels: self.gray_labels,
             rms_pct,
             max_pct,
             planar: false,
@@ -1898,11 +1964,19 @@ impl Candidate {
     }
 }
 
-/// Index of a sharpening method among the runner-up's candidates: 0 for the extended
-/// method, 1 for the papers' (a trial is of one or the other).
-fn method_slot(hint: SharpenHint) -> usize {
-    usize::from(hint == SharpenHint::Papers)
+/// Index of a trial's sharpening among the runners-up's candidates: [`EXTENDED_SLOT`] for
+/// the extended method, 1 for the papers', 2 for the extended method with gray labels (a
+/// trial of no sharpening is never in a slot).
+fn method_slot(trial: &SharpenTrial) -> usize {
+    match (trial.hint, trial.gray_labels) {
+        (SharpenHint::Papers, _) => 1,
+        (_, true) => 2,
+        _ => EXTENDED_SLOT,
+    }
 }
+
+/// [`method_slot`] of the extended method without gray labels.
+const EXTENDED_SLOT: usize = 0;
 
 /// Step of the refinement of the chosen smooth factor (`refinements`).
 const SMOOTH_FACTOR_STEP: f64 = 0.25;
@@ -1940,6 +2014,7 @@ fn refinements(centre: &SharpenTrial) -> Vec<Candidate> {
                     smooth_factor,
                     curved_walls,
                     passes: centre.passes,
+                    gray_labels: centre.gray_labels,
                 });
             }
         }
@@ -1953,6 +2028,7 @@ fn refinements(centre: &SharpenTrial) -> Vec<Candidate> {
             smooth_factor: s,
             curved_walls: (centre.curved_walls > 0.0).then_some(centre.curved_walls),
             passes: more,
+            gray_labels: centre.gray_labels,
         });
     }
     out

@@ -108,6 +108,8 @@ pub struct StatedSharpening {
     pub curved_walls: Option<f64>,
     /// Sharpening passes (1 unless stated).
     pub passes: u32,
+    /// Gray-vertex labels on surface samplings (field 41; off unless stated).
+    pub gray_labels: bool,
     /// The snaps the encoder vetoed (field 33), when stated.
     pub vetoes: Option<SnapVetoes>,
     /// The filter for after sharpening (none unless stated).
@@ -136,6 +138,7 @@ impl Default for StatedSharpening {
             smooth_factor: 2.0,
             curved_walls: None,
             passes: 1,
+            gray_labels: false,
             vetoes: None,
             after_filter: SurfaceFilter::NONE,
             projections: Vec::new(),
@@ -155,6 +158,7 @@ impl StatedSharpening {
             passes: stated
                 .and_then(|_| SharpenHint::passes_of(header))
                 .unwrap_or(1),
+            gray_labels: SharpenHint::gray_labels_of(header),
             vetoes,
             after_filter: SurfaceFilter::after_sharpening_of(header),
             projections: StatedProjection::all_of(header),
@@ -180,7 +184,8 @@ impl StatedSharpening {
         let opts = SharpenOptions::DEFAULT
             .with_method(self.method())
             .with_smooth_factor(self.smooth_factor)
-            .with_passes(self.passes);
+            .with_passes(self.passes)
+            .with_surface_gray_labels(self.gray_labels);
         match self.curved_walls {
             Some(w) => opts.with_curved_wall_factor(w),
             None => opts,
@@ -339,6 +344,17 @@ mod tests {
                 .with_method(Method::Papers)
                 .with_smooth_factor(1.5)
                 .with_passes(2)
+        );
+        // Field 41 turns the gray-vertex labels of surface samplings on.
+        let gray = h
+            .with(tag::SHARPEN_METHOD, SharpenHint::Extended.code())
+            .with(tag::SHARPEN_GRAY_LABELS, 1u64);
+        assert_eq!(
+            StatedSharpening::of(&gray).unwrap().options(),
+            SharpenOptions::DEFAULT
+                .with_smooth_factor(1.5)
+                .with_passes(2)
+                .with_surface_gray_labels(true)
         );
     }
 

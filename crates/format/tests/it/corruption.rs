@@ -373,8 +373,8 @@ fn unknown_optional_fields_are_skipped() {
         field(tag::QUANT_BITS, 0, &[12]),
         field(13, 0, &[0xff, 0x01]),
         field(15, 1, &[0x03]),
-        field(41, 2, &1.5f64.to_le_bytes()),
-        field(43, 3, &[3, b'a', b'b', b'c']),
+        field(45, 2, &1.5f64.to_le_bytes()),
+        field(47, 3, &[3, b'a', b'b', b'c']),
         field((1 << 50) | 1, 0, &[0]),
     ]
     .concat();

@@ -80,6 +80,8 @@ pub struct SwingInput {
     pub crease: bool,
     /// The stream states the apex restoration (field 39).
     pub apex: bool,
+    /// The stream states gray-vertex labels on surface samplings (field 41).
+    pub gray_labels: bool,
     /// The stream carries a filter for after sharpening (fields 17 and 19).
     pub after_filter: bool,
     /// The stream.
@@ -246,11 +248,11 @@ pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
 }
 
 /// Encodes `original` at `rate` and decodes it; `key` names the stream in the cache
-/// (`target/sharpen-swing/v46-<key>-<angles>.whet`).
+/// (`target/sharpen-swing/v47-<key>-<angles>.whet`).
 pub fn swing_input_of(original: Mesh, key: &str, rate: Rate, angles: Angles) -> SwingInput {
     let dir = whet_testkit::workspace_root().join("target/sharpen-swing");
     let _ = std::fs::create_dir_all(&dir);
-    let path = dir.join(format!("v46-{key}-{}.whet", angles.tag()));
+    let path = dir.join(format!("v47-{key}-{}.whet", angles.tag()));
     let bytes = match std::fs::read(&path) {
         Ok(b) => b,
         Err(_) => {
@@ -290,6 +292,7 @@ pub fn swing_input_of(original: Mesh, key: &str, rate: Rate, angles: Angles) -> 
         beside: whet_codec::SharpenHint::beside_of(&header).is_some(),
         crease: whet_codec::SharpenHint::crease_of(&header).is_some(),
         apex: whet_codec::SharpenHint::apex_of(&header).is_some(),
+        gray_labels: whet_codec::SharpenHint::gray_labels_of(&header),
         original,
         decoded,
         bytes,
