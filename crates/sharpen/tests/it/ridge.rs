@@ -9,15 +9,21 @@ const XS: [f64; 6] = [-2.5, -1.5, -0.5, 0.5, 1.5, 2.5];
 const NY: u32 = 6;
 
 fn ridge() -> Mesh {
+    columns(&XS.map(|x| [x, -x.abs()]))
+}
+
+/// A strip of `NY` rows (y = 0, 1, ...) through the profile points `[x, z]`, one column of
+/// vertices per point, each cell cut along the same diagonal.
+fn columns(profile: &[[f64; 2]]) -> Mesh {
     let mut p = Vec::new();
-    for &x in &XS {
+    for &[x, z] in profile {
         for j in 0..NY {
-            p.push(DVec3::new(x, j as f64, -x.abs()));
+            p.push(DVec3::new(x, j as f64, z));
         }
     }
     let id = |i: u32, j: u32| i * NY + j;
     let mut t = Vec::new();
-    for i in 0..XS.len() as u32 - 1 {
+    for i in 0..profile.len() as u32 - 1 {
         for j in 0..NY - 1 {
             t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
             t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
@@ -128,24 +134,17 @@ fn ridge_with_a_step_is_mixed_convexity() {
 const MIDDLE: [f64; 2] = [0.0, -0.3];
 
 fn two_wide_ridge() -> Mesh {
-    let xs: Vec<f64> = (-6..=6).map(f64::from).collect();
-    let mut p = Vec::new();
-    for &x in &xs {
-        for j in 0..NY {
-            let z = if x == 0.0 { MIDDLE[1] } else { -x.abs() };
-            let x = if x == 0.0 { MIDDLE[0] } else { x };
-            p.push(DVec3::new(x, j as f64, z));
-        }
-    }
-    let id = |i: u32, j: u32| i * NY + j;
-    let mut t = Vec::new();
-    for i in 0..xs.len() as u32 - 1 {
-        for j in 0..NY - 1 {
-            t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-            t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-        }
-    }
-    Mesh::new(p, t)
+    let profile: Vec<[f64; 2]> = (-6..=6)
+        .map(|i| {
+            let x = f64::from(i);
+            if i == 0 {
+                MIDDLE
+            } else {
+                [x, -x.abs()]
+            }
+        })
+        .collect();
+    columns(&profile)
 }
 
 #[test]
