@@ -326,14 +326,14 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
     // cad_box_hole at 1.9 bpv: the projections do better without the filter for after
     // sharpening (measured 2026-12-05 at 6 angle bits: 0.0103 % with it, 0.0078 % without,
     // 1M Metro samples), so that path is taken and checked too. fandisk at 3 bpv takes the
-    // runner-up's path; cad_box_hole at 3.1 bpv the gray labels (docs/swing.md section 2,
+    // runner-up's path; cad_bracket at 1.2 bpv the gray labels (docs/swing.md section 2,
     // "Gray labels").
     for (name, bpv, not) in [
         ("fandisk.off", 1.6, SharpenHint::Unsharpened),
         ("rocker_arm.off", 2.8, SharpenHint::Papers),
         ("cad_box_hole.off", 1.9, SharpenHint::Unsharpened),
         ("fandisk.off", 3.0, SharpenHint::Unsharpened),
-        ("cad_box_hole.off", 3.1, SharpenHint::Unsharpened),
+        ("cad_bracket.off", 1.2, SharpenHint::Unsharpened),
     ] {
         let mesh = whet_io::read_path(&shared_fixture(name), None).unwrap();
         let opts = SwingOptions::DEFAULT
@@ -573,10 +573,10 @@ fn sharpened_streams_state_the_sharpening_measured_best() {
             if (name, bpv) == ("fandisk.off", 3.0) {
                 assert!(runner_up_won, "{name}: {:?}", out.sharpen_trials);
             }
-            // cad_box_hole at 3.1 bpv states the gray labels (measured 2026-12-07 at these
+            // cad_bracket at 1.2 bpv states the gray labels (measured 2026-12-07 at these
             // options: the extended method's best with them beat it by the margin, and its
             // path ended best), so the gray candidate's slot is exercised.
-            if (name, bpv) == ("cad_box_hole.off", 3.1) {
+            if (name, bpv) == ("cad_bracket.off", 1.2) {
                 assert!(
                     gray.is_some() && base.gray_labels,
                     "{name}: {:?}",
