@@ -66,7 +66,7 @@ pub struct SharpenTrial {
     pub passes: u32,
     /// EdgeSharpener's gray-vertex labels on surface samplings
     /// (`SharpenOptions::surface_gray_labels`, header field 41): tried on the extended
-    /// method's best of the grid only.
+    /// method's best after the grid's refinement only.
     pub gray_labels: bool,
     /// Measured symmetric RMS error of `whet decode --sharpen`'s output, % of the diagonal.
     pub rms_pct: f64,
