@@ -926,7 +926,7 @@ fn bad_passes_and_curved_walls_exit_2_with_a_message() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let sharpen = ["sharpen", s(&mesh), "-o", s(&out)];
     let decode = ["decode", s(&stream), "-o", s(&out)];
-    let cases: [(&[&str], &[&str], &str); 7] = [
+    let cases: [(&[&str], &[&str], &str); 9] = [
         (&sharpen, &["--passes", "0"], "passes"),
         (&sharpen, &["--passes", "5"], "passes"),
         (&sharpen, &["--curved-walls", "0.5"], "curved_wall"),
@@ -940,6 +940,13 @@ fn bad_passes_and_curved_walls_exit_2_with_a_message() {
         ),
         // Without --sharpen the flags mean nothing: clap refuses them.
         (&decode, &["--passes", "2"], "--sharpen"),
+        (&decode, &["--gray-labels", "true"], "--sharpen"),
+        // The stream's gray labels are overridden by true or false only.
+        (
+            &decode,
+            &["--sharpen", "--gray-labels", "maybe"],
+            "--gray-labels",
+        ),
     ];
     for (command, extra, says) in cases {
         let args = [command, extra].concat();
