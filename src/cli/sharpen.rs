@@ -54,7 +54,9 @@ pub struct SharpenArgs {
     #[arg(long)]
     curved_walls: Option<f64>,
     /// extended and papers: run the sharpener this many times (1 to 4), each pass on the
-    /// previous one's output; a pass's splits can leave chamfers the next finds.
+    /// previous one's output; a pass's splits can leave chamfers the next finds. On
+    /// marching-cubes input 2 lowered the max or the RMS on every sampling measured (the max
+    /// nowhere higher; a third pass adds nothing), for 65-80 % more time.
     #[arg(long, default_value_t = 1)]
     passes: u32,
     /// normal-filter: neighbourhood radius in mean edge lengths (a little more than the widest

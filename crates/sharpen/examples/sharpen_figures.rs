@@ -6,6 +6,7 @@
 //! cargo run --release -p whet-sharpen --example sharpen_figures            # everything
 //! cargo run --release -p whet-sharpen --example sharpen_figures -- synth   # marching cubes only
 //! cargo run --release -p whet-sharpen --example sharpen_figures -- retile  # fixtures only
+//! cargo run --release -p whet-sharpen --example sharpen_figures -- synth 2 # two passes
 //! cargo run --release -p whet-sharpen --example sharpen_figures -- noise   # noise sweep
 //! cargo run --release -p whet-sharpen --example sharpen_figures -- swing   # swing-decoded
 //! cargo run --release -p whet-sharpen --example sharpen_figures -- swing rocker  # one fixture
@@ -68,8 +69,10 @@ fn row_line(label: &str, reference: &Mesh, input: &Mesh) -> (String, [(f64, f64)
     );
     for (i, method) in [Method::Papers, Method::Extended].into_iter().enumerate() {
         let t = Instant::now();
-        let out = sharpen(input, &SharpenOptions::DEFAULT.with_method(method))
-            .unwrap_or_else(|e| panic!("{label}: {e}"));
+        let opts = SharpenOptions::DEFAULT
+            .with_method(method)
+            .with_passes(passes());
+        let out = sharpen(input, &opts).unwrap_or_else(|e| panic!("{label}: {e}"));
         let ms = t.elapsed().as_secs_f64() * 1e3;
         let e = error(reference, &out.mesh, samples());
         errors[i + 1] = (e.rms_pct, e.max_pct);
@@ -91,6 +94,21 @@ fn row_line(label: &str, reference: &Mesh, input: &Mesh) -> (String, [(f64, f64)
     (line, errors)
 }
 
+/// EdgeSharpener passes for the `synth` and `noise` tables: their optional second argument
+/// (`synth 2`), else 1, the default.
+fn passes() -> u32 {
+    static PASSES: std::sync::OnceLock<u32> = std::sync::OnceLock::new();
+    *PASSES.get_or_init(|| {
+        let what = std::env::args().nth(1).unwrap_or_default();
+        match std::env::args().nth(2) {
+            Some(n) if what == "synth" || what == "noise" => n
+                .parse()
+                .unwrap_or_else(|_| panic!("{what} takes a number of passes, got {n:?}")),
+            _ => 1,
+        }
+    })
+}
+
 fn header(first: &str) {
     println!(
         "| {first} | V | RMS % | max % | papers RMS % | max % | RMS gain | max gain | reversed/new | ms \
@@ -101,6 +119,12 @@ fn header(first: &str) {
 
 fn synth() {
     println!("\n### Marching cubes of synth shapes (reference: the truth mesh)\n");
+    if passes() != 1 {
+        println!(
+            "EdgeSharpener in {} passes (`SharpenOptions::passes`).\n",
+            passes()
+        );
+    }
     header("shape, resolution, rotation");
     for kind in [ShapeKind::Cube, ShapeKind::Pyramid, ShapeKind::Fandisk] {
         for res in [32, 48, 64, 96, 128] {
@@ -262,6 +286,12 @@ fn swing_synth() {
 
 fn noise() {
     println!("\n### Normal noise (percent of the longest edge) on marching cubes at 64\n");
+    if passes() != 1 {
+        println!(
+            "EdgeSharpener in {} passes (`SharpenOptions::passes`).\n",
+            passes()
+        );
+    }
     header("shape, noise");
     for kind in [ShapeKind::Cube, ShapeKind::Fandisk] {
         let shape = Shape::new(kind, &ShapeParams::default().with_rotation(rotations()[0]))
