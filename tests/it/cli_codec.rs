@@ -478,3 +478,45 @@ fn a_stream_file_over_the_budget_is_refused_before_reading() {
         );
     }
 }
+
+#[test]
+fn automatic_angle_bits_report_each_quantization() {
+    // For the decoded output each quantization tried is measured (RMS and max), the lowest
+    // RMS is written, and no sharpening is chosen for any of them.
+    let dir = scratch_dir("cli-codec-auto");
+    let src = shared_fixture("fandisk.off");
+    let stream = dir.join("auto.whet");
+    let j = whet_json(&[
+        "encode",
+        s(&src),
+        "-o",
+        s(&stream),
+        "--bpv",
+        "2",
+        "--angle-bits",
+        "auto",
+        "--json",
+    ]);
+    let trials = j["angle_trials"].as_array().expect("angle_trials");
+    assert!(trials.len() >= 3, "{j}");
+    for t in trials {
+        for key in ["angle_bits", "bytes", "rms_error_pct", "max_error_pct"] {
+            assert!(t[key].is_number(), "missing {key}: {t}");
+        }
+        assert!(
+            t["rms_error_pct"].as_f64() <= t["max_error_pct"].as_f64(),
+            "{t}"
+        );
+        for key in ["sharpened_rms_error_pct", "sharpened_max_error_pct"] {
+            assert!(t[key].is_null(), "{key} without a sharpening: {t}");
+        }
+    }
+    let lowest = trials
+        .iter()
+        .min_by(|a, b| {
+            let rms = |t: &serde_json::Value| t["rms_error_pct"].as_f64().unwrap();
+            rms(a).total_cmp(&rms(b))
+        })
+        .unwrap();
+    assert_eq!(j["angle_bits"], lowest["angle_bits"], "{j}");
+}

@@ -22,6 +22,7 @@
 //! nearest reference faces; `DIAG_V=<vertex>` prints that input vertex's input and output
 //! positions; `DIAG_AT=x,y,z` dumps the neighbourhood of that point instead of the worst
 //! place; `DIAG_NO_WELD=1` turns off the extended method's cluster welding (`--no-weld`);
+//! `DIAG_PASSES=<n>` runs EdgeSharpener in that many passes (`--passes`);
 //! `DIAG_SAMPLES=<n>` sets Metro's samples a direction (300k; `0`: the default of `sharpen_figures`);
 //! `DIAG_ROT=x,y,z,angle` turns a synth shape about that axis by that many radians instead.
 
@@ -103,7 +104,13 @@ fn main() {
             &input,
             &SharpenOptions::DEFAULT
                 .with_method(method)
-                .with_weld_clusters(std::env::var_os("DIAG_NO_WELD").is_none()),
+                .with_weld_clusters(std::env::var_os("DIAG_NO_WELD").is_none())
+                .with_passes(
+                    std::env::var("DIAG_PASSES")
+                        .ok()
+                        .and_then(|p| p.parse().ok())
+                        .unwrap_or(1),
+                ),
         ),
         "sharpen",
     );

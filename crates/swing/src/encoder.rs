@@ -50,6 +50,13 @@ pub struct AngleTrial {
     /// Measured RMS error (of [`SwingOptions::error_of`]), % of the diagonal; `None` when
     /// this quantization reached no stream (an error target it cannot meet).
     pub rms_pct: Option<f64>,
+    /// The max error measured with it (`None` when only the RMS was measured: an error
+    /// target's search, or no stream).
+    pub max_pct: Option<f64>,
+    /// For the sharpened output: the `(rms, max)` its stream ends with once its sharpening
+    /// and projections are chosen, for the quantization written and for a finalist
+    /// (`SwingEncoder::encode`); `None` for the others.
+    pub sharpened: Option<(f64, f64)>,
 }
 
 /// One sharpening measured by the encoder's choice ([`SwingOutput::sharpen_trials`]).
@@ -117,6 +124,13 @@ impl SharpenTrial {
 /// max 0.26 % -> 0.42 %); a quarter makes a max 34 % lower worth an RMS 10 % higher, and
 /// keeps RMS the main figure.
 pub const MAX_ERROR_WEIGHT: f64 = 0.25;
+
+/// The automatic angle bits (sharpened output): a quantization whose score with
+/// EdgeSharpener's default comes within this factor of the best one's is a *finalist*, whose
+/// sharpening is chosen too (`SwingEncoder::encode`). The scores move by a few % from one
+/// edge length to the next (the walk's own noise allowance is 3 %), and the default's figures
+/// are only a proxy of the chosen sharpening's.
+const FINALIST_WINDOW: f64 = 1.05;
 
 /// What a later sharpening candidate or refinement must beat the score before it by: more
 /// than the sampling noise of a measurement (about 0.3 % at 300 000 samples).
@@ -552,13 +566,47 @@ impl SwingEncoder {
         let out = if o.auto_angle_bits {
             self.encode_auto_angle_bits(&prep)
         } else {
-            self.encode_prepared(&prep)
+            self.encode_prepared(&prep).map(|out| (out, None))
         };
-        let out = out.map_err(|e| explain_stuck(e, &prep.mesh))?;
+        let (out, finalist) = out.map_err(|e| explain_stuck(e, &prep.mesh))?;
         if o.error_of == ErrorOf::Sharpened {
-            return self.choose_sharpening(&prep, out);
+            return self.choose_sharpening_of_finalists(&prep, out, finalist);
         }
         self.veto_default_sharpening(&prep, out)
+    }
+
+    /// The sharpening chosen for `out`, and for the automatic angle bits' `finalist` when
+    /// there is one (the quantization whose measure came within [`FINALIST_WINDOW`] of
+    /// `out`'s): whichever of the two ends better by the margin is written. The automatic
+    /// choice measures each quantization with EdgeSharpener's default, while the stream
+    /// states the sharpening and projections measured best for it; near a tie the default's
+    /// figures do not say which quantization ends better (partLp at 5.2 bpv: 6 and 7 bits
+    /// within 3 % with the default, 20 % apart in RMS at the end).
+    fn choose_sharpening_of_finalists(
+        &self,
+        prep: &Prepared,
+        out: SwingOutput,
+        finalist: Option<SwingOutput>,
+    ) -> Result<SwingOutput, Error> {
+        let (mut chosen, trial) = self.choose_sharpening(prep, out)?;
+        let ended = |trials: &mut Vec<AngleTrial>, bits: u32, t: &SharpenTrial| {
+            if let Some(a) = trials.iter_mut().find(|a| a.angle_bits == bits) {
+                a.sharpened = Some((t.rms_pct, t.max_pct));
+            }
+        };
+        let mut trials = std::mem::take(&mut chosen.angle_trials);
+        ended(&mut trials, chosen.angle_bits, &trial);
+        if let Some(f) = finalist {
+            let (other, other_trial) = self.choose_sharpening(prep, f)?;
+            ended(&mut trials, other.angle_bits, &other_trial);
+            if other_trial.score() < SHARPEN_MARGIN * trial.score() {
+                let search = std::mem::take(&mut chosen.search);
+                chosen = other;
+                chosen.search = search;
+            }
+        }
+        chosen.angle_trials = trials;
+        Ok(chosen)
     }
 
     /// A stream encoded for the decoded output states no sharpening, so `whet decode
@@ -624,7 +672,11 @@ impl SwingEncoder {
     /// candidates after the first cost one more retiling at the same length (with a filter
     /// for after sharpening fitted on each candidate's output) and one Metro measurement
     /// each.
-    fn choose_sharpening(&self, prep: &Prepared, out: SwingOutput) -> Result<SwingOutput, Error> {
+    fn choose_sharpening(
+        &self,
+        prep: &Prepared,
+        out: SwingOutput,
+    ) -> Result<(SwingOutput, SharpenTrial), Error> {
         // A candidate's score must beat the ones before it (the default first, no
         // sharpening last) by SHARPEN_MARGIN.
         // (method, smooth factor, curved-wall factor; `None`: off). The sharpenings with
@@ -858,7 +910,7 @@ impl SwingEncoder {
         }
         chosen.sharpen_trials = trials;
         chosen.sharpen_input_max_pct = Some(input_max);
-        Ok(chosen)
+        Ok((chosen, chosen_trial))
     }
 
     /// The rest of [`Self::choose_sharpening`] for one sharpening (`decision`: its measured
@@ -1138,7 +1190,10 @@ impl SwingEncoder {
     /// error target) wins. Flat regions predict their swing angles almost exactly, so extra
     /// bits cost little there and pay off after sharpening; curved ones pay for every bit:
     /// which wins depends on the mesh and the rate, hence a measurement, not a rule.
-    fn encode_auto_angle_bits(&self, prep: &Prepared) -> Result<SwingOutput, Error> {
+    fn encode_auto_angle_bits(
+        &self,
+        prep: &Prepared,
+    ) -> Result<(SwingOutput, Option<SwingOutput>), Error> {
         let o = self.opts;
         if let Rate::EdgeLength(_) = o.rate {
             return Err(Error::Parameter(
@@ -1171,6 +1226,8 @@ impl SwingEncoder {
                         edge_length_fraction: f64::NAN,
                         bytes: 0,
                         rms_pct: None,
+                        max_pct: None,
+                        sharpened: None,
                     });
                     last_err = Some(e);
                     return Ok(None);
@@ -1179,9 +1236,14 @@ impl SwingEncoder {
             };
             hint = Some(out.edge_length_fraction);
             search.extend_from_slice(&out.search);
-            let rms = match out.rms_pct {
-                Some(r) => r,
-                None => enc.measure(prep, &out)?,
+            let (rms, max) = match out.rms_pct {
+                Some(r) => (r, None),
+                None => {
+                    let opts = whet_sharpen::SharpenOptions::DEFAULT;
+                    let (r, m) =
+                        enc.measure_figures(prep, &out, o.error_of, &opts, &mut Vec::new())?;
+                    (r, Some(m))
+                }
             };
             out.rms_pct = Some(rms);
             trials.push(AngleTrial {
@@ -1189,11 +1251,18 @@ impl SwingEncoder {
                 edge_length_fraction: out.edge_length_fraction,
                 bytes: out.bytes.len(),
                 rms_pct: Some(rms),
+                max_pct: max,
+                sharpened: None,
             });
-            let score = if by_error {
-                out.bytes.len() as f64
-            } else {
-                rms
+            // For the sharpened output the score its sharpening is chosen by (the max error
+            // counts too: `MAX_ERROR_WEIGHT`), so that the bits and the sharpening weigh the
+            // two errors alike; for the decoded one the RMS.
+            let score = match max {
+                _ if by_error => out.bytes.len() as f64,
+                Some(m) if o.error_of == ErrorOf::Sharpened => {
+                    rms * m.max(0.0).powf(MAX_ERROR_WEIGHT)
+                }
+                _ => rms,
             };
             Ok(Some((score, out)))
         };
@@ -1207,6 +1276,13 @@ impl SwingEncoder {
         let range = SwingOptions::AUTO_ANGLE_BITS;
         let start = SwingOptions::DEFAULT_ANGLE_BITS;
         let mut best: Option<(f64, SwingOutput)> = run(start)?;
+        // The best of the others, the finalist's candidate.
+        let mut second: Option<(f64, SwingOutput)> = None;
+        let keep_second = |c: (f64, SwingOutput), second: &mut Option<(f64, SwingOutput)>| {
+            if second.as_ref().is_none_or(|s| c.0 < s.0) {
+                *second = Some(c);
+            }
+        };
         for dir in [1i32, -1] {
             let mut bits = start;
             let mut misses = 0;
@@ -1221,9 +1297,12 @@ impl SwingEncoder {
                 };
                 let best_score = best.as_ref().map_or(f64::INFINITY, |b| b.0);
                 if score < best_score {
-                    best = Some((score, out));
+                    if let Some(old) = best.replace((score, out)) {
+                        keep_second(old, &mut second);
+                    }
                     misses = 0;
                 } else {
+                    keep_second((score, out), &mut second);
                     misses += 1;
                     if score > best_score * NOISE || misses >= 2 {
                         break;
@@ -1231,14 +1310,21 @@ impl SwingEncoder {
                 }
             }
         }
-        let Some((_, mut out)) = best else {
+        let Some((best_score, mut out)) = best else {
             return Err(
                 last_err.unwrap_or_else(|| Error::Stuck("no angle quantization worked".into()))
             );
         };
         out.search = search;
         out.angle_trials = trials;
-        Ok(out)
+        let finalist = second
+            .filter(|(score, _)| {
+                o.error_of == ErrorOf::Sharpened
+                    && !by_error
+                    && *score <= FINALIST_WINDOW * best_score
+            })
+            .map(|(_, f)| f);
+        Ok((out, finalist))
     }
 
     /// Retiles and encodes at edge length `fraction · diagonal`. Streams optimised for

@@ -252,7 +252,7 @@ pub fn swing_input(name: &str, bpv: f64, angles: Angles) -> SwingInput {
 pub fn swing_input_of(original: Mesh, key: &str, rate: Rate, angles: Angles) -> SwingInput {
     let dir = whet_testkit::workspace_root().join("target/sharpen-swing");
     let _ = std::fs::create_dir_all(&dir);
-    let path = dir.join(format!("v47-{key}-{}.whet", angles.tag()));
+    let path = dir.join(format!("v49-{key}-{}.whet", angles.tag()));
     let bytes = match std::fs::read(&path) {
         Ok(b) => b,
         Err(_) => {

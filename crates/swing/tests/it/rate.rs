@@ -218,6 +218,54 @@ fn automatic_angle_bits_climb_on_flat_parts_and_stay_low_on_smooth_ones() {
         "{:?}",
         out.angle_trials
     );
+    // Each quantization is scored with EdgeSharpener's default as the sharpening is chosen,
+    // the max error counting too. The best one's sharpening is chosen, and a finalist's
+    // (within 5 % of that score) too; the one that ends better by the margin is written.
+    let weighted = |(rms, max): (f64, f64)| rms * max.powf(whet_swing::MAX_ERROR_WEIGHT);
+    let score = |t: &whet_swing::AngleTrial| weighted((t.rms_pct.unwrap(), t.max_pct.unwrap()));
+    let measured: Vec<_> = out
+        .angle_trials
+        .iter()
+        .filter(|t| t.rms_pct.is_some())
+        .collect();
+    let best = measured
+        .iter()
+        .min_by(|a, b| score(a).total_cmp(&score(b)))
+        .unwrap();
+    let ended: Vec<_> = measured.iter().filter(|t| t.sharpened.is_some()).collect();
+    assert!(
+        ended.iter().any(|t| t.angle_bits == best.angle_bits),
+        "{:?}",
+        out.angle_trials
+    );
+    let written = ended
+        .iter()
+        .find(|t| t.angle_bits == out.angle_bits)
+        .unwrap_or_else(|| panic!("{:?}", out.angle_trials));
+    // Here a finalist is measured (2026-12-07, at these options: 8 bits scored 0.00391 with
+    // the default sharpening, 9 bits 0.00396; they ended at RMS 0.00201 and 0.00204 %), so
+    // this test runs that path; elsewhere one quantization alone can end.
+    assert_eq!(ended.len(), 2, "{:?}", out.angle_trials);
+    let other = ended
+        .iter()
+        .find(|t| t.angle_bits != out.angle_bits)
+        .unwrap();
+    let finalist = if other.angle_bits == best.angle_bits {
+        written
+    } else {
+        other
+    };
+    assert!(
+        score(finalist) <= 1.05 * score(best),
+        "{:?}",
+        out.angle_trials
+    );
+    // The proxy's best stays unless the finalist ends better by the 0.5 % margin.
+    assert!(
+        weighted(written.sharpened.unwrap()) <= weighted(other.sharpened.unwrap()) / 0.995,
+        "{:?}",
+        out.angle_trials
+    );
     let at_default = out
         .angle_trials
         .iter()
@@ -289,6 +337,7 @@ fn automatic_angle_bits_climb_on_flat_parts_and_stay_low_on_smooth_ones() {
             out.angle_trials
         );
     }
+    // For the decoded output the RMS alone decides.
     let best = out
         .angle_trials
         .iter()
