@@ -1186,10 +1186,13 @@ impl SwingEncoder {
     }
 
     /// The automatic angle-bit choice: every candidate quantization runs the rate (or error)
-    /// search, and the stream with the lowest measured error (or the smallest one meeting the
-    /// error target) wins. Flat regions predict their swing angles almost exactly, so extra
-    /// bits cost little there and pay off after sharpening; curved ones pay for every bit:
-    /// which wins depends on the mesh and the rate, hence a measurement, not a rule.
+    /// search, and the stream with the lowest measured error (for the sharpened output
+    /// `rms · max^MAX_ERROR_WEIGHT`, with EdgeSharpener's default), or the smallest one
+    /// meeting the error target, wins; for the sharpened output the runner-up within
+    /// [`FINALIST_WINDOW`] comes back too, as the finalist whose sharpening is also chosen.
+    /// Flat regions predict their swing angles almost exactly, so extra bits cost little
+    /// there and pay off after sharpening; curved ones pay for every bit: which wins depends
+    /// on the mesh and the rate, hence a measurement, not a rule.
     fn encode_auto_angle_bits(
         &self,
         prep: &Prepared,
