@@ -58,10 +58,21 @@ fn check_mesh(mesh: &whet_mesh::Mesh, what: &str) {
 /// choice, not its precision, is what is fuzzed.
 const SHARPENED_METRO_SAMPLES: usize = 2_000;
 
+/// Smallest stream size [`fuzz_encode`] asks of the automatic angle bits.
+const AUTO_MIN_BYTES: usize = 60;
+
+/// Most retiled triangles of [`fuzz_encode`]'s automatic angle bits: every quantization
+/// runs its own size search, so a tenth of the fixed-bits limit keeps an input within a
+/// few seconds.
+const AUTO_MAX_TRIANGLES: usize = 2_000;
+
 /// Encodes the mesh `data` describes (`whet_sharpen::fuzz_input`'s layout; byte 1 also
 /// picks the angle bits, byte 2 the edge length: 2 % to 50 % of the diagonal, and a last
-/// byte ending in two set bits `--optimize-for sharpened` (a quarter of the inputs), the encoder's choice of sharpening with its vetoes,
-/// projections and runner-up, measured with [`SHARPENED_METRO_SAMPLES`]) and, when the
+/// byte ending in two set bits `--optimize-for sharpened` (a quarter of the inputs), the
+/// encoder's choice of sharpening with its vetoes, projections and runner-up, measured with
+/// [`SHARPENED_METRO_SAMPLES`]; ending in four set bits, a sixteenth of the inputs, the
+/// automatic angle bits with a finalist instead of byte 1's, at a size target of
+/// [`AUTO_MIN_BYTES`] plus byte 2 instead of its edge length) and, when the
 /// encoder accepts it, decodes the stream. Panics only on a bug: a panic inside, an
 /// internal error, or a stream that does not decode bit for bit to the encoder's retiled
 /// mesh (indices in range, finite positions).
@@ -79,6 +90,14 @@ pub fn fuzz_encode(data: &[u8]) {
         opts = opts
             .with_error_of(ErrorOf::Sharpened)
             .with_metro_samples(SHARPENED_METRO_SAMPLES);
+    }
+    if data.last().is_some_and(|b| b & 15 == 15) {
+        // The automatic angle bits need a size target: each quantization gets its own size
+        // search, and a finalist its own choice of sharpening.
+        opts = opts
+            .with_rate(Rate::TargetBytes(AUTO_MIN_BYTES + usize::from(data[2])))
+            .with_auto_angle_bits(true)
+            .with_tuning(RetileTuning::DEFAULT.with_max_triangles(AUTO_MAX_TRIANGLES));
     }
     let out = match encode(&mesh, &opts) {
         Ok(out) => out,
