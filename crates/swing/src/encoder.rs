@@ -6,6 +6,7 @@
 use crate::retiler::{retile_fitted, FilterFits, RetileStats, RetileTuning};
 use crate::stated::StatedProjection;
 use crate::Error;
+use rayon::prelude::*;
 use whet_codec::{
     encode_retiled, prepare_mesh, EncodeReport, SharpenHint, SnapVetoes, SurfaceFilter,
     SwingEncoded, SwingGeometry, SwingParams, SwingStreamInfo, Version,
@@ -588,7 +589,20 @@ impl SwingEncoder {
         out: SwingOutput,
         finalist: Option<SwingOutput>,
     ) -> Result<SwingOutput, Error> {
-        let (mut chosen, trial) = self.choose_sharpening(prep, out)?;
+        // The two choices are independent: run side by side, so that each one's serial
+        // work (sharpening, projections) overlaps the other's (Metro runs on every core
+        // either way). The same result, and the same first error, as one after the other.
+        let (chosen, other) = match finalist {
+            Some(f) => {
+                let (a, b) = rayon::join(
+                    || self.choose_sharpening(prep, out),
+                    || self.choose_sharpening(prep, f),
+                );
+                (a?, Some(b?))
+            }
+            None => (self.choose_sharpening(prep, out)?, None),
+        };
+        let (mut chosen, trial) = chosen;
         let ended = |trials: &mut Vec<AngleTrial>, bits: u32, t: &SharpenTrial| {
             if let Some(a) = trials.iter_mut().find(|a| a.angle_bits == bits) {
                 a.sharpened = Some((t.rms_pct, t.max_pct));
@@ -596,8 +610,7 @@ impl SwingEncoder {
         };
         let mut trials = std::mem::take(&mut chosen.angle_trials);
         ended(&mut trials, chosen.angle_bits, &trial);
-        if let Some(f) = finalist {
-            let (other, other_trial) = self.choose_sharpening(prep, f)?;
+        if let Some((other, other_trial)) = other {
             ended(&mut trials, other.angle_bits, &other_trial);
             if other_trial.score() < SHARPEN_MARGIN * trial.score() {
                 let search = std::mem::take(&mut chosen.search);
@@ -717,7 +730,7 @@ impl SwingEncoder {
                 .with_angle_bits(out.angle_bits)
                 .with_auto_angle_bits(false),
         );
-        let mut streams = match at_bits.encode_at_for(prep, fraction, &candidates[1..]) {
+        let streams = match at_bits.encode_at_for(prep, fraction, &candidates[1..]) {
             // The same retiling (the retiler is deterministic); only the hint and the filter
             // for after sharpening differ.
             Ok(s) if s.first().is_some_and(|p| p.retiled == out.retiled) => s,
@@ -772,19 +785,17 @@ impl SwingEncoder {
                     .as_ref()
                     .is_none_or(|(b, _)| t.score() < SHARPEN_MARGIN * b.score())
         };
-        for (i, c) in candidates.iter().enumerate() {
-            let opts = c.sharpen_options();
-            let ((figures, _), stream) = if i == 0 {
-                // `out` was encoded for this one.
-                let f = self.measure_sharpened(prep, &out, &input, &opts, &mut measured, false)?;
-                (f, None)
-            } else {
-                let Some(p) = streams.next() else { break };
-                (
-                    self.measure_sharpened(prep, &p, &input, &opts, &mut measured, false)?,
-                    Some(p),
-                )
-            };
+        // `out` was encoded for the first candidate; the others have their streams (as far as
+        // they go).
+        let streams: Vec<SwingOutput> = streams.collect();
+        let jobs: Vec<(&SwingOutput, whet_sharpen::SharpenOptions)> = std::iter::once(&out)
+            .chain(&streams)
+            .zip(candidates.iter().map(Candidate::sharpen_options))
+            .collect();
+        let figures = self.measure_sharpened_each(prep, &jobs, &input, &mut measured)?;
+        drop(jobs);
+        let streams = std::iter::once(None).chain(streams.into_iter().map(Some));
+        for ((c, figures), stream) in candidates.iter().zip(figures).zip(streams) {
             let trial = c.trial(figures);
             trials.push(trial);
             let slot = &mut best_of[method_slot(&trial)];
@@ -806,10 +817,13 @@ impl SwingEncoder {
                 Ok(_) | Err(Error::Stuck(_)) => Vec::new(),
                 Err(e) => return Err(e),
             };
-            for (c, p) in refined.iter().zip(streams) {
-                let opts = c.sharpen_options();
-                let (figures, _) =
-                    self.measure_sharpened(prep, &p, &input, &opts, &mut measured, false)?;
+            let jobs: Vec<(&SwingOutput, whet_sharpen::SharpenOptions)> = streams
+                .iter()
+                .zip(refined.iter().map(Candidate::sharpen_options))
+                .collect();
+            let figures = self.measure_sharpened_each(prep, &jobs, &input, &mut measured)?;
+            drop(jobs);
+            for ((c, p), figures) in refined.iter().zip(streams).zip(figures) {
                 let trial = c.trial(figures);
                 trials.push(trial);
                 let slot = &mut best_of[method_slot(&trial)];
@@ -1702,44 +1716,65 @@ impl SwingEncoder {
                 SnapVetoes::default(),
             )
         };
-        let sharpened = match sharpened {
-            Some(s) => {
-                let mut m = s.mesh;
-                out.sharpened_filter.apply_after_sharpening(input, &mut m);
-                // The projections as the decoder reads them from the header
-                // (`StatedSharpening`), in its order.
-                let projections = [
-                    out.planar_factor.map(|factor| StatedProjection::Planar {
-                        factor,
-                        angle_bits: out.angle_bits,
-                    }),
-                    out.quadric_factor.map(|factor| StatedProjection::Quadric {
-                        factor,
-                        angle_bits: out.angle_bits,
-                    }),
-                    out.beside_factor.map(|factor| StatedProjection::Beside {
-                        factor,
-                        angle_bits: out.angle_bits,
-                    }),
-                    out.crease_factor
-                        .map(|max_move| StatedProjection::Crease { max_move }),
-                    out.apex_factor
-                        .map(|max_move| StatedProjection::Apex { max_move }),
-                ];
-                for p in projections.into_iter().flatten() {
-                    // The sharpened mesh is a manifold; were it refused, the decoder keeps it
-                    // unprojected too (with a warning).
-                    let _ = p.apply(&mut m);
-                }
-                Some(m)
-            }
-            // A retiled mesh is a valid manifold; should the sharpener refuse one anyway,
-            // `whet decode --sharpen` would fail the same way, and the decoded mesh is what
-            // the user keeps.
-            None => None,
-        };
+        // A retiled mesh is a valid manifold; should the sharpener refuse one anyway, `whet
+        // decode --sharpen` would fail the same way, and the decoded mesh is what the user
+        // keeps.
+        let sharpened = sharpened.map(|s| stated_output(out, input, s.mesh));
         let figures = self.measure_mesh(prep, sharpened.as_ref().unwrap_or(input), measured)?;
         Ok((figures, vetoes))
+    }
+
+    /// [`Self::measure_sharpened`], unjudged, of each `(stream, sharpening)` of `jobs` in
+    /// turn: the same figures, and the same first error, as measuring them one after the
+    /// other. The sharpenings of as many jobs as there are threads run side by side (that
+    /// many meshes in memory at once), then the Metro measures of those not in `measured`
+    /// (each mesh once): the sharpener and the projections are single-threaded, and side by
+    /// side they overlap one another's Metro work.
+    fn measure_sharpened_each(
+        &self,
+        prep: &Prepared,
+        jobs: &[(&SwingOutput, whet_sharpen::SharpenOptions)],
+        input: &Mesh,
+        measured: &mut Vec<(u64, (f64, f64))>,
+    ) -> Result<Vec<(f64, f64)>, Error> {
+        let mut figures = Vec::with_capacity(jobs.len());
+        for group in jobs.chunks(rayon::current_num_threads().max(1)) {
+            let meshes: Vec<Option<Mesh>> = group
+                .par_iter()
+                .map(|(out, opts)| {
+                    whet_sharpen::sharpen(input, opts)
+                        .ok()
+                        .map(|s| stated_output(out, input, s.mesh))
+                })
+                .collect();
+            let meshes: Vec<&Mesh> = meshes.iter().map(|m| m.as_ref().unwrap_or(input)).collect();
+            let keys: Vec<u64> = meshes.iter().map(|m| mesh_key(m)).collect();
+            // The meshes to measure: each key once, the first of its jobs, in job order.
+            let mut fresh: Vec<usize> = Vec::new();
+            for (k, key) in keys.iter().enumerate() {
+                let seen = measured.iter().any(|(x, _)| x == key)
+                    || fresh.iter().any(|&j| keys[j] == *key);
+                if !seen {
+                    fresh.push(k);
+                }
+            }
+            let opts = MetroOptions::DEFAULT.with_samples(self.opts.metro_samples);
+            let results: Vec<Result<(f64, f64), Error>> = fresh
+                .par_iter()
+                .map(|&k| {
+                    let r = metro(&prep.mesh, meshes[k], &opts)?;
+                    Ok((r.symmetric.rms_pct, r.symmetric.max_pct))
+                })
+                .collect();
+            for (&k, r) in fresh.iter().zip(results) {
+                measured.push((keys[k], r?));
+            }
+            for key in &keys {
+                let f = measured.iter().find(|(x, _)| x == key).map(|(_, f)| *f);
+                figures.push(f.ok_or_else(|| Error::Internal("a mesh left unmeasured".into()))?);
+            }
+        }
+        Ok(figures)
     }
 
     /// The symmetric `(rms, max)` errors of `mesh` against the original, % of the diagonal;
@@ -2121,6 +2156,40 @@ fn refinements(centre: &SharpenTrial) -> Vec<Candidate> {
         });
     }
     out
+}
+
+/// What `whet decode --sharpen` makes of `sharpened`, the sharpener's output on `input`
+/// (`out`'s decoded mesh without its surface filter): the stream's filter for after
+/// sharpening, then its projections in the decoder's order.
+fn stated_output(out: &SwingOutput, input: &Mesh, sharpened: Mesh) -> Mesh {
+    let mut m = sharpened;
+    out.sharpened_filter.apply_after_sharpening(input, &mut m);
+    // The projections as the decoder reads them from the header
+    // (`StatedSharpening`), in its order.
+    let projections = [
+        out.planar_factor.map(|factor| StatedProjection::Planar {
+            factor,
+            angle_bits: out.angle_bits,
+        }),
+        out.quadric_factor.map(|factor| StatedProjection::Quadric {
+            factor,
+            angle_bits: out.angle_bits,
+        }),
+        out.beside_factor.map(|factor| StatedProjection::Beside {
+            factor,
+            angle_bits: out.angle_bits,
+        }),
+        out.crease_factor
+            .map(|max_move| StatedProjection::Crease { max_move }),
+        out.apex_factor
+            .map(|max_move| StatedProjection::Apex { max_move }),
+    ];
+    for p in projections.into_iter().flatten() {
+        // The sharpened mesh is a manifold; were it refused, the decoder keeps it
+        // unprojected too (with a warning).
+        let _ = p.apply(&mut m);
+    }
+    m
 }
 
 /// Most bytes the sharpening choice (`--optimize-for sharpened`) adds to the size search's

@@ -47,6 +47,7 @@
 use crate::grid::{Cells, FastMap, PointGrid};
 use crate::surface::{Hit, Surface};
 use crate::Error;
+use rayon::prelude::*;
 use std::f64::consts::{PI, TAU};
 use whet_codec::{RetiledMesh, SurfaceFilter, SwingFrame, SwingParams, VertexSource};
 use whet_edgebreaker::Clers;
@@ -527,23 +528,30 @@ pub(crate) fn retile_fitted(
         // Candidates that sharpen to the same mesh (the papers' method with curved walls
         // that turn no edge smooth, a second pass that changes nothing) share one fit.
         // (Keyed by a hash, not by the meshes: 25 candidates' meshes need not stay in memory.)
+        // The sharpenings run side by side, as many at a time as there are threads (that
+        // many meshes in memory at once); the fits, which query the original's grid, after
+        // them in candidate order.
         let mut fitted: Vec<(Option<u64>, SurfaceFilter)> = Vec::new();
-        let after = sharpen
-            .iter()
-            .map(|o| {
-                let sharp = whet_sharpen::sharpen(&kept, o).ok().map(|s| s.mesh);
+        let mut after = Vec::with_capacity(sharpen.len());
+        for group in sharpen.chunks(rayon::current_num_threads().max(1)) {
+            let sharps: Vec<Option<whet_mesh::Mesh>> = group
+                .par_iter()
+                .map(|o| whet_sharpen::sharpen(&kept, o).ok().map(|s| s.mesh))
+                .collect();
+            for sharp in sharps {
                 let key = sharp.as_ref().map(crate::encoder::mesh_key);
                 if let Some((_, f)) = fitted.iter().find(|(k, _)| *k == key) {
-                    return *f;
+                    after.push(*f);
+                    continue;
                 }
                 let f = match &sharp {
                     Some(s) => fit_after_sharpening(&kept, &fields, s, closest),
                     None => SurfaceFilter::NONE,
                 };
                 fitted.push((key, f));
-                f
-            })
-            .collect();
+                after.push(f);
+            }
+        }
         (filter, extended, after)
     } else {
         (
