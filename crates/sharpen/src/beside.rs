@@ -142,6 +142,7 @@ pub fn project_beside_creases_onto_local_quadrics(
         return Ok(report);
     }
     let (crease, on_crease) = crease_edges(mesh, &table, opts.crease_angle_degrees);
+    let centroids = crate::crease::centroids(mesh);
     let normals = vertex_normals(mesh);
     let cos_max = opts.max_normal_angle_degrees.to_radians().cos();
     let max_move = opts.max_move * edge;
@@ -173,7 +174,7 @@ pub fn project_beside_creases_onto_local_quadrics(
             }
         }
         let side = SideReach {
-            mesh,
+            centroids: &centroids,
             table: &table,
             crease: &crease,
             centre: p[v],

@@ -204,7 +204,8 @@ impl SideFit {
 /// are no crease, every triangle whose centroid lies within `reach` of `centre`, at most
 /// `max_triangles` of them.
 pub(crate) struct SideReach<'a> {
-    pub mesh: &'a Mesh,
+    /// Each triangle's centroid ([`centroids`]).
+    pub centroids: &'a [DVec3],
     pub table: &'a whet_mesh::CornerTable,
     /// Per corner, whether the edge it faces is a crease.
     pub crease: &'a [bool],
@@ -225,7 +226,6 @@ impl SideReach<'_> {
         stack: &mut Vec<usize>,
         gathered: &mut Vec<usize>,
     ) -> bool {
-        let p = &self.mesh.positions;
         gathered.clear();
         while let Some(t) = stack.pop() {
             gathered.push(t);
@@ -241,12 +241,7 @@ impl SideReach<'_> {
                 if self.crease[c] || tri_stamp[u] == stamp {
                     continue;
                 }
-                let centroid = self.mesh.triangles[u]
-                    .iter()
-                    .map(|&w| p[w as usize])
-                    .sum::<DVec3>()
-                    / 3.0;
-                if centroid.distance(self.centre) < self.reach {
+                if self.centroids[u].distance(self.centre) < self.reach {
                     tri_stamp[u] = stamp;
                     stack.push(u);
                 }
@@ -254,6 +249,16 @@ impl SideReach<'_> {
         }
         true
     }
+}
+
+/// Each triangle's centroid, the mean of its corners (summed in corner order), as
+/// [`SideReach`] measures its reach from.
+pub(crate) fn centroids(mesh: &Mesh) -> Vec<DVec3> {
+    let p = &mesh.positions;
+    mesh.triangles
+        .iter()
+        .map(|t| t.iter().map(|&w| p[w as usize]).sum::<DVec3>() / 3.0)
+        .collect()
 }
 
 /// Per corner, whether the edge it faces is a crease (its two triangles' normals differ by
@@ -418,6 +423,7 @@ pub fn project_creases_onto_local_quadrics(
         .map(|t| mesh.face_cross(t).normalize_or_zero())
         .collect();
     let (crease, on_crease) = crease_edges_of(mesh, &table, &normals, opts.crease_angle_degrees);
+    let centroids = centroids(mesh);
     let max_triangles = MAX_TRIANGLES_PER_SQUARED_RING * opts.rings * opts.rings;
     let min_sin = MIN_SIDE_TURN_DEGREES.to_radians().sin();
     let cos_crease = opts.crease_angle_degrees.to_radians().cos();
@@ -487,7 +493,7 @@ pub fn project_creases_onto_local_quadrics(
                 stack.push(t);
             }
             let side = SideReach {
-                mesh,
+                centroids: &centroids,
                 table: &table,
                 crease: &crease,
                 centre: p[v],
