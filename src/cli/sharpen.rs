@@ -156,10 +156,9 @@ pub fn stated_vetoes(header: &whet_format::Header) -> CliResult<Option<whet_shar
 /// sharpening gives) is kept as it is with a warning, as the encoder's measurement keeps
 /// it: the fields are optional refinements, not part of the decoded mesh.
 pub fn project_as_stated(header: &whet_format::Header, sharpened: &mut Mesh) {
-    for p in whet_swing::StatedProjection::all_of(header) {
-        if let Err(e) = p.apply(sharpened) {
-            eprintln!("whet: the {} projection was skipped: {e}", p.name());
-        }
+    let projections = whet_swing::StatedProjection::all_of(header);
+    for (p, e) in whet_swing::StatedProjection::apply_all(&projections, sharpened) {
+        eprintln!("whet: the {} projection was skipped: {e}", p.name());
     }
 }
 

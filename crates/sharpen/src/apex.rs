@@ -12,7 +12,7 @@
 use glam::{DMat3, DVec3};
 use whet_mesh::{CornerTable, Mesh, VertexId};
 
-use crate::planar::{checked_table, vertex_normals};
+use crate::planar::{table_for, vertex_normals};
 use crate::Error;
 
 /// A vertex whose one-ring neighbours' normals all lie within this many degrees of its own
@@ -261,8 +261,27 @@ fn smallest_eigenvalue(a: DMat3) -> f64 {
 /// vertex order. Fails with [`Error::InvalidInput`] when `mesh` is not an oriented manifold
 /// with finite coordinates, [`Error::Parameter`] for options out of range.
 pub fn restore_apexes(mesh: &mut Mesh, opts: &ApexOptions) -> Result<ApexReport, Error> {
+    restore_apexes_in(mesh, opts, None)
+}
+
+/// [`restore_apexes`] on `table`, the corner table of `mesh`'s triangles, built once for
+/// several projections in a row (they move vertices, never triangles; the coordinates are
+/// checked again). A table of other triangles is not used: one is built, as without it.
+pub fn restore_apexes_with_table(
+    mesh: &mut Mesh,
+    opts: &ApexOptions,
+    table: &CornerTable,
+) -> Result<ApexReport, Error> {
+    restore_apexes_in(mesh, opts, Some(table))
+}
+
+fn restore_apexes_in(
+    mesh: &mut Mesh,
+    opts: &ApexOptions,
+    given: Option<&CornerTable>,
+) -> Result<ApexReport, Error> {
     opts.validate()?;
-    let table = checked_table(mesh)?;
+    let table = table_for(mesh, given)?;
     let nv = mesh.positions.len();
     let normals = vertex_normals(mesh);
     let edge = table.mean_edge_length(&mesh.positions);
@@ -427,6 +446,7 @@ fn angles_at_least(a: DVec3, b: DVec3, c: DVec3, min_sin: f64) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::planar::checked_table;
 
     /// A closed cone of half-angle `atan(radius / height)` with its apex at `(0, 0, height)`:
     /// `around` vertices on each of `rings` rings evenly spaced from the apex to the base

@@ -9,10 +9,10 @@
 //! vertex moves along its normal onto it. docs/sharpen.md, "One-sided quadric projection".
 
 use glam::DVec3;
-use whet_mesh::{Mesh, VertexId};
+use whet_mesh::{CornerTable, Mesh, VertexId};
 
 use crate::crease::{crease_edges, SideReach};
-use crate::planar::{add_height_sample, checked_table, solve6, vertex_normals};
+use crate::planar::{add_height_sample, solve6, table_for, vertex_normals};
 use crate::Error;
 
 /// Most triangles a gathering takes, per square of its reach in mean edges (as the crease
@@ -131,8 +131,27 @@ pub fn project_beside_creases_onto_local_quadrics(
     mesh: &mut Mesh,
     opts: &BesideOptions,
 ) -> Result<BesideReport, Error> {
+    project_beside_creases_onto_local_quadrics_in(mesh, opts, None)
+}
+
+/// [`project_beside_creases_onto_local_quadrics`] on `table`, the corner table of `mesh`'s triangles, built once for
+/// several projections in a row (they move vertices, never triangles; the coordinates are
+/// checked again). A table of other triangles is not used: one is built, as without it.
+pub fn project_beside_creases_onto_local_quadrics_with_table(
+    mesh: &mut Mesh,
+    opts: &BesideOptions,
+    table: &CornerTable,
+) -> Result<BesideReport, Error> {
+    project_beside_creases_onto_local_quadrics_in(mesh, opts, Some(table))
+}
+
+fn project_beside_creases_onto_local_quadrics_in(
+    mesh: &mut Mesh,
+    opts: &BesideOptions,
+    given: Option<&CornerTable>,
+) -> Result<BesideReport, Error> {
     opts.validate()?;
-    let table = checked_table(mesh)?;
+    let table = table_for(mesh, given)?;
     let p = &mesh.positions;
     let (nv, nt) = (p.len(), mesh.triangles.len());
     let edge = table.mean_edge_length(p);

@@ -16,9 +16,9 @@
 //! docs/sharpen.md, "Crease projection".
 
 use glam::DVec3;
-use whet_mesh::{CornerId, Mesh, VertexId};
+use whet_mesh::{CornerId, CornerTable, Mesh, VertexId};
 
-use crate::planar::{add_height_sample, checked_table, pin_quadratic_terms, solve6};
+use crate::planar::{add_height_sample, pin_quadratic_terms, solve6, table_for};
 use crate::Error;
 
 /// Most triangles one side's gathering takes, per square of the ring count (144 for three
@@ -409,8 +409,27 @@ pub fn project_creases_onto_local_quadrics(
     mesh: &mut Mesh,
     opts: &CreaseOptions,
 ) -> Result<CreaseReport, Error> {
+    project_creases_onto_local_quadrics_in(mesh, opts, None)
+}
+
+/// [`project_creases_onto_local_quadrics`] on `table`, the corner table of `mesh`'s triangles, built once for
+/// several projections in a row (they move vertices, never triangles; the coordinates are
+/// checked again). A table of other triangles is not used: one is built, as without it.
+pub fn project_creases_onto_local_quadrics_with_table(
+    mesh: &mut Mesh,
+    opts: &CreaseOptions,
+    table: &CornerTable,
+) -> Result<CreaseReport, Error> {
+    project_creases_onto_local_quadrics_in(mesh, opts, Some(table))
+}
+
+fn project_creases_onto_local_quadrics_in(
+    mesh: &mut Mesh,
+    opts: &CreaseOptions,
+    given: Option<&CornerTable>,
+) -> Result<CreaseReport, Error> {
     opts.validate()?;
-    let table = checked_table(mesh)?;
+    let table = table_for(mesh, given)?;
     let p = &mesh.positions;
     let (nv, nt) = (p.len(), mesh.triangles.len());
     let edge = table.mean_edge_length(p);

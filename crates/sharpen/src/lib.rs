@@ -52,9 +52,15 @@ mod snap;
 mod tags;
 mod weld;
 
-pub use apex::{restore_apexes, ApexOptions, ApexReport};
-pub use beside::{project_beside_creases_onto_local_quadrics, BesideOptions, BesideReport};
-pub use crease::{project_creases_onto_local_quadrics, CreaseOptions, CreaseReport};
+pub use apex::{restore_apexes, restore_apexes_with_table, ApexOptions, ApexReport};
+pub use beside::{
+    project_beside_creases_onto_local_quadrics,
+    project_beside_creases_onto_local_quadrics_with_table, BesideOptions, BesideReport,
+};
+pub use crease::{
+    project_creases_onto_local_quadrics, project_creases_onto_local_quadrics_with_table,
+    CreaseOptions, CreaseReport,
+};
 pub use edge_sharpener::EdgeSharpener;
 
 /// What sharpening holds at its peak per input triangle, with the input mesh and the
@@ -68,8 +74,13 @@ pub use fuzz::{fuzz_input, fuzz_seed, fuzz_sharpen};
 pub use judge::{Snap, SnapJudge, VetoReplay};
 pub use normal_filter::VertexSelection;
 pub use options::{Method, SharpenOptions, DEFAULT_CURVED_WALL_FACTOR, MAX_PASSES};
-pub use planar::{flatten_planar_regions, PlanarOptions, PlanarReport};
-pub use quadric::{project_onto_local_quadrics, QuadricOptions, QuadricReport};
+pub use planar::{
+    flatten_planar_regions, flatten_planar_regions_with_table, PlanarOptions, PlanarReport,
+};
+pub use quadric::{
+    project_onto_local_quadrics, project_onto_local_quadrics_with_table, QuadricOptions,
+    QuadricReport,
+};
 pub use report::{SharpenReport, UnmovedReason};
 pub use tags::SharpTags;
 

@@ -112,8 +112,27 @@ pub fn flatten_planar_regions(
     mesh: &mut Mesh,
     opts: &PlanarOptions,
 ) -> Result<PlanarReport, Error> {
+    flatten_planar_regions_in(mesh, opts, None)
+}
+
+/// [`flatten_planar_regions`] on `table`, the corner table of `mesh`'s triangles, built once for
+/// several projections in a row (they move vertices, never triangles; the coordinates are
+/// checked again). A table of other triangles is not used: one is built, as without it.
+pub fn flatten_planar_regions_with_table(
+    mesh: &mut Mesh,
+    opts: &PlanarOptions,
+    table: &CornerTable,
+) -> Result<PlanarReport, Error> {
+    flatten_planar_regions_in(mesh, opts, Some(table))
+}
+
+fn flatten_planar_regions_in(
+    mesh: &mut Mesh,
+    opts: &PlanarOptions,
+    given: Option<&CornerTable>,
+) -> Result<PlanarReport, Error> {
     opts.validate()?;
-    let table = checked_table(mesh)?;
+    let table = table_for(mesh, given)?;
     let p = &mesh.positions;
     let nt = mesh.triangles.len();
     let (normals, area): (Vec<DVec3>, Vec<f64>) = (0..nt)
@@ -246,6 +265,26 @@ pub fn flatten_planar_regions(
 
 /// The corner table of `mesh` for the post-sharpening passes, which need finite
 /// coordinates and an oriented manifold: [`Error::InvalidInput`] otherwise.
+/// The corner table a projection runs on: `given` when it is `mesh`'s (the same
+/// triangles; the coordinates are checked again, as a projection before may have moved
+/// them), else [`checked_table`]'s.
+pub(crate) fn table_for<'t>(
+    mesh: &Mesh,
+    given: Option<&'t CornerTable>,
+) -> Result<std::borrow::Cow<'t, CornerTable>, Error> {
+    match given {
+        Some(table) if table.triangles() == mesh.triangles.as_slice() => {
+            if let Some(v) = mesh.positions.iter().position(|p| !p.is_finite()) {
+                return Err(Error::InvalidInput(
+                    whet_mesh::MeshError::NonFiniteCoordinate { vertex: v as u32 },
+                ));
+            }
+            Ok(std::borrow::Cow::Borrowed(table))
+        }
+        _ => checked_table(mesh).map(std::borrow::Cow::Owned),
+    }
+}
+
 pub(crate) fn checked_table(mesh: &Mesh) -> Result<CornerTable, Error> {
     if let Some(v) = mesh.positions.iter().position(|p| !p.is_finite()) {
         return Err(Error::InvalidInput(

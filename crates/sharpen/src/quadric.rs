@@ -8,9 +8,9 @@
 //! docs/sharpen.md, "Local quadric projection".
 
 use glam::DVec3;
-use whet_mesh::{Mesh, VertexId};
+use whet_mesh::{CornerTable, Mesh, VertexId};
 
-use crate::planar::{add_height_sample, checked_table, solve6, vertex_normals};
+use crate::planar::{add_height_sample, solve6, table_for, vertex_normals};
 use crate::Error;
 
 /// Most points a fit gathers, per square of its ring count: 144 for three rings, about four
@@ -114,8 +114,27 @@ pub fn project_onto_local_quadrics(
     mesh: &mut Mesh,
     opts: &QuadricOptions,
 ) -> Result<QuadricReport, Error> {
+    project_onto_local_quadrics_in(mesh, opts, None)
+}
+
+/// [`project_onto_local_quadrics`] on `table`, the corner table of `mesh`'s triangles, built once for
+/// several projections in a row (they move vertices, never triangles; the coordinates are
+/// checked again). A table of other triangles is not used: one is built, as without it.
+pub fn project_onto_local_quadrics_with_table(
+    mesh: &mut Mesh,
+    opts: &QuadricOptions,
+    table: &CornerTable,
+) -> Result<QuadricReport, Error> {
+    project_onto_local_quadrics_in(mesh, opts, Some(table))
+}
+
+fn project_onto_local_quadrics_in(
+    mesh: &mut Mesh,
+    opts: &QuadricOptions,
+    given: Option<&CornerTable>,
+) -> Result<QuadricReport, Error> {
     opts.validate()?;
-    let table = checked_table(mesh)?;
+    let table = table_for(mesh, given)?;
     let p = &mesh.positions;
     let nv = p.len();
     let normals = vertex_normals(mesh);

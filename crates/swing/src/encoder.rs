@@ -2184,11 +2184,10 @@ fn stated_output(out: &SwingOutput, input: &Mesh, sharpened: Mesh) -> Mesh {
         out.apex_factor
             .map(|max_move| StatedProjection::Apex { max_move }),
     ];
-    for p in projections.into_iter().flatten() {
-        // The sharpened mesh is a manifold; were it refused, the decoder keeps it
-        // unprojected too (with a warning).
-        let _ = p.apply(&mut m);
-    }
+    let projections: Vec<StatedProjection> = projections.into_iter().flatten().collect();
+    // The sharpened mesh is a manifold; were it refused, the decoder keeps it unprojected too
+    // (with a warning).
+    let _ = StatedProjection::apply_all(&projections, &mut m);
     m
 }
 

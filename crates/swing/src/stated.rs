@@ -67,6 +67,66 @@ impl StatedProjection {
         }
     }
 
+    /// [`Self::apply`] on `table`, the corner table of `mesh`'s triangles (one table serves
+    /// several projections in a row: they move vertices, never triangles). The same result.
+    pub fn apply_on(
+        &self,
+        mesh: &mut Mesh,
+        table: &whet_mesh::CornerTable,
+    ) -> Result<(), whet_sharpen::Error> {
+        match *self {
+            StatedProjection::Planar { factor, angle_bits } => {
+                let opts = whet_sharpen::PlanarOptions::for_swing(angle_bits, factor);
+                whet_sharpen::flatten_planar_regions_with_table(mesh, &opts, table).map(|_| ())
+            }
+            StatedProjection::Quadric { factor, angle_bits } => {
+                let opts = whet_sharpen::QuadricOptions::for_swing(angle_bits, factor);
+                whet_sharpen::project_onto_local_quadrics_with_table(mesh, &opts, table).map(|_| ())
+            }
+            StatedProjection::Beside { factor, angle_bits } => {
+                let opts = whet_sharpen::BesideOptions::for_swing(angle_bits, factor);
+                whet_sharpen::project_beside_creases_onto_local_quadrics_with_table(
+                    mesh, &opts, table,
+                )
+                .map(|_| ())
+            }
+            StatedProjection::Crease { max_move } => {
+                let opts = whet_sharpen::CreaseOptions::DEFAULT.with_max_move(max_move);
+                whet_sharpen::project_creases_onto_local_quadrics_with_table(mesh, &opts, table)
+                    .map(|_| ())
+            }
+            StatedProjection::Apex { max_move } => {
+                let opts = whet_sharpen::ApexOptions::DEFAULT.with_max_move(max_move);
+                whet_sharpen::restore_apexes_with_table(mesh, &opts, table).map(|_| ())
+            }
+        }
+    }
+
+    /// Applies `projections` to `mesh` in order, as [`Self::apply`] one after the other
+    /// does, but on one corner table built for them all: the projections that failed, with
+    /// their errors (each failure leaves `mesh` as that projection found it).
+    pub fn apply_all(
+        projections: &[StatedProjection],
+        mesh: &mut Mesh,
+    ) -> Vec<(StatedProjection, whet_sharpen::Error)> {
+        let table = if projections.is_empty() {
+            None
+        } else {
+            // A mesh without a table (not a manifold) gets each projection's own refusal.
+            whet_mesh::CornerTable::new(mesh).ok()
+        };
+        projections
+            .iter()
+            .filter_map(|p| {
+                let done = match &table {
+                    Some(t) => p.apply_on(mesh, t),
+                    None => p.apply(mesh),
+                };
+                done.err().map(|e| (*p, e))
+            })
+            .collect()
+    }
+
     /// Applies it to `mesh`; an error leaves `mesh` as it was (it needs an oriented manifold,
     /// which sharpening gives).
     pub fn apply(&self, mesh: &mut Mesh) -> Result<(), whet_sharpen::Error> {
@@ -208,10 +268,7 @@ impl StatedSharpening {
         sharpened: &mut Mesh,
     ) -> Vec<(StatedProjection, whet_sharpen::Error)> {
         self.after_filter.apply_after_sharpening(decoded, sharpened);
-        self.projections
-            .iter()
-            .filter_map(|p| p.apply(sharpened).err().map(|e| (*p, e)))
-            .collect()
+        StatedProjection::apply_all(&self.projections, sharpened)
     }
 
     /// What `whet decode --sharpen` writes for the `decoded` mesh of this stream with no

@@ -1,5 +1,6 @@
 //! Integration tests of whet-swing: bit-exact round trips on built and public meshes, rate
-//! control, open and degenerate originals, corrupted streams, property tests, snap vetoes.
+//! control, open and degenerate originals, corrupted streams, property tests, snap vetoes,
+//! the stated projections on one corner table.
 #![allow(clippy::unwrap_used)] // a panic is a test failure
 
 mod corruption;
@@ -8,6 +9,7 @@ mod open;
 mod props;
 mod rate;
 mod round_trip;
+mod stated;
 mod vetoes;
 
 use whet_codec::{decode, DecodeOptions, SwingGeometry};
