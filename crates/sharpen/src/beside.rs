@@ -12,8 +12,9 @@ use glam::DVec3;
 use whet_mesh::{CornerTable, Mesh, VertexId};
 
 use crate::crease::{crease_edges, SideReach};
-use crate::planar::{add_height_sample, solve6, table_for, vertex_normals};
+use crate::planar::{add_height_sample, solve6, table_for, vertex_blocks, vertex_normals};
 use crate::Error;
+use rayon::prelude::*;
 
 /// Most triangles a gathering takes, per square of its reach in mean edges (as the crease
 /// projection's): past it the vertex stays.
@@ -167,90 +168,101 @@ fn project_beside_creases_onto_local_quadrics_in(
     let max_move = opts.max_move * edge;
     let max_triangles = MAX_TRIANGLES_PER_SQUARED_RING * opts.rings * opts.rings;
     const NONE: u32 = u32::MAX;
-    // The vertex whose gathering last took each triangle and each vertex.
-    let mut tri_stamp = vec![NONE; nt];
-    let mut vert_stamp = vec![NONE; nv];
-    let (mut gathered, mut stack) = (Vec::new(), Vec::new());
-    let mut moves: Vec<(usize, DVec3)> = Vec::new();
-    'vertices: for v in 0..nv {
-        let vid = VertexId(v as u32);
-        let n = normals[v];
-        if on_crease[v]
-            || n == DVec3::ZERO
-            || table.vertex_corner(vid).is_none()
-            || table.is_boundary_vertex(vid)
-        {
-            continue;
-        }
-        let stamp = v as u32;
-        stack.clear();
-        // The fan: its edges at v are no crease (v is on none).
-        for c in table.vertex_corners(vid) {
-            let t = c.index() / 3;
-            if tri_stamp[t] != stamp {
-                tri_stamp[t] = stamp;
-                stack.push(t);
+    // Vertex by vertex in blocks side by side, each with its own scratch; the moves after.
+    let block = |range: std::ops::Range<usize>| {
+        // The vertex whose gathering last took each triangle and each vertex.
+        let mut tri_stamp = vec![NONE; nt];
+        let mut vert_stamp = vec![NONE; nv];
+        let (mut gathered, mut stack) = (Vec::new(), Vec::new());
+        let mut report = BesideReport::default();
+        let mut moves: Vec<(usize, DVec3)> = Vec::new();
+        'vertices: for v in range {
+            let vid = VertexId(v as u32);
+            let n = normals[v];
+            if on_crease[v]
+                || n == DVec3::ZERO
+                || table.vertex_corner(vid).is_none()
+                || table.is_boundary_vertex(vid)
+            {
+                continue;
+            }
+            let stamp = v as u32;
+            stack.clear();
+            // The fan: its edges at v are no crease (v is on none).
+            for c in table.vertex_corners(vid) {
+                let t = c.index() / 3;
+                if tri_stamp[t] != stamp {
+                    tri_stamp[t] = stamp;
+                    stack.push(t);
+                }
+            }
+            let side = SideReach {
+                centroids: &centroids,
+                table: &table,
+                crease: &crease,
+                centre: p[v],
+                reach,
+                max_triangles,
+            };
+            if !side.gather(stamp, &mut tri_stamp, &mut stack, &mut gathered) {
+                continue;
+            }
+            let near = gathered
+                .iter()
+                .any(|&t| mesh.triangles[t].iter().any(|&w| on_crease[w as usize]));
+            if !near {
+                continue;
+            }
+            report.beside_vertices += 1;
+            // In the frame of v's normal, centred on v, scaled by the reach.
+            let (eu, ev) = n.any_orthonormal_pair();
+            let mut m = [[0.0f64; 7]; 6];
+            let mut points = 0usize;
+            for &t in &gathered {
+                for w in mesh.triangles[t] {
+                    let w = w as usize;
+                    if on_crease[w] || vert_stamp[w] == stamp {
+                        continue;
+                    }
+                    vert_stamp[w] = stamp;
+                    if normals[w].dot(n) < cos_max {
+                        continue 'vertices;
+                    }
+                    points += 1;
+                    let d = (p[w] - p[v]) / reach;
+                    let (a, b, h) = (d.dot(eu), d.dot(ev), d.dot(n));
+                    add_height_sample(&mut m, [a * a, a * b, b * b, a, b, 1.0], h);
+                }
+            }
+            // Six unknowns: at least twice as many points.
+            if points < 12 {
+                continue;
+            }
+            let Some(coef) = solve6(m) else {
+                continue;
+            };
+            report.fitted_vertices += 1;
+            // The fitted height at the vertex itself.
+            let h = coef[5] * reach;
+            let clamped = h.clamp(-max_move, max_move);
+            if clamped != h {
+                report.clamped_moves += 1;
+            }
+            if clamped != 0.0 {
+                moves.push((v, p[v] + n * clamped));
             }
         }
-        let side = SideReach {
-            centroids: &centroids,
-            table: &table,
-            crease: &crease,
-            centre: p[v],
-            reach,
-            max_triangles,
-        };
-        if !side.gather(stamp, &mut tri_stamp, &mut stack, &mut gathered) {
-            continue;
+        (report, moves)
+    };
+    let parts: Vec<_> = vertex_blocks(nv).into_par_iter().map(block).collect();
+    for (part, moves) in parts {
+        report.beside_vertices += part.beside_vertices;
+        report.fitted_vertices += part.fitted_vertices;
+        report.clamped_moves += part.clamped_moves;
+        report.moved_vertices += moves.len();
+        for (v, q) in moves {
+            mesh.positions[v] = q;
         }
-        let near = gathered
-            .iter()
-            .any(|&t| mesh.triangles[t].iter().any(|&w| on_crease[w as usize]));
-        if !near {
-            continue;
-        }
-        report.beside_vertices += 1;
-        // In the frame of v's normal, centred on v, scaled by the reach.
-        let (eu, ev) = n.any_orthonormal_pair();
-        let mut m = [[0.0f64; 7]; 6];
-        let mut points = 0usize;
-        for &t in &gathered {
-            for w in mesh.triangles[t] {
-                let w = w as usize;
-                if on_crease[w] || vert_stamp[w] == stamp {
-                    continue;
-                }
-                vert_stamp[w] = stamp;
-                if normals[w].dot(n) < cos_max {
-                    continue 'vertices;
-                }
-                points += 1;
-                let d = (p[w] - p[v]) / reach;
-                let (a, b, h) = (d.dot(eu), d.dot(ev), d.dot(n));
-                add_height_sample(&mut m, [a * a, a * b, b * b, a, b, 1.0], h);
-            }
-        }
-        // Six unknowns: at least twice as many points.
-        if points < 12 {
-            continue;
-        }
-        let Some(coef) = solve6(m) else {
-            continue;
-        };
-        report.fitted_vertices += 1;
-        // The fitted height at the vertex itself.
-        let h = coef[5] * reach;
-        let clamped = h.clamp(-max_move, max_move);
-        if clamped != h {
-            report.clamped_moves += 1;
-        }
-        if clamped != 0.0 {
-            moves.push((v, p[v] + n * clamped));
-        }
-    }
-    report.moved_vertices = moves.len();
-    for (v, q) in moves {
-        mesh.positions[v] = q;
     }
     Ok(report)
 }

@@ -18,8 +18,9 @@
 use glam::DVec3;
 use whet_mesh::{CornerId, CornerTable, Mesh, VertexId};
 
-use crate::planar::{add_height_sample, pin_quadratic_terms, solve6, table_for};
+use crate::planar::{add_height_sample, pin_quadratic_terms, solve6, table_for, vertex_blocks};
 use crate::Error;
+use rayon::prelude::*;
 
 /// Most triangles one side's gathering takes, per square of the ring count (144 for three
 /// rings, about three times what a regular mesh holds within that reach); a side that holds
@@ -449,229 +450,245 @@ fn project_creases_onto_local_quadrics_in(
     let max_move = opts.max_move * edge;
     // The gathering that last took each triangle and each vertex.
     const NONE: u32 = u32::MAX;
-    let mut tri_stamp = vec![NONE; nt];
-    let mut vert_stamp = vec![NONE; nv];
-    let mut stamp = 0u32;
-    let (mut fan, mut gathered, mut stack, mut points) =
-        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    let mut sides: [Vec<usize>; MAX_CORNER_SIDES] = Default::default();
-    let mut arc_points: [Vec<usize>; MAX_CORNER_SIDES] = Default::default();
     let min_triple = MIN_CORNER_TRIPLE_PRODUCT;
-    let mut moves: Vec<(usize, DVec3)> = Vec::new();
-    'vertices: for v in 0..nv {
-        let vid = VertexId(v as u32);
-        if !on_crease[v] || table.vertex_corner(vid).is_none() || table.is_boundary_vertex(vid) {
-            continue;
-        }
-        // The fan in swing order; the crease edges at v cut it into arcs. A swing from
-        // corner c crosses the edge that c's next corner faces.
-        fan.clear();
-        fan.extend(table.vertex_corners(vid));
-        let cuts: Vec<usize> = (0..fan.len())
-            .filter(|&i| crease[table.next(fan[i]).index()])
-            .collect();
-        let k = cuts.len();
-        match k {
-            2 => report.crease_vertices += 1,
-            3 if opts.corners => report.corner_vertices += 1,
-            4..=MAX_CORNER_SIDES if opts.corners && opts.strips => report.corner_vertices += 1,
-            _ => continue,
-        }
-        // Whether arcs with no vertex off the creases are left out (else they fail the fit).
-        let strips = k >= 3 && opts.strips;
-        // A cut at i lies between fan[i] and fan[i + 1] (cyclically); each side is the arc
-        // from the corner after one cut up to and including the corner at the next.
-        for (s, side) in sides.iter_mut().enumerate().take(k) {
-            side.clear();
-            let (from, to) = (cuts[s], cuts[(s + 1) % k]);
-            let mut i = (from + 1) % fan.len();
-            loop {
-                side.push(fan[i].index() / 3);
-                if i == to {
-                    break;
-                }
-                i = (i + 1) % fan.len();
-            }
-        }
-        let mut fits: [Option<SideFit>; MAX_CORNER_SIDES] = Default::default();
-        // Per arc, a bit for each other arc its gathering reached; and a bit per strip.
-        let mut reached = [0u32; MAX_CORNER_SIDES];
-        let mut strip_bits = 0u32;
-        for s in 0..k {
-            // Gather the side across non-crease edges, triangles whose centroid is within
-            // the reach; meeting another arc means a crease ends within it.
-            stamp = stamp.wrapping_add(1);
-            if stamp == NONE {
-                tri_stamp.fill(NONE);
-                vert_stamp.fill(NONE);
-                stamp = 0;
-            }
-            stack.clear();
-            for &t in &sides[s] {
-                tri_stamp[t] = stamp;
-                stack.push(t);
-            }
-            let side = SideReach {
-                centroids: &centroids,
-                table: &table,
-                crease: &crease,
-                centre: p[v],
-                reach,
-                max_triangles,
-            };
-            if !side.gather(stamp, &mut tri_stamp, &mut stack, &mut gathered) {
-                continue 'vertices;
-            }
-            for o in (0..k).filter(|&o| o != s) {
-                if sides[o].iter().any(|&t| tri_stamp[t] == stamp) {
-                    reached[s] |= 1 << o;
-                }
-            }
-            // Without strips every meeting counts; with them, only meetings between arcs
-            // that are kept, known once every arc is gathered.
-            if reached[s] != 0 && !strips {
-                continue 'vertices;
-            }
-            points.clear();
-            for &t in &gathered {
-                for w in mesh.triangles[t] {
-                    let w = w as usize;
-                    if !on_crease[w] && vert_stamp[w] != stamp {
-                        vert_stamp[w] = stamp;
-                        points.push(w);
-                    }
-                }
-            }
-            if points.is_empty() && strips {
-                strip_bits |= 1 << s;
+    // Vertex by vertex in blocks side by side, each with its own scratch; the moves after.
+    let block = |range: std::ops::Range<usize>| {
+        let mut tri_stamp = vec![NONE; nt];
+        let mut vert_stamp = vec![NONE; nv];
+        let mut stamp = 0u32;
+        let (mut fan, mut gathered, mut stack, mut points) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let mut sides: [Vec<usize>; MAX_CORNER_SIDES] = Default::default();
+        let mut arc_points: [Vec<usize>; MAX_CORNER_SIDES] = Default::default();
+        let mut report = CreaseReport::default();
+        let mut moves: Vec<(usize, DVec3)> = Vec::new();
+        'vertices: for v in range {
+            let vid = VertexId(v as u32);
+            if !on_crease[v] || table.vertex_corner(vid).is_none() || table.is_boundary_vertex(vid)
+            {
                 continue;
             }
-            let n = sides[s]
-                .iter()
-                .map(|&t| mesh.face_cross(t))
-                .sum::<DVec3>()
-                .normalize_or_zero();
-            if n == DVec3::ZERO {
-                continue 'vertices;
+            // The fan in swing order; the crease edges at v cut it into arcs. A swing from
+            // corner c crosses the edge that c's next corner faces.
+            fan.clear();
+            fan.extend(table.vertex_corners(vid));
+            let cuts: Vec<usize> = (0..fan.len())
+                .filter(|&i| crease[table.next(fan[i]).index()])
+                .collect();
+            let k = cuts.len();
+            match k {
+                2 => report.crease_vertices += 1,
+                3 if opts.corners => report.corner_vertices += 1,
+                4..=MAX_CORNER_SIDES if opts.corners && opts.strips => report.corner_vertices += 1,
+                _ => continue,
             }
-            let Some(fit) = fit_side(p, v, reach, &points, n, k >= 3) else {
-                continue 'vertices;
-            };
-            fits[s] = Some(fit);
-            // Kept for a merge of meeting arcs (only vertices of three or more crease edges).
-            if k >= 3 && opts.meeting_arcs {
-                arc_points[s].clear();
-                arc_points[s].extend_from_slice(&points);
-            }
-        }
-        // A strip cannot reach a kept arc: both would gather one component of triangles,
-        // and the kept arc's holds vertices off the creases. So only kept pairs are asked.
-        let kept_bits = ((1u32 << k) - 1) & !strip_bits;
-        let mut merged_sides = 0;
-        let kept: Vec<SideFit> = if k >= 3 && opts.meeting_arcs {
-            // Kept arcs that reach each other, directly or through others, are one side when
-            // one surface fits all their points and none of their triangles turns from it
-            // like a crease (a thin face or a strip the sharpener left, beside the face
-            // it meets past the crease's end).
-            let mut taken = 0u32;
-            let mut sides_fits = Vec::with_capacity(3);
-            for s in (0..k).filter(|&s| kept_bits >> s & 1 != 0) {
-                if taken >> s & 1 != 0 {
-                    continue;
-                }
-                let mut group = 1u32 << s;
+            // Whether arcs with no vertex off the creases are left out (else they fail the fit).
+            let strips = k >= 3 && opts.strips;
+            // A cut at i lies between fan[i] and fan[i + 1] (cyclically); each side is the arc
+            // from the corner after one cut up to and including the corner at the next.
+            for (s, side) in sides.iter_mut().enumerate().take(k) {
+                side.clear();
+                let (from, to) = (cuts[s], cuts[(s + 1) % k]);
+                let mut i = (from + 1) % fan.len();
                 loop {
-                    let mut grown = group;
-                    for o in (0..k).filter(|&o| kept_bits >> o & 1 != 0) {
-                        if group >> o & 1 != 0 || reached[o] & group != 0 {
-                            grown |= (1 << o) | (reached[o] & kept_bits);
-                        }
-                    }
-                    if grown == group {
+                    side.push(fan[i].index() / 3);
+                    if i == to {
                         break;
                     }
-                    group = grown;
+                    i = (i + 1) % fan.len();
                 }
-                taken |= group;
-                if group.count_ones() == 1 {
-                    sides_fits.extend(fits[s]);
+            }
+            let mut fits: [Option<SideFit>; MAX_CORNER_SIDES] = Default::default();
+            // Per arc, a bit for each other arc its gathering reached; and a bit per strip.
+            let mut reached = [0u32; MAX_CORNER_SIDES];
+            let mut strip_bits = 0u32;
+            for s in 0..k {
+                // Gather the side across non-crease edges, triangles whose centroid is within
+                // the reach; meeting another arc means a crease ends within it.
+                stamp = stamp.wrapping_add(1);
+                if stamp == NONE {
+                    tri_stamp.fill(NONE);
+                    vert_stamp.fill(NONE);
+                    stamp = 0;
+                }
+                stack.clear();
+                for &t in &sides[s] {
+                    tri_stamp[t] = stamp;
+                    stack.push(t);
+                }
+                let side = SideReach {
+                    centroids: &centroids,
+                    table: &table,
+                    crease: &crease,
+                    centre: p[v],
+                    reach,
+                    max_triangles,
+                };
+                if !side.gather(stamp, &mut tri_stamp, &mut stack, &mut gathered) {
+                    continue 'vertices;
+                }
+                for o in (0..k).filter(|&o| o != s) {
+                    if sides[o].iter().any(|&t| tri_stamp[t] == stamp) {
+                        reached[s] |= 1 << o;
+                    }
+                }
+                // Without strips every meeting counts; with them, only meetings between arcs
+                // that are kept, known once every arc is gathered.
+                if reached[s] != 0 && !strips {
+                    continue 'vertices;
+                }
+                points.clear();
+                for &t in &gathered {
+                    for w in mesh.triangles[t] {
+                        let w = w as usize;
+                        if !on_crease[w] && vert_stamp[w] != stamp {
+                            vert_stamp[w] = stamp;
+                            points.push(w);
+                        }
+                    }
+                }
+                if points.is_empty() && strips {
+                    strip_bits |= 1 << s;
                     continue;
                 }
-                let members = || (0..k).filter(move |&o| group >> o & 1 != 0);
-                points.clear();
-                let mut n = DVec3::ZERO;
-                for o in members() {
-                    points.extend_from_slice(&arc_points[o]);
-                    n += sides[o].iter().map(|&t| mesh.face_cross(t)).sum::<DVec3>();
+                let n = sides[s]
+                    .iter()
+                    .map(|&t| mesh.face_cross(t))
+                    .sum::<DVec3>()
+                    .normalize_or_zero();
+                if n == DVec3::ZERO {
+                    continue 'vertices;
                 }
-                points.sort_unstable();
-                points.dedup();
-                let n = n.normalize_or_zero();
-                let Some(fit) = (n != DVec3::ZERO)
-                    .then(|| fit_side(p, v, reach, &points, n, true))
-                    .flatten()
-                    .filter(|f| spread(f, p, v, reach, edge, &points) <= MAX_MERGED_SPREAD)
-                else {
+                let Some(fit) = fit_side(p, v, reach, &points, n, k >= 3) else {
                     continue 'vertices;
                 };
-                let tilted = members().flat_map(|o| &sides[o]).any(|&t| {
-                    let centroid = mesh.triangles[t]
-                        .iter()
-                        .map(|&w| p[w as usize])
-                        .sum::<DVec3>()
-                        / 3.0;
-                    let surface = fit.residual((centroid - p[v]) / reach).1;
-                    surface.normalize_or_zero().dot(normals[t]) < cos_crease
-                });
-                if tilted {
-                    continue 'vertices;
+                fits[s] = Some(fit);
+                // Kept for a merge of meeting arcs (only vertices of three or more crease edges).
+                if k >= 3 && opts.meeting_arcs {
+                    arc_points[s].clear();
+                    arc_points[s].extend_from_slice(&points);
                 }
-                merged_sides += 1;
-                sides_fits.push(fit);
             }
-            sides_fits
-        } else {
-            if (0..k).any(|s| kept_bits >> s & 1 != 0 && reached[s] & kept_bits != 0) {
-                continue;
-            }
-            // Every kept arc has its fit (an arc without one left the vertex above).
-            fits[..k].iter().flatten().copied().collect()
-        };
-        let solved = match kept[..] {
-            [ref f0, ref f1] => {
-                if f0.n.cross(f1.n).length() < min_sin {
+            // A strip cannot reach a kept arc: both would gather one component of triangles,
+            // and the kept arc's holds vertices off the creases. So only kept pairs are asked.
+            let kept_bits = ((1u32 << k) - 1) & !strip_bits;
+            let mut merged_sides = 0;
+            let kept: Vec<SideFit> = if k >= 3 && opts.meeting_arcs {
+                // Kept arcs that reach each other, directly or through others, are one side when
+                // one surface fits all their points and none of their triangles turns from it
+                // like a crease (a thin face or a strip the sharpener left, beside the face
+                // it meets past the crease's end).
+                let mut taken = 0u32;
+                let mut sides_fits = Vec::with_capacity(3);
+                for s in (0..k).filter(|&s| kept_bits >> s & 1 != 0) {
+                    if taken >> s & 1 != 0 {
+                        continue;
+                    }
+                    let mut group = 1u32 << s;
+                    loop {
+                        let mut grown = group;
+                        for o in (0..k).filter(|&o| kept_bits >> o & 1 != 0) {
+                            if group >> o & 1 != 0 || reached[o] & group != 0 {
+                                grown |= (1 << o) | (reached[o] & kept_bits);
+                            }
+                        }
+                        if grown == group {
+                            break;
+                        }
+                        group = grown;
+                    }
+                    taken |= group;
+                    if group.count_ones() == 1 {
+                        sides_fits.extend(fits[s]);
+                        continue;
+                    }
+                    let members = || (0..k).filter(move |&o| group >> o & 1 != 0);
+                    points.clear();
+                    let mut n = DVec3::ZERO;
+                    for o in members() {
+                        points.extend_from_slice(&arc_points[o]);
+                        n += sides[o].iter().map(|&t| mesh.face_cross(t)).sum::<DVec3>();
+                    }
+                    points.sort_unstable();
+                    points.dedup();
+                    let n = n.normalize_or_zero();
+                    let Some(fit) = (n != DVec3::ZERO)
+                        .then(|| fit_side(p, v, reach, &points, n, true))
+                        .flatten()
+                        .filter(|f| spread(f, p, v, reach, edge, &points) <= MAX_MERGED_SPREAD)
+                    else {
+                        continue 'vertices;
+                    };
+                    let tilted = members().flat_map(|o| &sides[o]).any(|&t| {
+                        let centroid = mesh.triangles[t]
+                            .iter()
+                            .map(|&w| p[w as usize])
+                            .sum::<DVec3>()
+                            / 3.0;
+                        let surface = fit.residual((centroid - p[v]) / reach).1;
+                        surface.normalize_or_zero().dot(normals[t]) < cos_crease
+                    });
+                    if tilted {
+                        continue 'vertices;
+                    }
+                    merged_sides += 1;
+                    sides_fits.push(fit);
+                }
+                sides_fits
+            } else {
+                if (0..k).any(|s| kept_bits >> s & 1 != 0 && reached[s] & kept_bits != 0) {
                     continue;
                 }
-                onto_two(f0, f1)
-            }
-            [ref f0, ref f1, ref f2] => {
-                let turns = [(f0, f1), (f1, f2), (f2, f0)];
-                if turns.iter().any(|(a, b)| a.n.cross(b.n).length() < min_sin)
-                    || f0.n.dot(f1.n.cross(f2.n)).abs() < min_triple
-                {
-                    continue;
+                // Every kept arc has its fit (an arc without one left the vertex above).
+                fits[..k].iter().flatten().copied().collect()
+            };
+            let solved = match kept[..] {
+                [ref f0, ref f1] => {
+                    if f0.n.cross(f1.n).length() < min_sin {
+                        continue;
+                    }
+                    onto_two(f0, f1)
                 }
-                onto_three(f0, f1, f2)
-            }
-            _ => continue,
-        };
-        report.fitted_vertices += 1;
-        report.strips_left_out += strip_bits.count_ones() as usize;
-        report.merged_sides += merged_sides;
-        let q = solved.map(|d| p[v] + d * reach);
-        match q {
-            Some(q) if q.is_finite() && q.distance(p[v]) <= max_move => {
-                if k >= 3 {
-                    report.moved_corners += 1;
+                [ref f0, ref f1, ref f2] => {
+                    let turns = [(f0, f1), (f1, f2), (f2, f0)];
+                    if turns.iter().any(|(a, b)| a.n.cross(b.n).length() < min_sin)
+                        || f0.n.dot(f1.n.cross(f2.n)).abs() < min_triple
+                    {
+                        continue;
+                    }
+                    onto_three(f0, f1, f2)
                 }
-                moves.push((v, q));
+                _ => continue,
+            };
+            report.fitted_vertices += 1;
+            report.strips_left_out += strip_bits.count_ones() as usize;
+            report.merged_sides += merged_sides;
+            let q = solved.map(|d| p[v] + d * reach);
+            match q {
+                Some(q) if q.is_finite() && q.distance(p[v]) <= max_move => {
+                    if k >= 3 {
+                        report.moved_corners += 1;
+                    }
+                    moves.push((v, q));
+                }
+                _ => report.refused_moves += 1,
             }
-            _ => report.refused_moves += 1,
         }
-    }
-    report.moved_vertices = moves.len();
-    for (v, q) in moves {
-        mesh.positions[v] = q;
+        (report, moves)
+    };
+    let parts: Vec<_> = vertex_blocks(nv).into_par_iter().map(block).collect();
+    for (part, moves) in parts {
+        report.crease_vertices += part.crease_vertices;
+        report.fitted_vertices += part.fitted_vertices;
+        report.refused_moves += part.refused_moves;
+        report.corner_vertices += part.corner_vertices;
+        report.moved_corners += part.moved_corners;
+        report.strips_left_out += part.strips_left_out;
+        report.merged_sides += part.merged_sides;
+        report.moved_vertices += moves.len();
+        for (v, q) in moves {
+            mesh.positions[v] = q;
+        }
     }
     Ok(report)
 }

@@ -285,6 +285,22 @@ pub(crate) fn table_for<'t>(
     }
 }
 
+/// The vertex ranges a projection's per-vertex pass runs side by side (rayon): a few per
+/// thread, at least [`MIN_BLOCK`] vertices each. Every such pass reads the input positions
+/// only and moves after it, so splitting the range changes nothing in its result.
+pub(crate) fn vertex_blocks(nv: usize) -> Vec<std::ops::Range<usize>> {
+    let blocks = (4 * rayon::current_num_threads()).clamp(1, nv.div_ceil(MIN_BLOCK).max(1));
+    let size = nv.div_ceil(blocks).max(1);
+    (0..nv)
+        .step_by(size)
+        .map(|a| a..(a + size).min(nv))
+        .collect()
+}
+
+/// Fewest vertices a block of [`vertex_blocks`] holds (the blocks' scratch arrays span the
+/// mesh).
+const MIN_BLOCK: usize = 2048;
+
 pub(crate) fn checked_table(mesh: &Mesh) -> Result<CornerTable, Error> {
     if let Some(v) = mesh.positions.iter().position(|p| !p.is_finite()) {
         return Err(Error::InvalidInput(

@@ -10,8 +10,9 @@
 use glam::DVec3;
 use whet_mesh::{CornerTable, Mesh, VertexId};
 
-use crate::planar::{add_height_sample, solve6, table_for, vertex_normals};
+use crate::planar::{add_height_sample, solve6, table_for, vertex_blocks, vertex_normals};
 use crate::Error;
+use rayon::prelude::*;
 
 /// Most points a fit gathers, per square of its ring count: 144 for three rings, about four
 /// times what a regular mesh's three rings hold (37). A vertex whose rings hold more stays.
@@ -151,67 +152,80 @@ fn project_onto_local_quadrics_in(
     // no regular surface sample, and without the cap each of its neighbours would walk
     // its whole fan, quadratic in its valence (a hostile stream can decode to one).
     let max_points = MAX_POINTS_PER_SQUARED_RING * opts.rings * opts.rings;
-    // The vertex whose rings last gathered each vertex.
-    let mut stamp = vec![NONE; nv];
-    let mut ring: Vec<u32> = Vec::new();
-    let mut report = QuadricReport::default();
-    let mut moves: Vec<(usize, DVec3)> = Vec::new();
-    'vertices: for v in 0..nv {
-        let n = normals[v];
-        let vid = VertexId(v as u32);
-        if n == DVec3::ZERO || table.vertex_corner(vid).is_none() || table.is_boundary_vertex(vid) {
-            continue;
-        }
-        // Breadth first, ring by ring; `ring[start..]` is the last ring gathered.
-        ring.clear();
-        ring.push(v as u32);
-        stamp[v] = v as u32;
-        let mut start = 0;
-        for _ in 0..opts.rings {
-            let end = ring.len();
-            for i in start..end {
-                for c in table.vertex_corners(VertexId(ring[i])) {
-                    let w = table.vertex(table.next(c)).0;
-                    if stamp[w as usize] != v as u32 {
-                        stamp[w as usize] = v as u32;
-                        if normals[w as usize].dot(n) < cos_max || ring.len() >= max_points {
-                            continue 'vertices;
+    // Vertex by vertex in blocks side by side, each with its own scratch; the moves after.
+    let block = |range: std::ops::Range<usize>| {
+        // The vertex whose rings last gathered each vertex.
+        let mut stamp = vec![NONE; nv];
+        let mut ring: Vec<u32> = Vec::new();
+        let mut report = QuadricReport::default();
+        let mut moves: Vec<(usize, DVec3)> = Vec::new();
+        'vertices: for v in range {
+            let n = normals[v];
+            let vid = VertexId(v as u32);
+            if n == DVec3::ZERO
+                || table.vertex_corner(vid).is_none()
+                || table.is_boundary_vertex(vid)
+            {
+                continue;
+            }
+            // Breadth first, ring by ring; `ring[start..]` is the last ring gathered.
+            ring.clear();
+            ring.push(v as u32);
+            stamp[v] = v as u32;
+            let mut start = 0;
+            for _ in 0..opts.rings {
+                let end = ring.len();
+                for i in start..end {
+                    for c in table.vertex_corners(VertexId(ring[i])) {
+                        let w = table.vertex(table.next(c)).0;
+                        if stamp[w as usize] != v as u32 {
+                            stamp[w as usize] = v as u32;
+                            if normals[w as usize].dot(n) < cos_max || ring.len() >= max_points {
+                                continue 'vertices;
+                            }
+                            ring.push(w);
                         }
-                        ring.push(w);
                     }
                 }
+                start = end;
             }
-            start = end;
+            // Six unknowns: at least twice as many points (an interior vertex's two rings hold
+            // about 19).
+            if ring.len() < 12 {
+                continue;
+            }
+            let (eu, ev) = n.any_orthonormal_pair();
+            let mut m = [[0.0f64; 7]; 6];
+            for &w in &ring {
+                let d = (p[w as usize] - p[v]) / scale;
+                let (u, s, h) = (d.dot(eu), d.dot(ev), d.dot(n));
+                add_height_sample(&mut m, [u * u, u * s, s * s, u, s, 1.0], h);
+            }
+            let Some(coef) = solve6(m) else {
+                continue;
+            };
+            report.fitted_vertices += 1;
+            // The fitted height at the vertex itself (u = s = 0).
+            let h = coef[5] * scale;
+            let clamped = h.clamp(-max_move, max_move);
+            if clamped != h {
+                report.clamped_moves += 1;
+            }
+            if clamped != 0.0 {
+                moves.push((v, p[v] + n * clamped));
+            }
         }
-        // Six unknowns: at least twice as many points (an interior vertex's two rings hold
-        // about 19).
-        if ring.len() < 12 {
-            continue;
+        (report, moves)
+    };
+    let parts: Vec<_> = vertex_blocks(nv).into_par_iter().map(block).collect();
+    let mut report = QuadricReport::default();
+    for (part, moves) in parts {
+        report.fitted_vertices += part.fitted_vertices;
+        report.clamped_moves += part.clamped_moves;
+        report.moved_vertices += moves.len();
+        for (v, q) in moves {
+            mesh.positions[v] = q;
         }
-        let (eu, ev) = n.any_orthonormal_pair();
-        let mut m = [[0.0f64; 7]; 6];
-        for &w in &ring {
-            let d = (p[w as usize] - p[v]) / scale;
-            let (u, s, h) = (d.dot(eu), d.dot(ev), d.dot(n));
-            add_height_sample(&mut m, [u * u, u * s, s * s, u, s, 1.0], h);
-        }
-        let Some(coef) = solve6(m) else {
-            continue;
-        };
-        report.fitted_vertices += 1;
-        // The fitted height at the vertex itself (u = s = 0).
-        let h = coef[5] * scale;
-        let clamped = h.clamp(-max_move, max_move);
-        if clamped != h {
-            report.clamped_moves += 1;
-        }
-        if clamped != 0.0 {
-            moves.push((v, p[v] + n * clamped));
-        }
-    }
-    report.moved_vertices = moves.len();
-    for (v, q) in moves {
-        mesh.positions[v] = q;
     }
     Ok(report)
 }
