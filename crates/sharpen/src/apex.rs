@@ -264,16 +264,13 @@ pub fn restore_apexes(mesh: &mut Mesh, opts: &ApexOptions) -> Result<ApexReport,
     restore_apexes_in(mesh, opts, None)
 }
 
-/// [`restore_apexes`] on `table`, the corner table of `mesh`'s triangles, built once for
-/// several projections in a row (they move vertices, never triangles; the coordinates are
-/// checked again). A table of other triangles is not used: one is built, as without it.
-pub fn restore_apexes_with_table(
-    mesh: &mut Mesh,
-    opts: &ApexOptions,
-    table: &CornerTable,
-) -> Result<ApexReport, Error> {
-    restore_apexes_in(mesh, opts, Some(table))
-}
+with_table_entry_point!(
+    restore_apexes,
+    restore_apexes_with_table,
+    restore_apexes_in,
+    ApexOptions,
+    ApexReport
+);
 
 fn restore_apexes_in(
     mesh: &mut Mesh,

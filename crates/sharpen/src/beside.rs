@@ -135,16 +135,13 @@ pub fn project_beside_creases_onto_local_quadrics(
     project_beside_creases_onto_local_quadrics_in(mesh, opts, None)
 }
 
-/// [`project_beside_creases_onto_local_quadrics`] on `table`, the corner table of `mesh`'s triangles, built once for
-/// several projections in a row (they move vertices, never triangles; the coordinates are
-/// checked again). A table of other triangles is not used: one is built, as without it.
-pub fn project_beside_creases_onto_local_quadrics_with_table(
-    mesh: &mut Mesh,
-    opts: &BesideOptions,
-    table: &CornerTable,
-) -> Result<BesideReport, Error> {
-    project_beside_creases_onto_local_quadrics_in(mesh, opts, Some(table))
-}
+with_table_entry_point!(
+    project_beside_creases_onto_local_quadrics,
+    project_beside_creases_onto_local_quadrics_with_table,
+    project_beside_creases_onto_local_quadrics_in,
+    BesideOptions,
+    BesideReport
+);
 
 fn project_beside_creases_onto_local_quadrics_in(
     mesh: &mut Mesh,

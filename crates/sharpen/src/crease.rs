@@ -74,8 +74,9 @@ pub struct CreaseOptions {
     pub strips: bool,
     /// Whether, at a vertex of three to six crease edges, arcs whose gatherings reach each
     /// other (a crease between them ends within the reach) count as one side, fitted to all
-    /// their points, when that fit holds them within [`MAX_MERGED_SPREAD`] and their
-    /// triangles turn from it by less than the crease angle; else the vertex stays.
+    /// their points, when that fit holds them within a tenth of a mean edge length (the
+    /// module's `MAX_MERGED_SPREAD`) and their triangles turn from it by less than the
+    /// crease angle; else the vertex stays.
     pub meeting_arcs: bool,
 }
 
@@ -413,16 +414,13 @@ pub fn project_creases_onto_local_quadrics(
     project_creases_onto_local_quadrics_in(mesh, opts, None)
 }
 
-/// [`project_creases_onto_local_quadrics`] on `table`, the corner table of `mesh`'s triangles, built once for
-/// several projections in a row (they move vertices, never triangles; the coordinates are
-/// checked again). A table of other triangles is not used: one is built, as without it.
-pub fn project_creases_onto_local_quadrics_with_table(
-    mesh: &mut Mesh,
-    opts: &CreaseOptions,
-    table: &CornerTable,
-) -> Result<CreaseReport, Error> {
-    project_creases_onto_local_quadrics_in(mesh, opts, Some(table))
-}
+with_table_entry_point!(
+    project_creases_onto_local_quadrics,
+    project_creases_onto_local_quadrics_with_table,
+    project_creases_onto_local_quadrics_in,
+    CreaseOptions,
+    CreaseReport
+);
 
 fn project_creases_onto_local_quadrics_in(
     mesh: &mut Mesh,

@@ -35,6 +35,26 @@
 //! ```
 #![forbid(unsafe_code)]
 
+/// The `*_with_table` entry point of a projection after sharpening: its body `$inner` on
+/// a corner table the caller built once for several projections in a row.
+macro_rules! with_table_entry_point {
+    ($name:ident, $with_table:ident, $inner:ident, $opts:ty, $report:ty) => {
+        #[doc = concat!(
+            "[`", stringify!($name), "`] on `table`, the corner table of `mesh`'s triangles, ",
+            "built once for several projections in a row (they move vertices, never triangles; ",
+            "the coordinates are checked again). A table of other triangles is not used: one is ",
+            "built, as without it."
+        )]
+        pub fn $with_table(
+            mesh: &mut Mesh,
+            opts: &$opts,
+            table: &CornerTable,
+        ) -> Result<$report, Error> {
+            $inner(mesh, opts, Some(table))
+        }
+    };
+}
+
 mod apex;
 mod beside;
 mod crease;

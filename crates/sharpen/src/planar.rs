@@ -115,16 +115,13 @@ pub fn flatten_planar_regions(
     flatten_planar_regions_in(mesh, opts, None)
 }
 
-/// [`flatten_planar_regions`] on `table`, the corner table of `mesh`'s triangles, built once for
-/// several projections in a row (they move vertices, never triangles; the coordinates are
-/// checked again). A table of other triangles is not used: one is built, as without it.
-pub fn flatten_planar_regions_with_table(
-    mesh: &mut Mesh,
-    opts: &PlanarOptions,
-    table: &CornerTable,
-) -> Result<PlanarReport, Error> {
-    flatten_planar_regions_in(mesh, opts, Some(table))
-}
+with_table_entry_point!(
+    flatten_planar_regions,
+    flatten_planar_regions_with_table,
+    flatten_planar_regions_in,
+    PlanarOptions,
+    PlanarReport
+);
 
 fn flatten_planar_regions_in(
     mesh: &mut Mesh,

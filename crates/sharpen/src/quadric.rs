@@ -118,16 +118,13 @@ pub fn project_onto_local_quadrics(
     project_onto_local_quadrics_in(mesh, opts, None)
 }
 
-/// [`project_onto_local_quadrics`] on `table`, the corner table of `mesh`'s triangles, built once for
-/// several projections in a row (they move vertices, never triangles; the coordinates are
-/// checked again). A table of other triangles is not used: one is built, as without it.
-pub fn project_onto_local_quadrics_with_table(
-    mesh: &mut Mesh,
-    opts: &QuadricOptions,
-    table: &CornerTable,
-) -> Result<QuadricReport, Error> {
-    project_onto_local_quadrics_in(mesh, opts, Some(table))
-}
+with_table_entry_point!(
+    project_onto_local_quadrics,
+    project_onto_local_quadrics_with_table,
+    project_onto_local_quadrics_in,
+    QuadricOptions,
+    QuadricReport
+);
 
 fn project_onto_local_quadrics_in(
     mesh: &mut Mesh,
