@@ -260,8 +260,6 @@ fn flatten_planar_regions_in(
     Ok(report)
 }
 
-/// The corner table of `mesh` for the post-sharpening passes, which need finite
-/// coordinates and an oriented manifold: [`Error::InvalidInput`] otherwise.
 /// The corner table a projection runs on: `given` when it is `mesh`'s (the same
 /// triangles; the coordinates are checked again, as a projection before may have moved
 /// them), else [`checked_table`]'s.
@@ -298,6 +296,8 @@ pub(crate) fn vertex_blocks(nv: usize) -> Vec<std::ops::Range<usize>> {
 /// mesh).
 const MIN_BLOCK: usize = 2048;
 
+/// The corner table of `mesh` for the post-sharpening passes, which need finite
+/// coordinates and an oriented manifold: [`Error::InvalidInput`] otherwise.
 pub(crate) fn checked_table(mesh: &Mesh) -> Result<CornerTable, Error> {
     if let Some(v) = mesh.positions.iter().position(|p| !p.is_finite()) {
         return Err(Error::InvalidInput(
