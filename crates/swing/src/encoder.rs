@@ -1728,8 +1728,8 @@ impl SwingEncoder {
     /// turn: the same figures, and the same first error, as measuring them one after the
     /// other. The sharpenings of as many jobs as there are threads run side by side (that
     /// many meshes in memory at once), then the Metro measures of those not in `measured`
-    /// (each mesh once): the sharpener and the projections are single-threaded, and side by
-    /// side they overlap one another's Metro work.
+    /// (each mesh once): the sharpener is single-threaded, and side by side the sharpenings
+    /// overlap one another's Metro work.
     fn measure_sharpened_each(
         &self,
         prep: &Prepared,
