@@ -251,7 +251,10 @@ fn project_beside_creases_onto_local_quadrics_in(
         }
         (report, moves)
     };
-    let parts: Vec<_> = vertex_blocks(nv).into_par_iter().map(block).collect();
+    let parts: Vec<_> = vertex_blocks(nv, 4 * (nt + nv))
+        .into_par_iter()
+        .map(block)
+        .collect();
     for (part, moves) in parts {
         report.beside_vertices += part.beside_vertices;
         report.fitted_vertices += part.fitted_vertices;

@@ -281,10 +281,15 @@ pub(crate) fn table_for<'t>(
 }
 
 /// The vertex ranges a projection's per-vertex pass runs side by side (rayon): a few per
-/// thread, at least [`MIN_BLOCK`] vertices each. Every such pass reads the input positions
-/// only and moves after it, so splitting the range changes nothing in its result.
-pub(crate) fn vertex_blocks(nv: usize) -> Vec<std::ops::Range<usize>> {
-    let blocks = (4 * rayon::current_num_threads()).clamp(1, nv.div_ceil(MIN_BLOCK).max(1));
+/// thread, at least [`MIN_BLOCK`] vertices each, and no more than [`SCRATCH_BUDGET`]
+/// bytes of scratch in all when each block holds `scratch_bytes` (its stamp arrays span
+/// the mesh). Every such pass reads the input positions only and moves after it, so
+/// splitting the range changes nothing in its result.
+pub(crate) fn vertex_blocks(nv: usize, scratch_bytes: usize) -> Vec<std::ops::Range<usize>> {
+    let by_memory = (SCRATCH_BUDGET / scratch_bytes.max(1)).max(1);
+    let blocks = (4 * rayon::current_num_threads())
+        .min(by_memory)
+        .clamp(1, nv.div_ceil(MIN_BLOCK).max(1));
     let size = nv.div_ceil(blocks).max(1);
     (0..nv)
         .step_by(size)
@@ -295,6 +300,10 @@ pub(crate) fn vertex_blocks(nv: usize) -> Vec<std::ops::Range<usize>> {
 /// Fewest vertices a block of [`vertex_blocks`] holds (the blocks' scratch arrays span the
 /// mesh).
 const MIN_BLOCK: usize = 2048;
+
+/// Most bytes the blocks of [`vertex_blocks`] hold in scratch together (64 MiB: a mesh of
+/// two million triangles still splits five ways).
+const SCRATCH_BUDGET: usize = 64 << 20;
 
 /// The corner table of `mesh` for the post-sharpening passes, which need finite
 /// coordinates and an oriented manifold: [`Error::InvalidInput`] otherwise.

@@ -214,7 +214,10 @@ fn project_onto_local_quadrics_in(
         }
         (report, moves)
     };
-    let parts: Vec<_> = vertex_blocks(nv).into_par_iter().map(block).collect();
+    let parts: Vec<_> = vertex_blocks(nv, 4 * nv)
+        .into_par_iter()
+        .map(block)
+        .collect();
     let mut report = QuadricReport::default();
     for (part, moves) in parts {
         report.fitted_vertices += part.fitted_vertices;
