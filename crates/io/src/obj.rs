@@ -24,7 +24,10 @@ use std::io::{BufRead, Write};
 
 use whet_mesh::Mesh;
 
-use crate::text::{parse_f64, parse_i64, show, strip_comment, tokens, write_f64, LineReader};
+use crate::text::{
+    parse_f64, parse_i64, show, strip_comment, tokens, write_face_line, write_point_line,
+    LineReader,
+};
 use crate::{finite_point, Error, Fan, ReadReport, Skipped};
 
 /// Reads an OBJ file and reports what it skipped.
@@ -265,18 +268,11 @@ pub(crate) fn write<W: Write>(w: &mut W, mesh: &Mesh) -> std::io::Result<()> {
         mesh.positions.len(),
         mesh.triangles.len()
     )?;
-    for p in &mesh.positions {
-        w.write_all(b"v ")?;
-        write_f64(w, p.x)?;
-        w.write_all(b" ")?;
-        write_f64(w, p.y)?;
-        w.write_all(b" ")?;
-        write_f64(w, p.z)?;
-        w.write_all(b"\n")?;
+    for &p in &mesh.positions {
+        write_point_line(w, b"v", p)?;
     }
     for t in &mesh.triangles {
-        let [a, b, c] = t.map(|i| u64::from(i) + 1);
-        writeln!(w, "f {a} {b} {c}")?;
+        write_face_line(w, b"f", t.map(|i| u64::from(i) + 1))?;
     }
     Ok(())
 }

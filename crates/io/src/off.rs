@@ -23,7 +23,10 @@ use std::io::{BufRead, Write};
 
 use whet_mesh::{DVec3, Mesh};
 
-use crate::text::{parse_f64, parse_i64, show, strip_comment, tokens, write_f64, LineReader};
+use crate::text::{
+    parse_f64, parse_i64, show, strip_comment, tokens, write_face_line, write_point_line,
+    LineReader,
+};
 use crate::{capacity, check_index, finite_point, Error, Fan, ReadReport, Skipped};
 
 /// The prefixes of the OFF keyword that announce per-vertex values after `x y z`.
@@ -294,16 +297,11 @@ fn check_keyword(keyword: &[u8], line: usize) -> Result<Prefixes, Error> {
 pub(crate) fn write<W: Write>(w: &mut W, mesh: &Mesh) -> std::io::Result<()> {
     writeln!(w, "OFF")?;
     writeln!(w, "{} {} 0", mesh.positions.len(), mesh.triangles.len())?;
-    for p in &mesh.positions {
-        write_f64(w, p.x)?;
-        w.write_all(b" ")?;
-        write_f64(w, p.y)?;
-        w.write_all(b" ")?;
-        write_f64(w, p.z)?;
-        w.write_all(b"\n")?;
+    for &p in &mesh.positions {
+        write_point_line(w, b"", p)?;
     }
-    for [a, b, c] in &mesh.triangles {
-        writeln!(w, "3 {a} {b} {c}")?;
+    for t in &mesh.triangles {
+        write_face_line(w, b"3", t.map(u64::from))?;
     }
     Ok(())
 }

@@ -34,7 +34,8 @@ use whet_mesh::{DVec3, Mesh};
 
 use crate::binary::{ended, BinReader, Decode};
 use crate::text::{
-    parse_f64, parse_i64, show, tokens, write_f64, LineReader, TokenReader, MAX_LINE,
+    parse_f64, parse_i64, show, tokens, write_f64, write_face_line, LineReader, TokenReader,
+    MAX_LINE,
 };
 use crate::{capacity, check_index, finite_point, Error, Fan, PlyEncoding, ReadReport, Skipped};
 
@@ -977,8 +978,8 @@ pub(crate) fn write<W: Write>(
                 }
                 w.write_all(b"\n")?;
             }
-            for [a, b, c] in &mesh.triangles {
-                writeln!(w, "3 {a} {b} {c}")?;
+            for t in &mesh.triangles {
+                write_face_line(w, b"3", t.map(u64::from))?;
             }
         }
         PlyEncoding::BinaryLittleEndian | PlyEncoding::BinaryBigEndian => {

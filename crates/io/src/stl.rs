@@ -34,7 +34,7 @@ use std::io::{BufRead, ErrorKind, Read, Write};
 use whet_mesh::{DVec3, Mesh};
 
 use crate::binary::{array, ended, BinReader};
-use crate::text::{parse_f64, show, tokens, write_f64, LineReader};
+use crate::text::{parse_f64, show, tokens, write_point_line, LineReader};
 use crate::{capacity, Error, Fan, ReadReport, Skipped, StlEncoding};
 
 /// Size of the binary header plus count.
@@ -299,22 +299,12 @@ pub(crate) fn write<W: Write>(w: &mut W, mesh: &Mesh, encoding: StlEncoding) -> 
 }
 
 fn write_ascii<W: Write>(w: &mut W, mesh: &Mesh) -> std::io::Result<()> {
-    let vec = |w: &mut W, p: DVec3| -> std::io::Result<()> {
-        write_f64(w, p.x)?;
-        w.write_all(b" ")?;
-        write_f64(w, p.y)?;
-        w.write_all(b" ")?;
-        write_f64(w, p.z)?;
-        w.write_all(b"\n")
-    };
     writeln!(w, "solid whet")?;
     for t in &mesh.triangles {
-        w.write_all(b"  facet normal ")?;
-        vec(w, normal(mesh, t))?;
+        write_point_line(w, b"  facet normal", normal(mesh, t))?;
         w.write_all(b"    outer loop\n")?;
         for &i in t {
-            w.write_all(b"      vertex ")?;
-            vec(w, mesh.positions[i as usize])?;
+            write_point_line(w, b"      vertex", mesh.positions[i as usize])?;
         }
         w.write_all(b"    endloop\n  endfacet\n")?;
     }
