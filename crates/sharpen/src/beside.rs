@@ -11,7 +11,7 @@
 use glam::DVec3;
 use whet_mesh::{CornerTable, Mesh, VertexId};
 
-use crate::crease::{crease_edges, SideReach};
+use crate::crease::{crease_edges, NearPoints, SideReach};
 use crate::planar::{add_height_sample, solve6, table_for, vertex_blocks, vertex_normals};
 use crate::Error;
 use rayon::prelude::*;
@@ -160,6 +160,21 @@ fn project_beside_creases_onto_local_quadrics_in(
     }
     let (crease, on_crease) = crease_edges(mesh, &table, opts.crease_angle_degrees);
     let centroids = crate::crease::centroids(mesh);
+    // The triangles touching a crease, and their centroids bucketed: a vertex whose fan
+    // touches none and that has none of those centroids within the reach gathers none of
+    // them, so its side would hold no crease vertex; it is skipped without the flood.
+    let touches_crease: Vec<bool> = mesh
+        .triangles
+        .iter()
+        .map(|t| t.iter().any(|&w| on_crease[w as usize]))
+        .collect();
+    let near_points = NearPoints::new(
+        (0..nt)
+            .filter(|&t| touches_crease[t])
+            .map(|t| centroids[t])
+            .collect(),
+        reach,
+    );
     let normals = vertex_normals(mesh);
     let cos_max = opts.max_normal_angle_degrees.to_radians().cos();
     let max_move = opts.max_move * edge;
@@ -186,12 +201,17 @@ fn project_beside_creases_onto_local_quadrics_in(
             let stamp = v as u32;
             stack.clear();
             // The fan: its edges at v are no crease (v is on none).
+            let mut fan_touches_crease = false;
             for c in table.vertex_corners(vid) {
                 let t = c.index() / 3;
+                fan_touches_crease |= touches_crease[t];
                 if tri_stamp[t] != stamp {
                     tri_stamp[t] = stamp;
                     stack.push(t);
                 }
+            }
+            if !fan_touches_crease && !near_points.any_within(p[v], reach) {
+                continue;
             }
             let side = SideReach {
                 centroids: &centroids,
@@ -204,9 +224,7 @@ fn project_beside_creases_onto_local_quadrics_in(
             if !side.gather(stamp, &mut tri_stamp, &mut stack, &mut gathered) {
                 continue;
             }
-            let near = gathered
-                .iter()
-                .any(|&t| mesh.triangles[t].iter().any(|&w| on_crease[w as usize]));
+            let near = gathered.iter().any(|&t| touches_crease[t]);
             if !near {
                 continue;
             }

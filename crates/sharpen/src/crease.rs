@@ -253,6 +253,128 @@ impl SideReach<'_> {
     }
 }
 
+/// Chosen points (the centroids of the triangles that touch a crease) bucketed in a uniform
+/// grid of cells no smaller than a reach, to tell without a gathering that none lies within
+/// that reach of a vertex: the one-sided projection floods up to 144 triangles around every
+/// vertex off a crease, and on swing-decoded parts many of those floods reach no crease.
+pub(crate) struct NearPoints {
+    origin: DVec3,
+    /// The cell's side; 0 when there is no point.
+    cell: f64,
+    dims: [usize; 3],
+    /// Per cell (x fastest), where its points start in `points`; one more entry at the end.
+    starts: Vec<u32>,
+    points: Vec<DVec3>,
+}
+
+impl NearPoints {
+    /// Buckets `points` in cells of at least `reach` (grown, doubling, until there are at
+    /// most eight cells a point and 64 more, so a sparse set does not allocate a dense grid).
+    /// A reach that is not positive and finite, or a non-finite point, gives a set that
+    /// answers `true` everywhere (nothing skipped).
+    pub fn new(points: Vec<DVec3>, reach: f64) -> NearPoints {
+        let everywhere = NearPoints {
+            origin: DVec3::ZERO,
+            cell: f64::NAN,
+            dims: [0; 3],
+            starts: Vec::new(),
+            points: Vec::new(),
+        };
+        if !(reach > 0.0 && reach.is_finite()) || points.iter().any(|p| !p.is_finite()) {
+            return everywhere;
+        }
+        if points.is_empty() {
+            return NearPoints {
+                cell: 0.0,
+                ..everywhere
+            };
+        }
+        let lo = points.iter().fold(DVec3::INFINITY, |a, &p| a.min(p));
+        let hi = points.iter().fold(DVec3::NEG_INFINITY, |a, &p| a.max(p));
+        let extent = hi - lo;
+        let max_cells = 8 * points.len() + 64;
+        // A hair over the reach: a point within the reach of a vertex then lies in the
+        // vertex's cell or a neighbour, whatever the rounding of the cells' coordinates.
+        let mut cell = reach * (1.0 + 1e-6);
+        let dims = loop {
+            let d = [extent.x, extent.y, extent.z].map(|e| (e / cell) as usize + 1);
+            let cells = d.iter().try_fold(1usize, |a, &n| a.checked_mul(n));
+            match cells {
+                Some(n) if n <= max_cells => break d,
+                _ => cell *= 2.0,
+            }
+        };
+        let index = |p: DVec3| {
+            let c = ((p - lo) / cell).to_array();
+            let k = |i: usize| (c[i] as usize).min(dims[i] - 1);
+            (k(2) * dims[1] + k(1)) * dims[0] + k(0)
+        };
+        let mut starts = vec![0u32; dims[0] * dims[1] * dims[2] + 1];
+        for &p in &points {
+            starts[index(p) + 1] += 1;
+        }
+        for i in 1..starts.len() {
+            starts[i] += starts[i - 1];
+        }
+        let mut fill = starts.clone();
+        let mut sorted = vec![DVec3::ZERO; points.len()];
+        for &p in &points {
+            let i = index(p);
+            sorted[fill[i] as usize] = p;
+            fill[i] += 1;
+        }
+        NearPoints {
+            origin: lo,
+            cell,
+            dims,
+            starts,
+            points: sorted,
+        }
+    }
+
+    /// Whether a point lies within `reach` of `q` (strictly, measured as
+    /// [`SideReach::gather`] measures: `point.distance(q) < reach`), `reach` no more than
+    /// the one the set was built for. May answer `true` wrongly (the set's reach was not
+    /// usable); never `false` wrongly.
+    pub fn any_within(&self, q: DVec3, reach: f64) -> bool {
+        if self.cell.is_nan() || !q.is_finite() {
+            return true;
+        }
+        if self.points.is_empty() {
+            return false;
+        }
+        let c = ((q - self.origin) / self.cell).to_array();
+        // The cells from one before q's to one after, clamped to the grid (a q far outside
+        // gives an empty range). Cell coordinates of huge values saturate, which keeps the
+        // ranges right.
+        let range = |i: usize| {
+            let k = c[i].floor();
+            let first = (k - 1.0).max(0.0);
+            let last = (k + 1.0).min(self.dims[i] as f64 - 1.0);
+            (first as usize, last as usize, first <= last)
+        };
+        let (x0, x1, okx) = range(0);
+        let (y0, y1, oky) = range(1);
+        let (z0, z1, okz) = range(2);
+        if !(okx && oky && okz) {
+            return false;
+        }
+        for z in z0..=z1 {
+            for y in y0..=y1 {
+                let row = (z * self.dims[1] + y) * self.dims[0];
+                let (a, b) = (self.starts[row + x0], self.starts[row + x1 + 1]);
+                if self.points[a as usize..b as usize]
+                    .iter()
+                    .any(|p| p.distance(q) < reach)
+                {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+}
+
 /// Each triangle's centroid, the mean of its corners (summed in corner order), as
 /// [`SideReach`] measures its reach from.
 pub(crate) fn centroids(mesh: &Mesh) -> Vec<DVec3> {
@@ -697,6 +819,48 @@ fn project_creases_onto_local_quadrics_in(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn near_points_answer_as_a_search_of_every_point_does() {
+        // Clustered points (a crease's centroids lie along lines) and queries around and
+        // beyond them, at reaches from a hundredth of the extent to more than all of it.
+        let mut noise = noise_source(0x2545_F491_4F6C_DD1D);
+        let mut unit = || noise() + 0.5;
+        for round in 0..40 {
+            let n = [0, 1, 5, 60, 400][round % 5];
+            let points: Vec<DVec3> = (0..n)
+                .map(|i| {
+                    let t = unit() * 10.0;
+                    let line = [DVec3::new(t, 0.0, 0.0), DVec3::new(0.0, t, 5.0)][i % 2];
+                    line + DVec3::new(unit(), unit(), unit()) * 0.3
+                })
+                .collect();
+            let reach = [0.05, 0.4, 1.0, 3.0, 25.0][round / 8 % 5];
+            let near = NearPoints::new(points.clone(), reach);
+            for _ in 0..500 {
+                let q = DVec3::new(unit() * 14.0 - 2.0, unit() * 14.0 - 2.0, unit() * 9.0 - 2.0);
+                // A smaller reach than the grid's is answered as well.
+                for r in [reach, 0.5 * reach] {
+                    let brute = points.iter().any(|p| p.distance(q) < r);
+                    assert_eq!(near.any_within(q, r), brute, "{round} {q} {r}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn near_points_without_a_usable_reach_skip_nothing() {
+        let points = vec![DVec3::ZERO, DVec3::X];
+        for reach in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            let near = NearPoints::new(points.clone(), reach);
+            assert!(near.any_within(DVec3::splat(100.0), 1.0));
+        }
+        let near = NearPoints::new(vec![DVec3::new(f64::NAN, 0.0, 0.0)], 1.0);
+        assert!(near.any_within(DVec3::splat(100.0), 1.0));
+        let near = NearPoints::new(points, 1.0);
+        assert!(near.any_within(DVec3::new(f64::NAN, 0.0, 0.0), 1.0));
+        assert!(!near.any_within(DVec3::new(1e300, -1e300, 0.0), 1.0));
+    }
 
     /// The deterministic pseudo-random numbers of the tests, in [-0.5, 0.5).
     fn noise_source(seed: u64) -> impl FnMut() -> f64 {
