@@ -12,7 +12,7 @@ use glam::DVec3;
 use whet_mesh::{CornerTable, Mesh, VertexId};
 
 use crate::crease::{crease_edges, NearPoints, SideReach};
-use crate::planar::{add_height_sample, solve6, table_for, vertex_blocks, vertex_normals};
+use crate::planar::{solve6, table_for, vertex_blocks, vertex_normals, HeightSamples};
 use crate::Error;
 use rayon::prelude::*;
 
@@ -231,7 +231,7 @@ fn project_beside_creases_onto_local_quadrics_in(
             report.beside_vertices += 1;
             // In the frame of v's normal, centred on v, scaled by the reach.
             let (eu, ev) = n.any_orthonormal_pair();
-            let mut m = [[0.0f64; 7]; 6];
+            let mut samples = HeightSamples::default();
             let mut points = 0usize;
             for &t in &gathered {
                 for w in mesh.triangles[t] {
@@ -246,14 +246,14 @@ fn project_beside_creases_onto_local_quadrics_in(
                     points += 1;
                     let d = (p[w] - p[v]) / reach;
                     let (a, b, h) = (d.dot(eu), d.dot(ev), d.dot(n));
-                    add_height_sample(&mut m, [a * a, a * b, b * b, a, b, 1.0], h);
+                    samples.add([a * a, a * b, b * b, a, b, 1.0], h);
                 }
             }
             // Six unknowns: at least twice as many points.
             if points < 12 {
                 continue;
             }
-            let Some(coef) = solve6(m) else {
+            let Some(coef) = solve6(samples.system()) else {
                 continue;
             };
             report.fitted_vertices += 1;

@@ -18,7 +18,7 @@
 use glam::DVec3;
 use whet_mesh::{CornerId, CornerTable, Mesh, VertexId};
 
-use crate::planar::{add_height_sample, pin_quadratic_terms, solve6, table_for, vertex_blocks};
+use crate::planar::{pin_quadratic_terms, solve6, table_for, vertex_blocks, HeightSamples};
 use crate::Error;
 use rayon::prelude::*;
 
@@ -436,12 +436,13 @@ fn fit_side(
     few: bool,
 ) -> Option<SideFit> {
     let (eu, ev) = n.any_orthonormal_pair();
-    let mut m = [[0.0f64; 7]; 6];
+    let mut samples = HeightSamples::default();
     for &w in points {
         let d = (p[w] - p[v]) / reach;
         let (a, b, h) = (d.dot(eu), d.dot(ev), d.dot(n));
-        add_height_sample(&mut m, [a * a, a * b, b * b, a, b, 1.0], h);
+        samples.add([a * a, a * b, b * b, a, b, 1.0], h);
     }
+    let mut m = samples.system();
     // A corner's wedge of a face holds few vertices off its creases within the reach:
     // under twelve, its plane (three unknowns, at least six points).
     if few && (6..12).contains(&points.len()) {

@@ -358,10 +358,11 @@ fn fit_plane(pts: &[DVec3], normal: DVec3) -> Option<PlaneFit> {
         let (u, v) = (u / scale, v / scale);
         [u * u, u * v, v * v, u, v, 1.0]
     };
-    let mut m = [[0.0f64; 7]; 6];
+    let mut samples = HeightSamples::default();
     for &(u, v, h) in &local {
-        add_height_sample(&mut m, basis(u, v), h);
+        samples.add(basis(u, v), h);
     }
+    let m = samples.system();
     let coef = solve6(m)?;
     // The plane: the same system with the quadratic terms pinned to zero.
     let mut m_plane = m;
@@ -409,20 +410,43 @@ pub(crate) fn vertex_normals(mesh: &Mesh) -> Vec<DVec3> {
     normals
 }
 
-/// Adds one sample of height `h` with quadratic basis `b` (`[u^2, uv, v^2, u, v, 1]`) to
-/// the least-squares normal equations `m` of a quadratic height field (augmented: the right
-/// side in column 6), as the planar, quadric and crease fits all build them.
-#[inline]
-pub(crate) fn add_height_sample(m: &mut [[f64; 7]; 6], b: [f64; 6], h: f64) {
-    for i in 0..6 {
-        for j in 0..6 {
-            m[i][j] += b[i] * b[j];
+/// The least-squares normal equations of a quadratic height field over the basis `[u^2,
+/// uv, v^2, u, v, 1]`, as the planar, quadric, one-sided and crease fits all build them,
+/// sample by sample. The matrix is symmetric, so only its upper triangle and the right side
+/// are summed (27 products a sample instead of 42: the sums were a tenth of `whet decode
+/// --sharpen`); [`HeightSamples::system`] mirrors it. Each entry below the diagonal sums the
+/// same products as its mirror (`b[j] b[i]` is `b[i] b[j]`), in the same order, so the
+/// system is the full one's bit for bit.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct HeightSamples {
+    m: [[f64; 7]; 6],
+}
+
+impl HeightSamples {
+    /// Adds one sample of height `h` with basis values `b`.
+    #[inline]
+    pub fn add(&mut self, b: [f64; 6], h: f64) {
+        for i in 0..6 {
+            for j in i..6 {
+                self.m[i][j] += b[i] * b[j];
+            }
+            self.m[i][6] += b[i] * h;
         }
-        m[i][6] += b[i] * h;
+    }
+
+    /// The augmented system (the right side in column 6) for [`solve6`].
+    pub fn system(&self) -> [[f64; 7]; 6] {
+        let mut m = self.m;
+        for i in 1..6 {
+            for j in 0..i {
+                m[i][j] = m[j][i];
+            }
+        }
+        m
     }
 }
 
-/// Pins the quadratic terms of the normal equations `m` (as [`add_height_sample`] builds
+/// Pins the quadratic terms of the normal equations `m` (as [`HeightSamples::system`] gives
 /// them) to zero, so that [`solve6`] gives the least-squares plane `h = d u + e v + f`.
 pub(crate) fn pin_quadratic_terms(m: &mut [[f64; 7]; 6]) {
     for i in 0..3 {
@@ -468,6 +492,38 @@ pub(crate) fn solve6(mut m: [[f64; 7]; 6]) -> Option<[f64; 6]> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn height_samples_give_the_full_sums_bit_for_bit() {
+        // Every product summed into the full matrix, as the fits summed them before the
+        // upper triangle alone was.
+        let mut full = [[0.0f64; 7]; 6];
+        let mut samples = HeightSamples::default();
+        let mut state = 0x9E37_79B9_7F4A_7C15u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        for _ in 0..500 {
+            let (u, v, h) = (next() * 3.0, next() * 1e-3, next());
+            let b = [u * u, u * v, v * v, u, v, 1.0];
+            for i in 0..6 {
+                for j in 0..6 {
+                    full[i][j] += b[i] * b[j];
+                }
+                full[i][6] += b[i] * h;
+            }
+            samples.add(b, h);
+        }
+        let system = samples.system();
+        for i in 0..6 {
+            for j in 0..7 {
+                assert_eq!(system[i][j].to_bits(), full[i][j].to_bits(), "{i} {j}");
+            }
+        }
+    }
 
     /// A `n` x `n` grid of unit cells bent along x into `z = bend * x^2`, its vertices
     /// pushed along z by a deterministic pseudo-random `noise`.

@@ -10,7 +10,7 @@
 use glam::DVec3;
 use whet_mesh::{CornerTable, Mesh, VertexId};
 
-use crate::planar::{add_height_sample, solve6, table_for, vertex_blocks, vertex_normals};
+use crate::planar::{solve6, table_for, vertex_blocks, vertex_normals, HeightSamples};
 use crate::Error;
 use rayon::prelude::*;
 
@@ -192,13 +192,13 @@ fn project_onto_local_quadrics_in(
                 continue;
             }
             let (eu, ev) = n.any_orthonormal_pair();
-            let mut m = [[0.0f64; 7]; 6];
+            let mut samples = HeightSamples::default();
             for &w in &ring {
                 let d = (p[w as usize] - p[v]) / scale;
                 let (u, s, h) = (d.dot(eu), d.dot(ev), d.dot(n));
-                add_height_sample(&mut m, [u * u, u * s, s * s, u, s, 1.0], h);
+                samples.add([u * u, u * s, s * s, u, s, 1.0], h);
             }
-            let Some(coef) = solve6(m) else {
+            let Some(coef) = solve6(samples.system()) else {
                 continue;
             };
             report.fitted_vertices += 1;
