@@ -292,17 +292,22 @@ impl NearPoints {
         let lo = points.iter().fold(DVec3::INFINITY, |a, &p| a.min(p));
         let hi = points.iter().fold(DVec3::NEG_INFINITY, |a, &p| a.max(p));
         let extent = hi - lo;
-        let max_cells = 8 * points.len() + 64;
+        if !extent.is_finite() {
+            // Points spread over more than the largest f64 (a hostile stream's).
+            return everywhere;
+        }
+        let max_cells = (8 * points.len() + 64) as f64;
         // A hair over the reach: a point within the reach of a vertex then lies in the
         // vertex's cell or a neighbour, whatever the rounding of the cells' coordinates.
+        // Counted in f64, which neither overflows nor wraps; doubling ends once a cell
+        // spans the extent (one cell), at the latest.
         let mut cell = reach * (1.0 + 1e-6);
         let dims = loop {
-            let d = [extent.x, extent.y, extent.z].map(|e| (e / cell) as usize + 1);
-            let cells = d.iter().try_fold(1usize, |a, &n| a.checked_mul(n));
-            match cells {
-                Some(n) if n <= max_cells => break d,
-                _ => cell *= 2.0,
+            let d = [extent.x, extent.y, extent.z].map(|e| (e / cell).floor() + 1.0);
+            if d[0] * d[1] * d[2] <= max_cells {
+                break d.map(|n| n as usize);
             }
+            cell *= 2.0;
         };
         let index = |p: DVec3| {
             let c = ((p - lo) / cell).to_array();
@@ -858,6 +863,13 @@ mod tests {
         }
         let near = NearPoints::new(vec![DVec3::new(f64::NAN, 0.0, 0.0)], 1.0);
         assert!(near.any_within(DVec3::splat(100.0), 1.0));
+        // An extent past the largest f64, and one of 1e300 reaches.
+        let far = vec![DVec3::splat(-1e308), DVec3::splat(1e308)];
+        assert!(NearPoints::new(far, 1.0).any_within(DVec3::ZERO, 1.0));
+        let wide = vec![DVec3::ZERO, DVec3::splat(1e300)];
+        let near = NearPoints::new(wide, 1e-300);
+        assert!(near.any_within(DVec3::ZERO, 1e-300));
+        assert!(!near.any_within(DVec3::splat(1e299), 1e-300));
         let near = NearPoints::new(points, 1.0);
         assert!(near.any_within(DVec3::new(f64::NAN, 0.0, 0.0), 1.0));
         assert!(!near.any_within(DVec3::new(1e300, -1e300, 0.0), 1.0));
