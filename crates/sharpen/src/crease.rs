@@ -823,7 +823,7 @@ fn project_creases_onto_local_quadrics_in(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     #[test]
@@ -876,7 +876,7 @@ mod tests {
     }
 
     /// The deterministic pseudo-random numbers of the tests, in [-0.5, 0.5).
-    fn noise_source(seed: u64) -> impl FnMut() -> f64 {
+    pub(crate) fn noise_source(seed: u64) -> impl FnMut() -> f64 {
         let mut state = seed;
         move || {
             state ^= state << 13;

@@ -499,13 +499,7 @@ mod tests {
         // upper triangle alone was.
         let mut full = [[0.0f64; 7]; 6];
         let mut samples = HeightSamples::default();
-        let mut state = 0x9E37_79B9_7F4A_7C15u64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut next = crate::crease::tests::noise_source(0x9E37_79B9_7F4A_7C15);
         for _ in 0..500 {
             let (u, v, h) = (next() * 3.0, next() * 1e-3, next());
             let b = [u * u, u * v, v * v, u, v, 1.0];
