@@ -327,8 +327,9 @@ mod tests {
             f64::MAX,
             f64::EPSILON,
             std::f64::consts::PI,
-            // Ties of two shortest strings: 1690060720831323.25 (spacing 0.25) prints as
-            // ...23.3 here and ...23.2 by zmij; 2^60 + 2^8 odd multiples likewise.
+            // A tie of two shortest strings: 1690060720831323.25 (spacing 0.25) prints as
+            // ...23.3 here and ...23.2 by zmij. Then a large integer (exponent layout), and
+            // values of few significant bits (may_tie's path).
             f64::from_bits(0x4318_0467_b3a7_ed6d),
             1152921504606847232.0,
             0.1234375,
