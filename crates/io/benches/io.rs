@@ -1,5 +1,6 @@
-//! Read speed of the two formats whet reads most: a ~1M-triangle grid mesh as binary
-//! little-endian PLY and as ascii OFF, both held in memory.
+//! Read and write speed of the two formats whet reads most: a ~1M-triangle grid mesh as
+//! binary little-endian PLY and as ascii OFF, both held in memory. Writing the text formats
+//! prints every coordinate in shortest round-trip form (`write_f64`: zmij's digits).
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
 use whet_io::{read, write, Format, PlyEncoding, WriteOptions};
@@ -55,5 +56,30 @@ fn bench_read(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench_read);
+fn bench_write(c: &mut Criterion) {
+    let mesh = grid(708);
+    let mut group = c.benchmark_group("write_1m_triangles");
+    group.sample_size(10);
+    for (name, format, opts) in [
+        (
+            "ply_binary_le",
+            Format::Ply,
+            WriteOptions::DEFAULT.with_ply(PlyEncoding::BinaryLittleEndian),
+        ),
+        ("off_ascii", Format::Off, WriteOptions::DEFAULT),
+    ] {
+        let mut out = Vec::new();
+        write(&mut out, &mesh, format, &opts).expect("writing to memory cannot fail");
+        group.throughput(Throughput::Bytes(out.len() as u64));
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                out.clear();
+                write(&mut out, &mesh, format, &opts).expect("writing to memory cannot fail");
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench_read, bench_write);
 criterion_main!(benches);
