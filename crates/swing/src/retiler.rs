@@ -1805,11 +1805,13 @@ impl Retiler<'_, '_> {
         let mut best: Option<(f64, f64, Option<u32>)> = None;
         for wn in nodes {
             if self.valid_existing(an, bn, wn, false) {
-                let base = self.existing_cost(an, bn, wn);
                 // The off-surface term only adds (it is at least 0), so a candidate whose
                 // cost without it already reaches the best cannot win: its three surface
                 // queries are skipped (half the run on small hostile meshes, where every
-                // front node is near the gate). The same choice as measuring every one.
+                // front node is near the gate), and so is the rest of its cost once a
+                // partial sum reaches the best (infinity then). The same choice as
+                // measuring every one.
+                let base = self.existing_cost_below(an, bn, wn, best.map(|(bc, ..)| bc));
                 if best.is_some_and(|(bc, ..)| base >= bc) {
                     continue;
                 }
@@ -1877,6 +1879,14 @@ impl Retiler<'_, '_> {
 
     /// Cost of closing gate `an -> bn` with existing node `wn` (0 when every check passes).
     fn existing_cost(&self, an: u32, bn: u32, wn: u32) -> f64 {
+        self.existing_cost_below(an, bn, wn, None)
+    }
+
+    /// [`Self::existing_cost`], or infinity as soon as a partial sum reaches `bound`: every
+    /// term is at least 0 and a sum of such terms never decreases, so the cost would reach
+    /// it too. The surface query of the facing test and the wedge checks are then skipped
+    /// (the fallback measures every front node near its gate). Without a bound, the cost.
+    fn existing_cost_below(&self, an: u32, bn: u32, wn: u32, bound: Option<f64>) -> f64 {
         let a = self.nodes[an as usize].v;
         let b = self.nodes[bn as usize].v;
         let w = self.nodes[wn as usize].v;
@@ -1885,13 +1895,17 @@ impl Retiler<'_, '_> {
             self.pos[b as usize],
             self.pos[w as usize],
         );
-        let mut c = self.shape_cost(a, b, pw, self.nrm[w as usize]);
+        let reached = |c: f64| bound.is_some_and(|bound| c >= bound);
+        let mut c = self.shape_cost_below(a, b, pw, self.nrm[w as usize], bound);
         let nt = (pa - pw).cross(pb - pw).normalize_or_zero();
         for (x, y) in [(w, b), (a, w)] {
             if let Some(&t) = self.edges.get(&ekey(x, y)) {
                 let fold = nt.dot(self.tri_normal[t as usize]).clamp(-1.0, 1.0).acos();
                 c += 2.0 * (fold - self.tune.max_fold).max(0.0);
             }
+        }
+        if reached(c) {
+            return f64::INFINITY;
         }
         c + 2.0 * self.existing_wedges(an, bn, wn)
     }
@@ -1908,12 +1922,21 @@ impl Retiler<'_, '_> {
     /// Penalties of triangle `(w, a, b)`: long edges, degeneracy, facing inwards, folding
     /// against the parent.
     fn shape_cost(&self, a: u32, b: u32, pw: DVec3, nw: DVec3) -> f64 {
+        self.shape_cost_below(a, b, pw, nw, None)
+    }
+
+    /// [`Self::shape_cost`], or infinity when its edge-length term alone reaches `bound`
+    /// (the other terms only add; see [`Self::existing_cost_below`]).
+    fn shape_cost_below(&self, a: u32, b: u32, pw: DVec3, nw: DVec3, bound: Option<f64>) -> f64 {
         let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
         let l = self.l;
         let longest = (pw - pa).length().max((pw - pb).length()) / l;
         // Edges of 2L or more leave gates without a swing circle: the front can then only
         // zip itself shut with ever longer edges. Avoid them at almost any price.
         let mut c = 3.0 * (longest - 1.2).max(0.0) + 20.0 * (longest - 1.9).max(0.0);
+        if bound.is_some_and(|bound| c >= bound) {
+            return f64::INFINITY;
+        }
         let n = (pa - pw).cross(pb - pw);
         let len = n.length();
         if len.is_nan() || len <= 1e-9 * l * l {
