@@ -18,9 +18,10 @@
 use glam::DVec3;
 use whet_mesh::{CornerId, CornerTable, Mesh, VertexId};
 
-use crate::planar::{pin_quadratic_terms, solve6, table_for, vertex_blocks, HeightSamples};
+use crate::planar::{
+    apply_moves, pin_quadratic_terms, run_vertex_blocks, solve6, table_for, HeightSamples,
+};
 use crate::Error;
-use rayon::prelude::*;
 
 /// Most triangles one side's gathering takes, per square of the ring count (144 for three
 /// rings, about three times what a regular mesh holds within that reach); a side that holds
@@ -802,11 +803,7 @@ fn project_creases_onto_local_quadrics_in(
         }
         (report, moves)
     };
-    let parts: Vec<_> = vertex_blocks(nv, 4 * (nt + nv))
-        .into_par_iter()
-        .map(block)
-        .collect();
-    for (part, moves) in parts {
+    for (part, moves) in run_vertex_blocks(nv, 4 * (nt + nv), block) {
         report.crease_vertices += part.crease_vertices;
         report.fitted_vertices += part.fitted_vertices;
         report.refused_moves += part.refused_moves;
@@ -814,10 +811,7 @@ fn project_creases_onto_local_quadrics_in(
         report.moved_corners += part.moved_corners;
         report.strips_left_out += part.strips_left_out;
         report.merged_sides += part.merged_sides;
-        report.moved_vertices += moves.len();
-        for (v, q) in moves {
-            mesh.positions[v] = q;
-        }
+        report.moved_vertices += apply_moves(&mut mesh.positions, moves);
     }
     Ok(report)
 }

@@ -9,6 +9,7 @@ use glam::DVec3;
 use whet_mesh::{CornerId, CornerTable, Mesh, VertexId};
 
 use crate::Error;
+use rayon::prelude::*;
 
 /// Options of [`flatten_planar_regions`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -285,7 +286,7 @@ pub(crate) fn table_for<'t>(
 /// bytes of scratch in all when each block holds `scratch_bytes` (its stamp arrays span
 /// the mesh). Every such pass reads the input positions only and moves after it, so
 /// splitting the range changes nothing in its result.
-pub(crate) fn vertex_blocks(nv: usize, scratch_bytes: usize) -> Vec<std::ops::Range<usize>> {
+fn vertex_blocks(nv: usize, scratch_bytes: usize) -> Vec<std::ops::Range<usize>> {
     let by_memory = (SCRATCH_BUDGET / scratch_bytes.max(1)).max(1);
     let blocks = (4 * rayon::current_num_threads())
         .min(by_memory)
@@ -295,6 +296,37 @@ pub(crate) fn vertex_blocks(nv: usize, scratch_bytes: usize) -> Vec<std::ops::Ra
         .step_by(size)
         .map(|a| a..(a + size).min(nv))
         .collect()
+}
+
+/// A projection's per-vertex pass over [`vertex_blocks`] side by side: each block's report
+/// and moves (vertex, new position), in block order. The caller applies the moves
+/// ([`apply_moves`]) once the pass, which reads the positions, is done.
+pub(crate) fn run_vertex_blocks<R: Send>(
+    nv: usize,
+    scratch_bytes: usize,
+    block: impl Fn(std::ops::Range<usize>) -> (R, Vec<(usize, DVec3)>) + Sync + Send,
+) -> Vec<(R, Vec<(usize, DVec3)>)> {
+    vertex_blocks(nv, scratch_bytes)
+        .into_par_iter()
+        .map(block)
+        .collect()
+}
+
+/// Moves the vertices of `moves` to their new positions; how many there were.
+pub(crate) fn apply_moves(positions: &mut [DVec3], moves: Vec<(usize, DVec3)>) -> usize {
+    let count = moves.len();
+    for (v, q) in moves {
+        positions[v] = q;
+    }
+    count
+}
+
+/// A fit's height `h` at its vertex as a step along the vertex's normal, clamped to
+/// `max_move`: the step (0 for none) and whether it was clamped. The local quadric and
+/// one-sided projections' move.
+pub(crate) fn clamped_step(h: f64, max_move: f64) -> (f64, bool) {
+    let step = h.clamp(-max_move, max_move);
+    (step, step != h)
 }
 
 /// Fewest vertices a block of [`vertex_blocks`] holds (the blocks' scratch arrays span the

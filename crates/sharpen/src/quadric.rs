@@ -10,9 +10,10 @@
 use glam::DVec3;
 use whet_mesh::{CornerTable, Mesh, VertexId};
 
-use crate::planar::{solve6, table_for, vertex_blocks, vertex_normals, HeightSamples};
+use crate::planar::{
+    apply_moves, clamped_step, run_vertex_blocks, solve6, table_for, vertex_normals, HeightSamples,
+};
 use crate::Error;
-use rayon::prelude::*;
 
 /// Most points a fit gathers, per square of its ring count: 144 for three rings, about four
 /// times what a regular mesh's three rings hold (37). A vertex whose rings hold more stays.
@@ -203,29 +204,19 @@ fn project_onto_local_quadrics_in(
             };
             report.fitted_vertices += 1;
             // The fitted height at the vertex itself (u = s = 0).
-            let h = coef[5] * scale;
-            let clamped = h.clamp(-max_move, max_move);
-            if clamped != h {
-                report.clamped_moves += 1;
-            }
-            if clamped != 0.0 {
-                moves.push((v, p[v] + n * clamped));
+            let (step, clamped) = clamped_step(coef[5] * scale, max_move);
+            report.clamped_moves += usize::from(clamped);
+            if step != 0.0 {
+                moves.push((v, p[v] + n * step));
             }
         }
         (report, moves)
     };
-    let parts: Vec<_> = vertex_blocks(nv, 4 * nv)
-        .into_par_iter()
-        .map(block)
-        .collect();
     let mut report = QuadricReport::default();
-    for (part, moves) in parts {
+    for (part, moves) in run_vertex_blocks(nv, 4 * nv, block) {
         report.fitted_vertices += part.fitted_vertices;
         report.clamped_moves += part.clamped_moves;
-        report.moved_vertices += moves.len();
-        for (v, q) in moves {
-            mesh.positions[v] = q;
-        }
+        report.moved_vertices += apply_moves(&mut mesh.positions, moves);
     }
     Ok(report)
 }
