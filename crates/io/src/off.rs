@@ -16,6 +16,9 @@
 //! with columns after `x y z` when the keyword has no prefix); face colours (the faces with
 //! values after their indices).
 //!
+//! The body is read in blocks of lines parsed in parallel ([`read`]), with the result and
+//! errors of a reading line by line.
+//!
 //! Writes plain `OFF` with coordinates in shortest round-trip form, so a written mesh reads
 //! back bit for bit.
 
@@ -23,9 +26,11 @@ use std::io::{BufRead, Write};
 
 use whet_mesh::{DVec3, Mesh};
 
+use rayon::prelude::*;
+
 use crate::text::{
-    parse_f64, parse_i64, show, strip_comment, tokens, write_face_line, write_point_line,
-    LineReader,
+    holds_data, line_spans, parse_f64, parse_i64, pieces, show, strip_comment, tokens,
+    write_face_line, write_point_line, Chunking, LineBlocks, LineReader,
 };
 use crate::{capacity, check_index, finite_point, Error, Fan, ReadReport, Skipped};
 
@@ -41,52 +46,260 @@ struct Prefixes {
 }
 
 /// Reads an OFF file and reports what it skipped.
+///
+/// The header is read line by line; the body in blocks of lines ([`LineBlocks`]) cut into
+/// pieces that are parsed in parallel ([`Chunking::DEFAULT`]): parsing (float and integer
+/// conversion) is most of the time of reading a large OFF file. The result, errors
+/// included, is the one a reading line by line gives: the first error in file order, and
+/// nothing read after the last face.
 pub(crate) fn read<R: BufRead>(reader: R) -> Result<(Mesh, ReadReport), Error> {
-    let mut lines = LineReader::new(reader);
+    read_chunked(reader, &Chunking::DEFAULT)
+}
+
+/// [`read`] with the blocks and pieces of `chunking` (the tests' small ones give the same
+/// result as the default).
+fn read_chunked<R: BufRead>(reader: R, chunking: &Chunking) -> Result<(Mesh, ReadReport), Error> {
+    let mut lines = LineReader::with_max_len(reader, chunking.max_line);
     let (vertex_count, face_count, prefixes) = read_header(&mut lines)?;
-    // Vertices with columns after `x y z`, and faces with values after their indices.
-    let mut extra_vertices: u64 = 0;
-    let mut extra_faces: u64 = 0;
+    let first_line = lines.line() + 1;
+    let mut blocks = LineBlocks::new(lines.into_inner(), first_line, chunking);
+    let mut body = Body {
+        vertex_count,
+        face_count,
+        positions: Vec::with_capacity(capacity(vertex_count)),
+        triangles: Vec::with_capacity(capacity(face_count)),
+        faces: 0,
+        extra_vertices: 0,
+        extra_faces: 0,
+        piece_triangles: Vec::new(),
+    };
+    while body.lines_wanted() > 0 {
+        let Some((block, first_line)) = blocks.next_block()? else {
+            return Err(body.truncated());
+        };
+        body.parse_block(block, first_line, chunking)?;
+    }
+    let report = report(prefixes, body.extra_vertices, body.extra_faces);
+    Ok((Mesh::new(body.positions, body.triangles), report))
+}
 
-    let mut positions = Vec::with_capacity(capacity(vertex_count));
-    while (positions.len() as u64) < vertex_count {
-        if !lines.advance()? {
-            return Err(Error::truncated(format!(
-                "expected {vertex_count} vertices, file ended after {}",
-                positions.len()
-            )));
-        }
-        let index = positions.len();
-        if let Some((p, extra)) = parse_vertex(lines.current(), lines.line(), index)? {
-            positions.push(p);
-            extra_vertices += u64::from(extra);
+/// The body of an OFF file as its blocks are parsed.
+struct Body {
+    vertex_count: u64,
+    face_count: u64,
+    positions: Vec<DVec3>,
+    triangles: Vec<[u32; 3]>,
+    /// Face lines read.
+    faces: u64,
+    /// Vertices with columns after `x y z`, and faces with values after their indices.
+    extra_vertices: u64,
+    extra_faces: u64,
+    /// Each piece's triangles, kept from block to block.
+    piece_triangles: Vec<Vec<[u32; 3]>>,
+}
+
+/// What a first pass over a piece of a block found: its lines and data lines, up to the
+/// first line longer than the limit if there is one (its index in the piece).
+struct PieceCount {
+    lines: usize,
+    data: u64,
+    too_long: Option<usize>,
+}
+
+/// A piece of a block to parse: its byte range, the number of its first line, and the
+/// index among the data lines the block's reading still wants of its first data line.
+struct PiecePlan {
+    range: std::ops::Range<usize>,
+    first_line: usize,
+    first_data: u64,
+}
+
+impl Body {
+    /// Data lines still to read: vertices, then faces.
+    fn lines_wanted(&self) -> u64 {
+        (self.vertex_count - self.positions.len() as u64) + (self.face_count - self.faces)
+    }
+
+    /// The error of an input that ends before its vertices and faces.
+    fn truncated(&self) -> Error {
+        if (self.positions.len() as u64) < self.vertex_count {
+            Error::truncated(format!(
+                "expected {} vertices, file ended after {}",
+                self.vertex_count,
+                self.positions.len()
+            ))
+        } else {
+            Error::truncated(format!(
+                "expected {} faces, file ended after {}",
+                self.face_count, self.faces
+            ))
         }
     }
 
-    let vertex_total = positions.len();
-    let mut triangles = Vec::with_capacity(capacity(face_count));
-    let mut face: u64 = 0;
-    while face < face_count {
-        if !lines.advance()? {
-            return Err(Error::truncated(format!(
-                "expected {face_count} faces, file ended after {face}"
-            )));
+    /// Parses the lines of `block` (whole lines, the first numbered `first_line`) that the
+    /// body still wants: its pieces are counted in parallel, placed in order, then parsed
+    /// in parallel.
+    fn parse_block(
+        &mut self,
+        block: &[u8],
+        first_line: usize,
+        chunking: &Chunking,
+    ) -> Result<(), Error> {
+        let max_line = chunking.max_line;
+        let pieces = pieces(block, chunking.piece);
+        let counts: Vec<PieceCount> = pieces
+            .par_iter()
+            .map(|range| count_piece(&block[range.clone()], max_line))
+            .collect();
+        // Place the pieces: the lines of those past the last wanted data line are not
+        // read, nor those past a line too long that a reading line by line would reach.
+        let wanted = self.lines_wanted();
+        let vertices_wanted = self.vertex_count - self.positions.len() as u64;
+        let mut plans = Vec::new();
+        let (mut line, mut data) = (first_line, 0);
+        let mut too_long = None;
+        for (range, count) in pieces.into_iter().zip(&counts) {
+            if data >= wanted {
+                break;
+            }
+            plans.push(PiecePlan {
+                range,
+                first_line: line,
+                first_data: data,
+            });
+            data += count.data;
+            if let (Some(k), true) = (count.too_long, data < wanted) {
+                too_long = Some(line + k);
+                break;
+            }
+            line += count.lines;
         }
-        // face < face_count <= u32::MAX, so it fits usize.
-        let face_index = face as usize;
-        if let Some(extra) = parse_face(
-            lines.current(),
-            lines.line(),
-            face_index,
-            vertex_total,
-            &mut triangles,
-        )? {
-            face += 1;
-            extra_faces += u64::from(extra);
+        let read = data.min(wanted);
+        // Both below a block's line count, so they fit usize.
+        let vertices = read.min(vertices_wanted);
+        let base = self.positions.len();
+        self.positions.resize(base + vertices as usize, DVec3::ZERO);
+        let mut slots = Vec::with_capacity(plans.len());
+        let mut rest = &mut self.positions[base..];
+        for (plan, count) in plans.iter().zip(&counts) {
+            let end = (plan.first_data + count.data).min(vertices_wanted);
+            let n = end.saturating_sub(plan.first_data.min(vertices_wanted)) as usize;
+            let whole = std::mem::take(&mut rest);
+            let (slot, tail) = whole.split_at_mut(n.min(whole.len()));
+            slots.push(slot);
+            rest = tail;
+        }
+        if self.piece_triangles.len() < plans.len() {
+            self.piece_triangles.resize_with(plans.len(), Vec::new);
+        }
+        let piece = PieceParse {
+            block,
+            wanted,
+            vertices_wanted,
+            first_vertex: base,
+            first_face: self.faces,
+            vertex_count: self.vertex_count,
+            max_line,
+        };
+        let results: Vec<Result<(u64, u64), Error>> = plans
+            .par_iter()
+            .zip(slots)
+            .zip(&mut self.piece_triangles)
+            .map(|((plan, slot), triangles)| piece.parse(plan, slot, triangles))
+            .collect();
+        for (result, triangles) in results.into_iter().zip(&self.piece_triangles) {
+            let (extra_vertices, extra_faces) = result?;
+            self.extra_vertices += extra_vertices;
+            self.extra_faces += extra_faces;
+            self.triangles.extend_from_slice(triangles);
+        }
+        self.faces += read - vertices;
+        match too_long {
+            Some(line) => Err(Error::parse(
+                line,
+                format!("line is longer than {max_line} bytes"),
+            )),
+            None => Ok(()),
         }
     }
-    let report = report(prefixes, extra_vertices, extra_faces);
-    Ok((Mesh::new(positions, triangles), report))
+}
+
+/// A first pass over a piece: its lines and data lines, stopping at a line longer than
+/// `max_line` bytes.
+fn count_piece(text: &[u8], max_line: usize) -> PieceCount {
+    let mut count = PieceCount {
+        lines: 0,
+        data: 0,
+        too_long: None,
+    };
+    for span in line_spans(text) {
+        if span.len() > max_line {
+            count.too_long = Some(count.lines);
+            break;
+        }
+        count.data += u64::from(holds_data(&text[span]));
+        count.lines += 1;
+    }
+    count
+}
+
+/// What the pieces of one block share: the block, and where its data lines go.
+struct PieceParse<'a> {
+    block: &'a [u8],
+    /// Data lines the body wanted before the block, of which the first `vertices_wanted`
+    /// are vertices.
+    wanted: u64,
+    vertices_wanted: u64,
+    /// The indices of the block's first vertex and first face.
+    first_vertex: usize,
+    first_face: u64,
+    /// The file's vertex count, which bounds face indices.
+    vertex_count: u64,
+    max_line: usize,
+}
+
+impl PieceParse<'_> {
+    /// Parses the wanted data lines of `plan`'s piece: vertices into `slot` (the piece's
+    /// share of the block's new positions), faces onto `triangles` (cleared first); the
+    /// count of vertices and faces with extra values.
+    fn parse(
+        &self,
+        plan: &PiecePlan,
+        slot: &mut [DVec3],
+        triangles: &mut Vec<[u32; 3]>,
+    ) -> Result<(u64, u64), Error> {
+        triangles.clear();
+        let text = &self.block[plan.range.clone()];
+        let (mut extra_vertices, mut extra_faces) = (0, 0);
+        let mut data = plan.first_data;
+        for (k, span) in line_spans(text).enumerate() {
+            if data >= self.wanted || span.len() > self.max_line {
+                // The end of what is wanted, or a line too long, which the caller reports.
+                break;
+            }
+            let line = &text[span];
+            if !holds_data(line) {
+                continue;
+            }
+            let line_no = plan.first_line + k;
+            // Indices below the counts of the header, which fit u32 and so usize.
+            if data < self.vertices_wanted {
+                let index = self.first_vertex + data as usize;
+                let (p, extra) = parse_vertex(line, line_no, index)?
+                    .ok_or_else(|| Error::parse(line_no, "expected a vertex"))?;
+                slot[(data - plan.first_data) as usize] = p;
+                extra_vertices += u64::from(extra);
+            } else {
+                let face = (self.first_face + data - self.vertices_wanted) as usize;
+                let vertex_count = self.vertex_count as usize;
+                let extra = parse_face(line, line_no, face, vertex_count, triangles)?
+                    .ok_or_else(|| Error::parse(line_no, "expected a face"))?;
+                extra_faces += u64::from(extra);
+            }
+            data += 1;
+        }
+        Ok((extra_vertices, extra_faces))
+    }
 }
 
 /// What the reader skipped: `extra_vertices` vertices with columns after `x y z`, whose
@@ -128,7 +341,20 @@ fn report(prefixes: Prefixes, extra_vertices: u64, extra_faces: u64) -> ReadRepo
 /// Parses the vertex line `line` into the position and whether columns follow `x y z`; `None`
 /// for a blank or comment line.
 fn parse_vertex(line: &[u8], line_no: usize, index: usize) -> Result<Option<(DVec3, bool)>, Error> {
-    let mut toks = tokens(strip_comment(line));
+    let line = strip_comment(line);
+    // The common line: UTF-8 checked once for the line instead of once per coordinate (a
+    // tenth of the time of reading), three coordinates that parse. Anything else takes the
+    // path below, which names the problem.
+    if let Ok(text) = std::str::from_utf8(line) {
+        let mut toks = text.split_ascii_whitespace();
+        if let (Some(x), Some(y), Some(z)) = (toks.next(), toks.next(), toks.next()) {
+            if let (Ok(x), Ok(y), Ok(z)) = (x.parse(), y.parse(), z.parse()) {
+                let extra = toks.next().is_some();
+                return finite_point(x, y, z, index).map(|p| Some((p, extra)));
+            }
+        }
+    }
+    let mut toks = tokens(line);
     let Some(first) = toks.next() else {
         return Ok(None);
     };
@@ -163,7 +389,11 @@ fn parse_face(
     vertex_count: usize,
     triangles: &mut Vec<[u32; 3]>,
 ) -> Result<Option<bool>, Error> {
-    let mut toks = tokens(strip_comment(line));
+    let line = strip_comment(line);
+    if let Some(extra) = parse_triangle(line, vertex_count, triangles) {
+        return Ok(Some(extra));
+    }
+    let mut toks = tokens(line);
     let Some(count_tok) = toks.next() else {
         return Ok(None);
     };
@@ -199,6 +429,44 @@ fn parse_face(
         fan.push(check_index(index, face, vertex_count)?, triangles);
     }
     Ok(Some(toks.next().is_some()))
+}
+
+/// The common face line, a triangle of plain indices (`3 i j k`, digits only, each index
+/// under `vertex_count`), onto `triangles`, and whether values follow; `None`, with nothing
+/// pushed, for any other line, which [`parse_face`] then reads token by token (naming the
+/// problem if there is one). A third of the time of reading went to tokenizing and checking
+/// face lines the general way.
+fn parse_triangle(line: &[u8], vertex_count: usize, triangles: &mut Vec<[u32; 3]>) -> Option<bool> {
+    let mut pos = 0;
+    // The next whitespace-separated token as a plain decimal under `limit`.
+    let mut number = |limit: usize| -> Option<usize> {
+        while pos < line.len() && line[pos].is_ascii_whitespace() {
+            pos += 1;
+        }
+        let start = pos;
+        let mut value: usize = 0;
+        while pos < line.len() && line[pos].is_ascii_digit() && pos - start < 10 {
+            value = 10 * value + usize::from(line[pos] - b'0');
+            pos += 1;
+        }
+        let ends = pos == line.len() || line[pos].is_ascii_whitespace();
+        (pos > start && ends && value < limit).then_some(value)
+    };
+    if number(4)? != 3 {
+        return None;
+    }
+    let tri = [
+        number(vertex_count)?,
+        number(vertex_count)?,
+        number(vertex_count)?,
+    ];
+    // Indices under vertex_count <= u32::MAX + 1 fit u32.
+    let tri = tri.map(|i| u32::try_from(i).ok());
+    let [Some(a), Some(b), Some(c)] = tri else {
+        return None;
+    };
+    triangles.push([a, b, c]);
+    Some(line[pos..].iter().any(|b| !b.is_ascii_whitespace()))
 }
 
 /// Reads the keyword and the vertex and face counts.
@@ -309,6 +577,7 @@ pub(crate) fn write<W: Write>(w: &mut W, mesh: &Mesh) -> std::io::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::text::MAX_LINE;
 
     fn read<R: BufRead>(reader: R) -> Result<Mesh, Error> {
         super::read(reader).map(|(mesh, _)| mesh)
@@ -412,6 +681,197 @@ mod tests {
             read_str("OFF BINARY\n"),
             Err(Error::Unsupported { .. })
         ));
+    }
+
+    /// The body read line by line, as the reader did before it read blocks: the oracle of
+    /// the block reader.
+    fn read_by_lines(text: &[u8], max_line: usize) -> Result<(Mesh, ReadReport), Error> {
+        let mut lines = LineReader::with_max_len(text, max_line);
+        let (vertex_count, face_count, prefixes) = read_header(&mut lines)?;
+        let (mut extra_vertices, mut extra_faces) = (0, 0);
+        let mut positions = Vec::new();
+        while (positions.len() as u64) < vertex_count {
+            if !lines.advance()? {
+                return Err(Error::truncated(format!(
+                    "expected {vertex_count} vertices, file ended after {}",
+                    positions.len()
+                )));
+            }
+            let index = positions.len();
+            if let Some((p, extra)) = parse_vertex(lines.current(), lines.line(), index)? {
+                positions.push(p);
+                extra_vertices += u64::from(extra);
+            }
+        }
+        let mut triangles = Vec::new();
+        let mut face: u64 = 0;
+        while face < face_count {
+            if !lines.advance()? {
+                return Err(Error::truncated(format!(
+                    "expected {face_count} faces, file ended after {face}"
+                )));
+            }
+            let (line, line_no) = (lines.current(), lines.line());
+            let vertex_total = positions.len();
+            if let Some(extra) =
+                parse_face(line, line_no, face as usize, vertex_total, &mut triangles)?
+            {
+                face += 1;
+                extra_faces += u64::from(extra);
+            }
+        }
+        let report = report(prefixes, extra_vertices, extra_faces);
+        Ok((Mesh::new(positions, triangles), report))
+    }
+
+    /// Small blocks and tasks: block boundaries inside lines, at line breaks, between the
+    /// vertices and the faces, and every block split among tasks.
+    const SMALL: [Chunking; 5] = [
+        Chunking {
+            block: 1,
+            max_line: MAX_LINE,
+            piece: 1,
+        },
+        Chunking {
+            block: 2,
+            max_line: MAX_LINE,
+            piece: 5,
+        },
+        Chunking {
+            block: 7,
+            max_line: MAX_LINE,
+            piece: 3,
+        },
+        Chunking {
+            block: 31,
+            max_line: MAX_LINE,
+            piece: 40,
+        },
+        Chunking {
+            block: 200,
+            max_line: MAX_LINE,
+            piece: 8,
+        },
+    ];
+
+    /// The block reader's result, with every chunking of `SMALL` and the default, against the
+    /// line-by-line oracle (errors compared by their Debug form).
+    fn assert_reads_as_by_lines(text: &[u8], max_line: usize) {
+        let expect = format!("{:?}", read_by_lines(text, max_line));
+        let default = Chunking {
+            max_line,
+            ..Chunking::DEFAULT
+        };
+        for chunking in SMALL
+            .iter()
+            .map(|c| Chunking { max_line, ..*c })
+            .chain([default])
+        {
+            let got = format!("{:?}", read_chunked(text, &chunking));
+            assert_eq!(
+                got,
+                expect,
+                "{chunking:?} on {:?}",
+                String::from_utf8_lossy(text)
+            );
+        }
+    }
+
+    #[test]
+    fn blocks_read_as_lines_do() {
+        let cases: &[&str] = &[
+            "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+            "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2",
+            "\u{feff}OFF 4 2 0\r\n# c\r\n0 0 0\r\n\r\n1 0 0 9\r\n  # x\r\n0 1 0\r\n1 1 0\r\n3 0 1 2 255 0 0\r\n4\t0 1\t3 2\r\ntrailing junk\r\n",
+            "COFF\n3 1\n0 0 0 1 1 1 1\n1 0 0 1 1 1 1 # c\n0 1 0\n3 0 1 2\n",
+            "OFF\n3 1 0\n0 0 0\n1 0\n0 1 0\n3 0 1 2\n",
+            "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n",
+            "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n+3 00 01 2 # c\n",
+            "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 00000000000000000002\n",
+            "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1\n",
+            "OFF\n3 1 0\n0 0 0\nnan 0 0\n0 1 0\n",
+            "OFF\n3 1 0\n0 0 0\n1 0 0\n",
+            "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+            "OFF\n0 0 0\n",
+        ];
+        for text in cases {
+            assert_reads_as_by_lines(text.as_bytes(), MAX_LINE);
+        }
+        // Non-UTF-8 bytes in a comment and in a coordinate.
+        assert_reads_as_by_lines(
+            b"OFF\n3 1 0\n0 0 0 # \xff\n1 0 0\n0 1 0\n3 0 1 2\n",
+            MAX_LINE,
+        );
+        assert_reads_as_by_lines(b"OFF\n3 1 0\n0 0 0\n1 \xff 0\n0 1 0\n3 0 1 2\n", MAX_LINE);
+    }
+
+    #[test]
+    fn blocks_refuse_long_lines_as_lines_do() {
+        let text = b"OFF\n3 1 0\n0 0 0\n1.000000000000000 0 0\n0 1 0\n3 0 1 2";
+        for max_line in [5, 11, 19, 20, 21, 22, 40] {
+            assert_reads_as_by_lines(text, max_line);
+        }
+        // A line too long after the last face is never read, in the last face's piece or
+        // after it.
+        let junk = b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n# a comment far too long\nxx";
+        for max_line in [5, 8, 12, 40] {
+            assert_reads_as_by_lines(junk, max_line);
+        }
+        assert!(read_chunked(
+            &junk[..],
+            &Chunking {
+                max_line: 8,
+                ..Chunking::DEFAULT
+            }
+        )
+        .is_ok());
+        let e = read_chunked(
+            &text[..],
+            &Chunking {
+                max_line: 19,
+                ..SMALL[2]
+            },
+        )
+        .unwrap_err();
+        assert!(
+            matches!(&e, Error::Parse { line: 4, message } if message.contains("19 bytes")),
+            "{e}"
+        );
+    }
+
+    proptest::proptest! {
+        /// Random OFF texts made of well-formed and broken lines (comments, blank lines, CRLF,
+        /// tabs, extra values, polygons, bad tokens, indices out of range, truncation, junk
+        /// after the faces) read the same by blocks as line by line.
+        #[test]
+        fn blocks_read_random_texts_as_lines_do(
+            vertices in 0usize..7,
+            faces in 0usize..7,
+            picks in proptest::collection::vec((0usize..12, 0usize..12), 0..24),
+        ) {
+            const VERTEX: [&str; 12] = [
+                "0 0 0", "1.5 -2 3e-3", "1\t2  3", " 4 5 6 7 8", "0 1 0\r", "# only a comment",
+                "", "   ", "1 2", "1 x 3", "nan 0 0", "2 2 2 # tail",
+            ];
+            const FACE: [&str; 12] = [
+                "3 0 1 2", "4 0 1 2 3", "3 0 1 2 255 0 0", "3\t2 1 0\r", "# c", "",
+                "3 0 1", "2 0 1", "3 0 1 9", "3 -1 0 1", "+3 01 0 2", "5 0 1 2 3 4",
+            ];
+            let mut text = format!("OFF\n{vertices} {faces} 0\n");
+            for &(v, f) in &picks {
+                text.push_str(VERTEX[v]);
+                text.push('\n');
+                if f % 3 == 0 {
+                    text.push_str(FACE[f]);
+                    text.push('\n');
+                }
+            }
+            for &(_, f) in &picks {
+                text.push_str(FACE[f]);
+                text.push('\n');
+            }
+            assert_reads_as_by_lines(text.as_bytes(), MAX_LINE);
+        }
     }
 
     #[test]

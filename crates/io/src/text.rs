@@ -112,6 +112,161 @@ impl<R: BufRead> LineReader<R> {
     }
 }
 
+/// How [`LineBlocks`] cuts its input into blocks and its readers cut a block into pieces.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Chunking {
+    /// Bytes a block holds before it ends at a line break.
+    pub block: usize,
+    /// Longest line accepted, in bytes.
+    pub max_line: usize,
+    /// Bytes of a block one task takes (more, to end at a line break).
+    pub piece: usize,
+}
+
+impl Chunking {
+    /// Blocks of 4 MiB (large enough to split among threads, small enough that reading
+    /// stays streaming), lines up to [`MAX_LINE`], pieces of 256 KiB.
+    pub const DEFAULT: Chunking = Chunking {
+        block: 1 << 22,
+        max_line: MAX_LINE,
+        piece: 1 << 18,
+    };
+}
+
+/// Reads a `BufRead` in blocks of whole lines (about [`Chunking::block`] bytes; more when
+/// one line is longer), so that the pieces of a block can be parsed in parallel, each line
+/// where it lies in the block, without the copy per line [`LineReader`] makes.
+///
+/// A line longer than [`Chunking::max_line`] that a block would have to hold whole is refused
+/// with the error [`LineReader`] gives it; one that a block holds (when blocks are larger than
+/// that) is for the caller to refuse if it reads so far ([`line_spans`]).
+pub(crate) struct LineBlocks<R> {
+    reader: R,
+    buf: Vec<u8>,
+    /// `buf[..filled]` is read; `buf[consumed..filled]` is not yet handed out.
+    filled: usize,
+    consumed: usize,
+    /// Number of the first line not yet handed out.
+    next_line: usize,
+    eof: bool,
+    block: usize,
+    max_line: usize,
+}
+
+impl<R: BufRead> LineBlocks<R> {
+    /// Blocks of `reader`'s lines, the first of them numbered `first_line`.
+    pub(crate) fn new(reader: R, first_line: usize, chunking: &Chunking) -> Self {
+        LineBlocks {
+            reader,
+            buf: Vec::new(),
+            filled: 0,
+            consumed: 0,
+            next_line: first_line,
+            eof: false,
+            // At least one byte, so that every read makes progress.
+            block: chunking.block.max(1),
+            max_line: chunking.max_line,
+        }
+    }
+
+    /// The next block of whole lines (the last may lack its line break at the end of the
+    /// input) and the number of its first line, or `None` at the end of the input.
+    pub(crate) fn next_block(&mut self) -> Result<Option<(&[u8], usize)>, Error> {
+        // Keep what follows the last line handed out.
+        self.buf.copy_within(self.consumed..self.filled, 0);
+        self.filled -= self.consumed;
+        self.consumed = 0;
+        let first_line = self.next_line;
+        // Read until the block holds `block` bytes and a line break, or the input ends.
+        let mut last_break: Option<usize> = None;
+        let mut searched = 0;
+        let end = loop {
+            // Only the bytes read since the last search can hold a later line break.
+            if let Some(i) = memchr::memrchr(b'\n', &self.buf[searched..self.filled]) {
+                last_break = Some(searched + i);
+            }
+            searched = self.filled;
+            if self.eof {
+                break self.filled;
+            }
+            match last_break {
+                Some(i) if self.filled >= self.block => break i + 1,
+                None if self.filled > self.max_line => {
+                    return Err(Error::parse(
+                        first_line,
+                        format!("line is longer than {} bytes", self.max_line),
+                    ));
+                }
+                _ => {}
+            }
+            let want = self.block.max(self.filled + self.block / 4 + 1);
+            if self.buf.len() < want {
+                self.buf.resize(want, 0);
+            }
+            let n = read_some(&mut self.reader, &mut self.buf[self.filled..])?;
+            self.eof = n == 0;
+            self.filled += n;
+        };
+        if end == 0 {
+            return Ok(None);
+        }
+        self.consumed = end;
+        let block = &self.buf[..end];
+        self.next_line += memchr::memchr_iter(b'\n', block).count();
+        if block.last() != Some(&b'\n') {
+            self.next_line += 1;
+        }
+        Ok(Some((block, first_line)))
+    }
+}
+
+/// The pieces of `block` (whole lines, as [`LineBlocks`] gives them): ranges of about
+/// `piece` bytes, each ending after a line break or at the block's end.
+pub(crate) fn pieces(block: &[u8], piece: usize) -> Vec<std::ops::Range<usize>> {
+    let mut out = Vec::new();
+    let mut start = 0;
+    while start < block.len() {
+        let cut = (start + piece.max(1)).min(block.len());
+        let stop = memchr::memchr(b'\n', &block[cut..]).map_or(block.len(), |i| cut + i + 1);
+        out.push(start..stop);
+        start = stop;
+    }
+    out
+}
+
+/// The lines of `text` (whole lines: it ends after a line break or at the end of the
+/// input) as byte ranges without their line break, in one search for the breaks (a search
+/// per line costs a call and a set-up each, and most lines are some 30 bytes).
+pub(crate) fn line_spans(text: &[u8]) -> impl Iterator<Item = std::ops::Range<usize>> + '_ {
+    let last = (text.last().is_some_and(|&b| b != b'\n')).then_some(text.len());
+    let mut start = 0;
+    memchr::memchr_iter(b'\n', text)
+        .chain(last)
+        .map(move |stop| {
+            let line = start..stop;
+            start = stop + 1;
+            line
+        })
+}
+
+/// Whether `line` holds data: something before any `#` comment.
+pub(crate) fn holds_data(line: &[u8]) -> bool {
+    line.iter()
+        .find(|b| !b.is_ascii_whitespace())
+        .is_some_and(|&b| b != b'#')
+}
+
+/// One `read` of `reader` into `buf`, retried when interrupted.
+fn read_some<R: Read>(reader: &mut R, buf: &mut [u8]) -> Result<usize, Error> {
+    loop {
+        match reader.read(buf) {
+            Ok(n) => return Ok(n),
+            Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(e.into()),
+        }
+    }
+}
+
 /// A stream of whitespace-separated tokens that may span lines (the PLY ascii body).
 pub(crate) struct TokenReader<R> {
     lines: LineReader<R>,
