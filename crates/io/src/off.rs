@@ -62,22 +62,23 @@ fn read_chunked<R: BufRead>(reader: R, chunking: &Chunking) -> Result<(Mesh, Rea
     let mut lines = LineReader::with_max_len(reader, chunking.max_line);
     let (vertex_count, face_count, prefixes) = read_header(&mut lines)?;
     let first_line = lines.line() + 1;
-    let mut blocks = LineBlocks::new(lines.into_inner(), first_line, chunking);
+    let mut blocks = LineBlocks::new(lines.into_inner(), chunking);
     let mut body = Body {
         vertex_count,
         face_count,
         positions: Vec::with_capacity(capacity(vertex_count)),
         triangles: Vec::with_capacity(capacity(face_count)),
         faces: 0,
+        next_line: first_line,
         extra_vertices: 0,
         extra_faces: 0,
         piece_triangles: Vec::new(),
     };
     while body.lines_wanted() > 0 {
-        let Some((block, first_line)) = blocks.next_block()? else {
+        let Some(block) = blocks.next_block(body.next_line)? else {
             return Err(body.truncated());
         };
-        body.parse_block(block, first_line, chunking)?;
+        body.parse_block(block, chunking)?;
     }
     let report = report(prefixes, body.extra_vertices, body.extra_faces);
     Ok((Mesh::new(body.positions, body.triangles), report))
@@ -91,6 +92,8 @@ struct Body {
     triangles: Vec<[u32; 3]>,
     /// Face lines read.
     faces: u64,
+    /// Number of the next block's first line.
+    next_line: usize,
     /// Vertices with columns after `x y z`, and faces with values after their indices.
     extra_vertices: u64,
     extra_faces: u64,
@@ -136,15 +139,10 @@ impl Body {
         }
     }
 
-    /// Parses the lines of `block` (whole lines, the first numbered `first_line`) that the
+    /// Parses the lines of `block` (whole lines, the first numbered `next_line`) that the
     /// body still wants: its pieces are counted in parallel, placed in order, then parsed
     /// in parallel.
-    fn parse_block(
-        &mut self,
-        block: &[u8],
-        first_line: usize,
-        chunking: &Chunking,
-    ) -> Result<(), Error> {
+    fn parse_block(&mut self, block: &[u8], chunking: &Chunking) -> Result<(), Error> {
         let max_line = chunking.max_line;
         let pieces = pieces(block, chunking.piece);
         let counts: Vec<PieceCount> = pieces
@@ -156,7 +154,7 @@ impl Body {
         let wanted = self.lines_wanted();
         let vertices_wanted = self.vertex_count - self.positions.len() as u64;
         let mut plans = Vec::new();
-        let (mut line, mut data) = (first_line, 0);
+        let (mut line, mut data) = (self.next_line, 0);
         let mut too_long = None;
         for (range, count) in pieces.into_iter().zip(&counts) {
             if data >= wanted {
@@ -174,6 +172,8 @@ impl Body {
             }
             line += count.lines;
         }
+        // Past the block's lines, unless the reading ends in it.
+        self.next_line = line;
         let read = data.min(wanted);
         // Both below a block's line count, so they fit usize.
         let vertices = read.min(vertices_wanted);

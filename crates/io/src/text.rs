@@ -135,7 +135,8 @@ impl Chunking {
 
 /// Reads a `BufRead` in blocks of whole lines (about [`Chunking::block`] bytes; more when
 /// one line is longer), so that the pieces of a block can be parsed in parallel, each line
-/// where it lies in the block, without the copy per line [`LineReader`] makes.
+/// where it lies in the block, without the copy per line [`LineReader`] makes. The caller
+/// numbers the lines: it counts them as it parses.
 ///
 /// A line longer than [`Chunking::max_line`] that a block would have to hold whole is refused
 /// with the error [`LineReader`] gives it; one that a block holds (when blocks are larger than
@@ -146,22 +147,19 @@ pub(crate) struct LineBlocks<R> {
     /// `buf[..filled]` is read; `buf[consumed..filled]` is not yet handed out.
     filled: usize,
     consumed: usize,
-    /// Number of the first line not yet handed out.
-    next_line: usize,
     eof: bool,
     block: usize,
     max_line: usize,
 }
 
 impl<R: BufRead> LineBlocks<R> {
-    /// Blocks of `reader`'s lines, the first of them numbered `first_line`.
-    pub(crate) fn new(reader: R, first_line: usize, chunking: &Chunking) -> Self {
+    /// Blocks of `reader`'s lines.
+    pub(crate) fn new(reader: R, chunking: &Chunking) -> Self {
         LineBlocks {
             reader,
             buf: Vec::new(),
             filled: 0,
             consumed: 0,
-            next_line: first_line,
             eof: false,
             // At least one byte, so that every read makes progress.
             block: chunking.block.max(1),
@@ -170,13 +168,13 @@ impl<R: BufRead> LineBlocks<R> {
     }
 
     /// The next block of whole lines (the last may lack its line break at the end of the
-    /// input) and the number of its first line, or `None` at the end of the input.
-    pub(crate) fn next_block(&mut self) -> Result<Option<(&[u8], usize)>, Error> {
+    /// input), or `None` at the end of the input; `first_line`, the number of its first
+    /// line, names a line too long to hold.
+    pub(crate) fn next_block(&mut self, first_line: usize) -> Result<Option<&[u8]>, Error> {
         // Keep what follows the last line handed out.
         self.buf.copy_within(self.consumed..self.filled, 0);
         self.filled -= self.consumed;
         self.consumed = 0;
-        let first_line = self.next_line;
         // Read until the block holds `block` bytes and a line break, or the input ends.
         let mut last_break: Option<usize> = None;
         let mut searched = 0;
@@ -211,12 +209,7 @@ impl<R: BufRead> LineBlocks<R> {
             return Ok(None);
         }
         self.consumed = end;
-        let block = &self.buf[..end];
-        self.next_line += memchr::memchr_iter(b'\n', block).count();
-        if block.last() != Some(&b'\n') {
-            self.next_line += 1;
-        }
-        Ok(Some((block, first_line)))
+        Ok(Some(&self.buf[..end]))
     }
 }
 
