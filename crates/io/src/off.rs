@@ -62,7 +62,7 @@ fn read_chunked<R: BufRead>(reader: R, chunking: &Chunking) -> Result<(Mesh, Rea
     let mut lines = LineReader::with_max_len(reader, chunking.max_line);
     let (vertex_count, face_count, prefixes) = read_header(&mut lines)?;
     let first_line = lines.line() + 1;
-    let mut blocks = LineBlocks::new(lines.into_inner(), chunking);
+    let mut blocks = LineBlocks::new(lines.into_inner(), chunking, false);
     let mut body = Body {
         vertex_count,
         face_count,
@@ -144,7 +144,7 @@ impl Body {
     /// in parallel.
     fn parse_block(&mut self, block: &[u8], chunking: &Chunking) -> Result<(), Error> {
         let max_line = chunking.max_line;
-        let pieces = pieces(block, chunking.piece);
+        let pieces = pieces(block, chunking.piece, false);
         let counts: Vec<PieceCount> = pieces
             .par_iter()
             .map(|range| count_piece(&block[range.clone()], max_line))

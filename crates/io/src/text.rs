@@ -12,7 +12,7 @@ use crate::Error;
 pub(crate) const MAX_LINE: usize = 1 << 26;
 
 /// The UTF-8 byte order mark some Windows tools put at the start of text files.
-const BOM: &[u8] = b"\xEF\xBB\xBF";
+pub(crate) const BOM: &[u8] = b"\xEF\xBB\xBF";
 
 /// Reads a `BufRead` line by line into one reused buffer, counting 1-based line numbers.
 ///
@@ -150,11 +150,15 @@ pub(crate) struct LineBlocks<R> {
     eof: bool,
     block: usize,
     max_line: usize,
+    /// Whether a line ending in `\\` continues on the next ([`ends_statement`]): blocks then
+    /// end only where a statement does.
+    continued: bool,
 }
 
 impl<R: BufRead> LineBlocks<R> {
-    /// Blocks of `reader`'s lines.
-    pub(crate) fn new(reader: R, chunking: &Chunking) -> Self {
+    /// Blocks of `reader`'s lines; with `continued`, blocks end only at the end of a
+    /// statement (OBJ's lines ending in `\\` continue on the next).
+    pub(crate) fn new(reader: R, chunking: &Chunking, continued: bool) -> Self {
         LineBlocks {
             reader,
             buf: Vec::new(),
@@ -164,6 +168,7 @@ impl<R: BufRead> LineBlocks<R> {
             // At least one byte, so that every read makes progress.
             block: chunking.block.max(1),
             max_line: chunking.max_line,
+            continued,
         }
     }
 
@@ -175,27 +180,40 @@ impl<R: BufRead> LineBlocks<R> {
         self.buf.copy_within(self.consumed..self.filled, 0);
         self.filled -= self.consumed;
         self.consumed = 0;
-        // Read until the block holds `block` bytes and a line break, or the input ends.
+        // Read until the block holds `block` bytes and the end of a statement (a line break
+        // unless lines continue), or the input ends.
         let mut last_break: Option<usize> = None;
+        let mut last_end: Option<usize> = None;
         let mut searched = 0;
         let end = loop {
-            // Only the bytes read since the last search can hold a later line break.
-            if let Some(i) = memchr::memrchr(b'\n', &self.buf[searched..self.filled]) {
+            // Only the bytes read since the last search can hold later line breaks.
+            let fresh = &self.buf[searched..self.filled];
+            if let Some(i) = memchr::memrchr(b'\n', fresh) {
                 last_break = Some(searched + i);
             }
+            let ends = memchr::memrchr_iter(b'\n', fresh)
+                .map(|i| searched + i)
+                .find(|&i| !self.continued || ends_statement(&self.buf, i));
+            last_end = ends.or(last_end);
             searched = self.filled;
             if self.eof {
                 break self.filled;
             }
-            match last_break {
-                Some(i) if self.filled >= self.block => break i + 1,
-                None if self.filled > self.max_line => {
-                    return Err(Error::parse(
-                        first_line,
-                        format!("line is longer than {} bytes", self.max_line),
-                    ));
+            if let (Some(i), true) = (last_end, self.filled >= self.block) {
+                break i + 1;
+            }
+            // The line being read is too long: what comes before it is read first (it may
+            // hold an error of its own), then it is refused, at its number.
+            if self.filled - last_break.map_or(0, |i| i + 1) > self.max_line {
+                if let Some(i) = last_end {
+                    break i + 1;
                 }
-                _ => {}
+                let line =
+                    first_line + memchr::memchr_iter(b'\n', &self.buf[..self.filled]).count();
+                return Err(Error::parse(
+                    line,
+                    format!("line is longer than {} bytes", self.max_line),
+                ));
             }
             let want = self.block.max(self.filled + self.block / 4 + 1);
             if self.buf.len() < want {
@@ -214,17 +232,30 @@ impl<R: BufRead> LineBlocks<R> {
 }
 
 /// The pieces of `block` (whole lines, as [`LineBlocks`] gives them): ranges of about
-/// `piece` bytes, each ending after a line break or at the block's end.
-pub(crate) fn pieces(block: &[u8], piece: usize) -> Vec<std::ops::Range<usize>> {
+/// `piece` bytes, each ending after a line break (one that ends a statement, with
+/// `continued`) or at the block's end.
+pub(crate) fn pieces(block: &[u8], piece: usize, continued: bool) -> Vec<std::ops::Range<usize>> {
     let mut out = Vec::new();
     let mut start = 0;
     while start < block.len() {
         let cut = (start + piece.max(1)).min(block.len());
-        let stop = memchr::memchr(b'\n', &block[cut..]).map_or(block.len(), |i| cut + i + 1);
+        let stop = memchr::memchr_iter(b'\n', &block[cut..])
+            .map(|i| cut + i)
+            .find(|&i| !continued || ends_statement(block, i))
+            .map_or(block.len(), |i| i + 1);
         out.push(start..stop);
         start = stop;
     }
     out
+}
+
+/// Whether the line break at `text[i]` ends a statement: the line it ends, without a
+/// trailing `\r`, does not end in `\\` (OBJ's continuation, as [`LineReader`]'s lines are read).
+pub(crate) fn ends_statement(text: &[u8], i: usize) -> bool {
+    let line = &text[..i];
+    let line = line.strip_suffix(b"\r").unwrap_or(line);
+    // A `\\` of the line itself: the line break before the line is not one.
+    line.last() != Some(&b'\\')
 }
 
 /// The lines of `text` (whole lines: it ends after a line break or at the end of the
