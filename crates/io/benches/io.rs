@@ -1,5 +1,5 @@
-//! Read and write speed of the two formats whet reads most: a ~1M-triangle grid mesh as
-//! binary little-endian PLY and as ascii OFF, both held in memory. Writing the text formats
+//! Read and write speed of the formats whet reads most: a ~1M-triangle grid mesh as binary
+//! little-endian PLY, as ascii OFF and (reading) as OBJ, all held in memory. Writing the text formats
 //! prints every coordinate in shortest round-trip form (`write_f64`: zmij's digits).
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
@@ -43,16 +43,19 @@ fn bench_read(c: &mut Criterion) {
         )
     });
 
-    let mut off = Vec::new();
-    write(&mut off, &mesh, Format::Off, &opts).expect("writing to memory cannot fail");
-    group.throughput(Throughput::Bytes(off.len() as u64));
-    group.bench_function("off_ascii", |b| {
-        b.iter_batched(
-            || (),
-            |()| read(&off[..], Format::Off).expect("valid OFF"),
-            BatchSize::PerIteration,
-        )
-    });
+    // The text formats, read in blocks parsed on rayon's threads.
+    for (name, format) in [("off_ascii", Format::Off), ("obj", Format::Obj)] {
+        let mut text = Vec::new();
+        write(&mut text, &mesh, format, &opts).expect("writing to memory cannot fail");
+        group.throughput(Throughput::Bytes(text.len() as u64));
+        group.bench_function(name, |b| {
+            b.iter_batched(
+                || (),
+                |()| read(&text[..], format).expect("a file whet wrote"),
+                BatchSize::PerIteration,
+            )
+        });
+    }
     group.finish();
 }
 
