@@ -1,6 +1,6 @@
 //! Read and write speed of the formats whet reads most: a ~1M-triangle grid mesh as binary
-//! little-endian PLY, as ascii OFF and (reading) as OBJ, all held in memory. Writing the text formats
-//! prints every coordinate in shortest round-trip form (`write_f64`: zmij's digits).
+//! little-endian PLY, as ascii OFF and (reading) as OBJ, all held in memory. Writing the text
+//! formats prints every coordinate in shortest round-trip form (`write_f64`: zmij's digits).
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
 use whet_io::{read, write, Format, PlyEncoding, WriteOptions};
