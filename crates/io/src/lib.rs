@@ -39,6 +39,8 @@
 mod binary;
 mod error;
 mod format;
+#[doc(hidden)]
+pub mod fuzz;
 mod obj;
 mod off;
 mod ply;

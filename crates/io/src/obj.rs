@@ -46,7 +46,10 @@ pub(crate) fn read<R: BufRead>(reader: R) -> Result<(Mesh, ReadReport), Error> {
 }
 
 /// [`read`] with the blocks and pieces of `chunking`.
-fn read_chunked<R: BufRead>(reader: R, chunking: &Chunking) -> Result<(Mesh, ReadReport), Error> {
+pub(crate) fn read_chunked<R: BufRead>(
+    reader: R,
+    chunking: &Chunking,
+) -> Result<(Mesh, ReadReport), Error> {
     let mut blocks = LineBlocks::new(reader, chunking, true);
     let mut state = State::default();
     let mut line = 1;

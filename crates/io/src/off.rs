@@ -58,7 +58,10 @@ pub(crate) fn read<R: BufRead>(reader: R) -> Result<(Mesh, ReadReport), Error> {
 
 /// [`read`] with the blocks and pieces of `chunking` (the tests' small ones give the same
 /// result as the default).
-fn read_chunked<R: BufRead>(reader: R, chunking: &Chunking) -> Result<(Mesh, ReadReport), Error> {
+pub(crate) fn read_chunked<R: BufRead>(
+    reader: R,
+    chunking: &Chunking,
+) -> Result<(Mesh, ReadReport), Error> {
     let mut lines = LineReader::with_max_len(reader, chunking.max_line);
     let (vertex_count, face_count, prefixes) = read_header(&mut lines)?;
     let first_line = lines.line() + 1;

@@ -112,6 +112,9 @@ impl<R: BufRead> LineReader<R> {
     }
 }
 
+/// The first read of a [`LineBlocks`], before its buffer grows to a block.
+const FIRST_READ: usize = 1 << 16;
+
 /// How [`LineBlocks`] cuts its input into blocks and its readers cut a block into pieces.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Chunking {
@@ -182,15 +185,13 @@ impl<R: BufRead> LineBlocks<R> {
         self.consumed = 0;
         // Read until the block holds `block` bytes and the end of a statement (a line break
         // unless lines continue), or the input ends.
-        let mut last_break: Option<usize> = None;
         let mut last_end: Option<usize> = None;
         let mut searched = 0;
+        // Lines starting before `scanned` are known to be no longer than the limit.
+        let mut scanned = 0;
         let end = loop {
-            // Only the bytes read since the last search can hold later line breaks.
+            // Only the bytes read since the last search can hold later statement ends.
             let fresh = &self.buf[searched..self.filled];
-            if let Some(i) = memchr::memrchr(b'\n', fresh) {
-                last_break = Some(searched + i);
-            }
             let ends = memchr::memrchr_iter(b'\n', fresh)
                 .map(|i| searched + i)
                 .find(|&i| !self.continued || ends_statement(&self.buf, i));
@@ -202,22 +203,34 @@ impl<R: BufRead> LineBlocks<R> {
             if let (Some(i), true) = (last_end, self.filled >= self.block) {
                 break i + 1;
             }
-            // The line being read is too long: what comes before it is read first (it may
-            // hold an error of its own), then it is refused, at its number.
-            if self.filled - last_break.map_or(0, |i| i + 1) > self.max_line {
-                if let Some(i) = last_end {
-                    break i + 1;
+            // What follows the last statement end is more than a line's limit: if a line
+            // there is too long, what comes before that statement is read first (it may hold
+            // an error of its own), then the line is refused, at its number.
+            let open = last_end.map_or(0, |i| i + 1);
+            if self.filled - open > self.max_line {
+                match self.first_long_line(scanned.max(open)) {
+                    Ok(start) => scanned = start,
+                    Err(long) => {
+                        if let Some(i) = last_end {
+                            break i + 1;
+                        }
+                        let before = memchr::memchr_iter(b'\n', &self.buf[..long]).count();
+                        return Err(Error::parse(
+                            first_line + before,
+                            format!("line is longer than {} bytes", self.max_line),
+                        ));
+                    }
                 }
-                let line =
-                    first_line + memchr::memchr_iter(b'\n', &self.buf[..self.filled]).count();
-                return Err(Error::parse(
-                    line,
-                    format!("line is longer than {} bytes", self.max_line),
-                ));
             }
-            let want = self.block.max(self.filled + self.block / 4 + 1);
-            if self.buf.len() < want {
-                self.buf.resize(want, 0);
+            // Grow the buffer as the data comes, up to a block (a small file does not
+            // take a block's memory).
+            if self.filled == self.buf.len() {
+                let grown = if self.filled < self.block {
+                    (2 * self.filled).max(FIRST_READ).min(self.block)
+                } else {
+                    self.filled + self.block / 4
+                };
+                self.buf.resize(grown.max(self.filled + 1), 0);
             }
             let n = read_some(&mut self.reader, &mut self.buf[self.filled..])?;
             self.eof = n == 0;
@@ -228,6 +241,23 @@ impl<R: BufRead> LineBlocks<R> {
         }
         self.consumed = end;
         Ok(Some(&self.buf[..end]))
+    }
+
+    /// The start of the first line from `from` (a line's start) longer than the limit, the
+    /// unfinished last line included, as `Err`; or `Ok` with the start of that last line
+    /// when none is.
+    fn first_long_line(&self, from: usize) -> Result<usize, usize> {
+        let mut start = from;
+        for i in memchr::memchr_iter(b'\n', &self.buf[from..self.filled]) {
+            if from + i - start > self.max_line {
+                return Err(start);
+            }
+            start = from + i + 1;
+        }
+        if self.filled - start > self.max_line {
+            return Err(start);
+        }
+        Ok(start)
     }
 }
 
