@@ -97,7 +97,8 @@ pub fn read_path_with_report(
 ///
 /// Binary data is decoded record by record and text line by line, except OFF bodies and OBJ
 /// files, which are read in blocks of 4 MiB whose lines are parsed on rayon's threads;
-/// nothing is read in one piece. Polygons are fan-triangulated. STL vertices are welded exactly (identical
+/// nothing is read in one piece. Reading may consume bytes past the end of the mesh (up to
+/// a block after an OFF file's last face). Polygons are fan-triangulated. STL vertices are welded exactly (identical
 /// coordinates become one vertex, in order of first appearance). An STL stream whose first
 /// bytes are `solid` is read as ascii when its first 84 bytes are all text and as binary
 /// otherwise; [`read_path`] decides by the file size instead. Attributes besides positions and

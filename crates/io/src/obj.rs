@@ -546,7 +546,7 @@ pub(crate) fn write<W: Write>(w: &mut W, mesh: &Mesh) -> std::io::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::text::{LineReader, MAX_LINE};
+    use crate::text::{assert_chunkings_agree, LineReader, MAX_LINE};
     use whet_mesh::DVec3;
 
     fn read<R: BufRead>(reader: R) -> Result<Mesh, Error> {
@@ -680,57 +680,35 @@ mod tests {
         state.finish()
     }
 
-    /// Small blocks and pieces: boundaries inside lines, inside continued statements and
-    /// between them.
-    const SMALL: [Chunking; 5] = [
-        Chunking {
-            block: 1,
-            max_line: MAX_LINE,
-            piece: 1,
-        },
-        Chunking {
-            block: 2,
-            max_line: MAX_LINE,
-            piece: 5,
-        },
-        Chunking {
-            block: 7,
-            max_line: MAX_LINE,
-            piece: 3,
-        },
-        Chunking {
-            block: 31,
-            max_line: MAX_LINE,
-            piece: 40,
-        },
-        Chunking {
-            block: 200,
-            max_line: MAX_LINE,
-            piece: 8,
-        },
-    ];
-
-    /// The block reader's result with every chunking of `SMALL` and the default against the
-    /// oracle's (compared by their Debug form, errors included).
+    /// The block reader against the oracle ([`crate::text::assert_chunkings_agree`]).
     fn assert_reads_as_by_lines(text: &[u8], max_line: usize) {
-        let expect = format!("{:?}", read_by_lines(text, max_line));
-        let default = Chunking {
-            max_line,
-            ..Chunking::DEFAULT
-        };
-        for chunking in SMALL
-            .iter()
-            .map(|c| Chunking { max_line, ..*c })
-            .chain([default])
-        {
-            let got = format!("{:?}", read_chunked(text, &chunking));
-            assert_eq!(
-                got,
-                expect,
-                "{chunking:?} on {:?}",
-                String::from_utf8_lossy(text)
-            );
+        assert_chunkings_agree(text, max_line, read_by_lines, |t, c| read_chunked(t, c));
+    }
+
+    /// A reader whose data ends in a failure, as a broken pipe's does.
+    struct Failing;
+
+    impl std::io::Read for Failing {
+        fn read(&mut self, _: &mut [u8]) -> std::io::Result<usize> {
+            Err(std::io::Error::other("the pipe broke"))
         }
+    }
+
+    #[test]
+    fn what_was_read_before_a_failing_read_is_parsed_first() {
+        use std::io::Read;
+        // An error in the lines read before the failure is the one reported, as a reading
+        // line by line reports it; a failure where more lines are needed is an I/O error.
+        let reader = std::io::BufReader::new(b"v 1 x 0\n".chain(Failing));
+        let e = super::read(reader).unwrap_err();
+        assert!(matches!(&e, Error::Parse { line: 1, .. }), "{e}");
+        let reader = std::io::BufReader::new(b"v 1 2 0\n".chain(Failing));
+        let e = super::read(reader).unwrap_err();
+        assert!(matches!(e, Error::Io(_)), "{e}");
+        // OFF stops after its last face, before the failure.
+        let off = b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+        let reader = std::io::BufReader::new(off.chain(Failing));
+        assert!(crate::read(reader, crate::Format::Off).is_ok());
     }
 
     #[test]

@@ -580,7 +580,7 @@ pub(crate) fn write<W: Write>(w: &mut W, mesh: &Mesh) -> std::io::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::text::MAX_LINE;
+    use crate::text::{assert_chunkings_agree, MAX_LINE};
 
     fn read<R: BufRead>(reader: R) -> Result<Mesh, Error> {
         super::read(reader).map(|(mesh, _)| mesh)
@@ -727,57 +727,9 @@ mod tests {
         Ok((Mesh::new(positions, triangles), report))
     }
 
-    /// Small blocks and tasks: block boundaries inside lines, at line breaks, between the
-    /// vertices and the faces, and every block split among tasks.
-    const SMALL: [Chunking; 5] = [
-        Chunking {
-            block: 1,
-            max_line: MAX_LINE,
-            piece: 1,
-        },
-        Chunking {
-            block: 2,
-            max_line: MAX_LINE,
-            piece: 5,
-        },
-        Chunking {
-            block: 7,
-            max_line: MAX_LINE,
-            piece: 3,
-        },
-        Chunking {
-            block: 31,
-            max_line: MAX_LINE,
-            piece: 40,
-        },
-        Chunking {
-            block: 200,
-            max_line: MAX_LINE,
-            piece: 8,
-        },
-    ];
-
-    /// The block reader's result, with every chunking of `SMALL` and the default, against the
-    /// line-by-line oracle (errors compared by their Debug form).
+    /// The block reader against the oracle ([`crate::text::assert_chunkings_agree`]).
     fn assert_reads_as_by_lines(text: &[u8], max_line: usize) {
-        let expect = format!("{:?}", read_by_lines(text, max_line));
-        let default = Chunking {
-            max_line,
-            ..Chunking::DEFAULT
-        };
-        for chunking in SMALL
-            .iter()
-            .map(|c| Chunking { max_line, ..*c })
-            .chain([default])
-        {
-            let got = format!("{:?}", read_chunked(text, &chunking));
-            assert_eq!(
-                got,
-                expect,
-                "{chunking:?} on {:?}",
-                String::from_utf8_lossy(text)
-            );
-        }
+        assert_chunkings_agree(text, max_line, read_by_lines, |t, c| read_chunked(t, c));
     }
 
     #[test]
@@ -832,7 +784,7 @@ mod tests {
             &text[..],
             &Chunking {
                 max_line: 19,
-                ..SMALL[2]
+                ..crate::text::SMALL_CHUNKINGS[2]
             },
         )
         .unwrap_err();

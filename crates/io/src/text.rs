@@ -156,6 +156,8 @@ pub(crate) struct LineBlocks<R> {
     /// Whether a line ending in `\\` continues on the next ([`ends_statement`]): blocks then
     /// end only where a statement does.
     continued: bool,
+    /// A read that failed after a block's worth was read: the next block's error.
+    failed: Option<Error>,
 }
 
 impl<R: BufRead> LineBlocks<R> {
@@ -172,6 +174,7 @@ impl<R: BufRead> LineBlocks<R> {
             block: chunking.block.max(1),
             max_line: chunking.max_line,
             continued,
+            failed: None,
         }
     }
 
@@ -179,6 +182,9 @@ impl<R: BufRead> LineBlocks<R> {
     /// input), or `None` at the end of the input; `first_line`, the number of its first
     /// line, names a line too long to hold.
     pub(crate) fn next_block(&mut self, first_line: usize) -> Result<Option<&[u8]>, Error> {
+        if let Some(e) = self.failed.take() {
+            return Err(e);
+        }
         // Keep what follows the last line handed out.
         self.buf.copy_within(self.consumed..self.filled, 0);
         self.filled -= self.consumed;
@@ -187,8 +193,10 @@ impl<R: BufRead> LineBlocks<R> {
         // unless lines continue), or the input ends.
         let mut last_end: Option<usize> = None;
         let mut searched = 0;
-        // Lines starting before `scanned` are known to be no longer than the limit.
-        let mut scanned = 0;
+        // The search for lines too long: line breaks before `scanned` are found, and the
+        // line in progress there starts at `line_start` (both only grow: each byte is
+        // searched once however long the lines).
+        let (mut scanned, mut line_start) = (0, 0);
         let end = loop {
             // Only the bytes read since the last search can hold later statement ends.
             let fresh = &self.buf[searched..self.filled];
@@ -208,8 +216,9 @@ impl<R: BufRead> LineBlocks<R> {
             // an error of its own), then the line is refused, at its number.
             let open = last_end.map_or(0, |i| i + 1);
             if self.filled - open > self.max_line {
-                match self.first_long_line(scanned.max(open)) {
-                    Ok(start) => scanned = start,
+                line_start = line_start.max(open);
+                match self.first_long_line(scanned.max(open), line_start) {
+                    Ok(start) => (scanned, line_start) = (self.filled, start),
                     Err(long) => {
                         if let Some(i) = last_end {
                             break i + 1;
@@ -232,7 +241,18 @@ impl<R: BufRead> LineBlocks<R> {
                 };
                 self.buf.resize(grown.max(self.filled + 1), 0);
             }
-            let n = read_some(&mut self.reader, &mut self.buf[self.filled..])?;
+            let n = match read_some(&mut self.reader, &mut self.buf[self.filled..]) {
+                Ok(n) => n,
+                // What is read is handed out first (it may end the reading, or hold an
+                // error of its own); the next block is the error.
+                Err(e) => match last_end {
+                    Some(i) => {
+                        self.failed = Some(e);
+                        break i + 1;
+                    }
+                    None => return Err(e),
+                },
+            };
             self.eof = n == 0;
             self.filled += n;
         };
@@ -243,11 +263,10 @@ impl<R: BufRead> LineBlocks<R> {
         Ok(Some(&self.buf[..end]))
     }
 
-    /// The start of the first line from `from` (a line's start) longer than the limit, the
-    /// unfinished last line included, as `Err`; or `Ok` with the start of that last line
-    /// when none is.
-    fn first_long_line(&self, from: usize) -> Result<usize, usize> {
-        let mut start = from;
+    /// The start of the first line longer than the limit, the unfinished last line included,
+    /// as `Err`, searching the line breaks from `from` on, the line in progress there
+    /// starting at `start`; or `Ok` with the start of the last line when none is.
+    fn first_long_line(&self, from: usize, mut start: usize) -> Result<usize, usize> {
         for i in memchr::memchr_iter(b'\n', &self.buf[from..self.filled]) {
             if from + i - start > self.max_line {
                 return Err(start);
@@ -492,6 +511,64 @@ fn may_tie(a: f64) -> bool {
         e >= -25
     } else {
         a >= 9007199254740992.0
+    }
+}
+
+/// Small blocks and pieces for the block readers' tests: boundaries inside lines, inside
+/// continued statements, between vertices and faces, and every block split among tasks.
+#[cfg(test)]
+pub(crate) const SMALL_CHUNKINGS: [Chunking; 5] = [
+    Chunking {
+        block: 1,
+        max_line: MAX_LINE,
+        piece: 1,
+    },
+    Chunking {
+        block: 2,
+        max_line: MAX_LINE,
+        piece: 5,
+    },
+    Chunking {
+        block: 7,
+        max_line: MAX_LINE,
+        piece: 3,
+    },
+    Chunking {
+        block: 31,
+        max_line: MAX_LINE,
+        piece: 40,
+    },
+    Chunking {
+        block: 200,
+        max_line: MAX_LINE,
+        piece: 8,
+    },
+];
+
+/// Asserts that `read` gives `text` the result the line-by-line `oracle` gives it (both in
+/// their Debug form, errors included) with every chunking of [`SMALL_CHUNKINGS`] and the
+/// default, lines limited to `max_line` bytes.
+#[cfg(test)]
+pub(crate) fn assert_chunkings_agree<T: std::fmt::Debug, U: std::fmt::Debug>(
+    text: &[u8],
+    max_line: usize,
+    oracle: impl Fn(&[u8], usize) -> T,
+    read: impl Fn(&[u8], &Chunking) -> U,
+) {
+    let expect = format!("{:?}", oracle(text, max_line));
+    let default = Chunking {
+        max_line,
+        ..Chunking::DEFAULT
+    };
+    let small = SMALL_CHUNKINGS.iter().map(|c| Chunking { max_line, ..*c });
+    for chunking in small.chain([default]) {
+        let got = format!("{:?}", read(text, &chunking));
+        assert_eq!(
+            got,
+            expect,
+            "{chunking:?} on {:?}",
+            String::from_utf8_lossy(text)
+        );
     }
 }
 
