@@ -156,7 +156,8 @@ pub(crate) struct LineBlocks<R> {
     /// Whether a line ending in `\\` continues on the next ([`ends_statement`]): blocks then
     /// end only where a statement does.
     continued: bool,
-    /// A read that failed after a block's worth was read: the next block's error.
+    /// A read that failed after whole statements were read: those are handed out first,
+    /// and the next call returns the error.
     failed: Option<Error>,
 }
 
