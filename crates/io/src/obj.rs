@@ -30,8 +30,8 @@ use whet_mesh::Mesh;
 use rayon::prelude::*;
 
 use crate::text::{
-    line_spans, parse_f64, parse_i64, pieces, show, strip_comment, tokens, write_face_line,
-    write_point_line, Chunking, LineBlocks, BOM,
+    line_spans, parse_f64, parse_i64, pieces, plain_point, show, strip_comment, tokens,
+    write_face_line, write_point_line, Chunking, LineBlocks, BOM,
 };
 use crate::{finite_point, Error, Fan, ReadReport, Skipped};
 
@@ -357,13 +357,9 @@ impl State {
         match toks.next() {
             Some("v") => {
                 let index = self.vertex_base + self.positions.len();
-                let (Some(x), Some(y), Some(z)) = (toks.next(), toks.next(), toks.next()) else {
+                let Some(p) = plain_point(&mut toks) else {
                     return false;
                 };
-                let (Ok(x), Ok(y), Ok(z)) = (x.parse(), y.parse(), z.parse()) else {
-                    return false;
-                };
-                let p = whet_mesh::DVec3::new(x, y, z);
                 if index >= u32::MAX as usize || !p.is_finite() {
                     return false;
                 }

@@ -29,7 +29,7 @@ use whet_mesh::{DVec3, Mesh};
 use rayon::prelude::*;
 
 use crate::text::{
-    holds_data, line_spans, parse_f64, parse_i64, pieces, show, strip_comment, tokens,
+    holds_data, line_spans, parse_f64, parse_i64, pieces, plain_point, show, strip_comment, tokens,
     write_face_line, write_point_line, Chunking, LineBlocks, LineReader,
 };
 use crate::{capacity, check_index, finite_point, Error, Fan, ReadReport, Skipped};
@@ -350,11 +350,9 @@ fn parse_vertex(line: &[u8], line_no: usize, index: usize) -> Result<Option<(DVe
     // path below, which names the problem.
     if let Ok(text) = std::str::from_utf8(line) {
         let mut toks = text.split_ascii_whitespace();
-        if let (Some(x), Some(y), Some(z)) = (toks.next(), toks.next(), toks.next()) {
-            if let (Ok(x), Ok(y), Ok(z)) = (x.parse(), y.parse(), z.parse()) {
-                let extra = toks.next().is_some();
-                return finite_point(x, y, z, index).map(|p| Some((p, extra)));
-            }
+        if let Some(p) = plain_point(&mut toks) {
+            let extra = toks.next().is_some();
+            return finite_point(p.x, p.y, p.z, index).map(|p| Some((p, extra)));
         }
     }
     let mut toks = tokens(line);

@@ -426,6 +426,18 @@ pub(crate) fn parse_i64(token: &[u8]) -> Option<i64> {
     Some(value)
 }
 
+/// The next three tokens of `toks` as a point, when all three are there and parse as
+/// floats (finite or not): the quick path of the readers' vertex lines, which leave any
+/// other line to their token-by-token path.
+pub(crate) fn plain_point(toks: &mut std::str::SplitAsciiWhitespace<'_>) -> Option<DVec3> {
+    let (x, y, z) = (toks.next()?, toks.next()?, toks.next()?);
+    Some(DVec3::new(
+        x.parse().ok()?,
+        y.parse().ok()?,
+        z.parse().ok()?,
+    ))
+}
+
 /// A token as it appears in the file, cut to a readable length, for error messages.
 pub(crate) fn show(token: &[u8]) -> String {
     const MAX: usize = 40;
