@@ -2050,6 +2050,18 @@ pub(crate) fn corner_vertices(run: &mut Run) -> Vec<u32> {
 /// max 1.7x worse.
 pub(crate) const CORNER_SURFACE_GAP: f64 = 0.5;
 
+/// A vertex inside a cut corner within this fraction of its mean edge length of one of the
+/// three planes lies on one of the corner's faces, as marching cubes puts it; one farther off
+/// all three (up to [`CORNER_SURFACE_GAP`]) may lie on a face the three planes do not hold, a
+/// narrow real face cutting the corner, and moves only when the three surfaces also meet
+/// pairwise in creases around it ([`creases_meet`]). Measured on the vertices that test
+/// refused on 990 generic and 120 near-axis samplings (`generic_sweep`, the near-axis test):
+/// at box corners the nearest plane is 0.04-0.07 edges away (refusing those cost a near-axis
+/// cube at 42 cells 0.705 -> 0.824 % in max), at the narrow face's end 0.44, on a near-axis
+/// hole's rim, whose refusal helped, 0.31-0.47 (docs/results.md, "A narrow face's end is no
+/// cut corner").
+pub(crate) const CORNER_ON_FACE: f64 = 0.25;
+
 /// Fewest triangles a smooth region needs for [`unlabelled_corner_vertices`] to extrapolate
 /// its plane to a corner: the rule moves a vertex up to [`CORNER_MOVE_LIMIT`] edges on three
 /// planes taken from neighbours, and the plane of a region about one fan across (a coarse
@@ -2158,6 +2170,8 @@ fn unlabelled_corner_vertices(run: &mut Run, placed: &mut Vec<DVec3>, moved: &mu
                             2.0 * d.max(mean),
                         )
                         || !supported_within(run, q, &[v], reach)
+                        || (gap > CORNER_ON_FACE * mean
+                            && !creases_meet(run, v, q, [x, y, z], CURVED_TOLERANCE * mean))
                     {
                         continue;
                     }
@@ -2185,6 +2199,100 @@ fn unlabelled_corner_vertices(run: &mut Run, placed: &mut Vec<DVec3>, moved: &mu
         placed.push(w);
         moved.push(v);
     }
+}
+
+/// Rings around an unlabelled corner vertex in which [`creases_meet`] looks for its corner's
+/// creases.
+pub(crate) const CORNER_CREASE_RINGS: usize = 3;
+
+/// Most vertices [`creases_meet`] visits: around a vertex of very high valence it stops
+/// there, and a crease it did not reach refuses the corner (the move is the risk).
+const CORNER_CREASE_VERTICES: usize = 128;
+
+/// Whether every two of a corner's three planes meet near vertex `v` (within
+/// [`CORNER_CREASE_RINGS`]) in a crease, or both meet a fourth surface there whose plane holds
+/// the corner point `q` too (within `tol`: the apex of four or more faces, of which the
+/// triple holds two that are not adjacent). Two surfaces meet in a crease where a vertex lies
+/// on both, or lies on one with a neighbour on the other: the chamfer edges and vertices of a
+/// crease that marching cubes cut. A narrow real face along one of the creases leaves that
+/// pair apart (synth thin-face, a face 0.02 wide, about 1.8 edges at 99 cells: its vertices
+/// lie too deep under both planes of the edge it cuts for a label, and that crease stays as
+/// it is); the corner point of the three planes is then a corner the face cut off, and moving
+/// the vertex at the face's end onto it put a spike 1.2 edges out, 0.68 % of the diagonal
+/// off the part (docs/results.md, "A narrow face's end is no cut corner").
+fn creases_meet(run: &Run, v: u32, q: DVec3, triple: [&LabelPlane; 3], tol: f64) -> bool {
+    // The vertices within the rings, breadth first.
+    let mut ring: Vec<u32> = vec![v];
+    let mut start = 0;
+    'rings: for _ in 0..CORNER_CREASE_RINGS {
+        let end = ring.len();
+        for i in start..end {
+            for c in run.table.vertex_corners(VertexId(ring[i])) {
+                let w = run.cv(next(c.index()));
+                if !ring.contains(&w) {
+                    if ring.len() == CORNER_CREASE_VERTICES {
+                        break 'rings;
+                    }
+                    ring.push(w);
+                }
+            }
+        }
+        start = end;
+    }
+    // The surfaces on them, the triple's first; at most 64, one bit each.
+    let mut surfaces: Vec<LabelPlane> = triple.iter().map(|&lp| *lp).collect();
+    for &w in &ring {
+        for lp in planes_of(run, w) {
+            if surfaces.len() < 64 && surfaces.iter().all(|o| !same_surface(run, o, lp)) {
+                surfaces.push(*lp);
+            }
+        }
+    }
+    let on = |w: u32| {
+        let mut bits = 0u64;
+        for lp in planes_of(run, w) {
+            for (i, o) in surfaces.iter().enumerate() {
+                if same_surface(run, o, lp) {
+                    bits |= 1 << i;
+                }
+            }
+        }
+        bits
+    };
+    // Bit j of `meets[i]`: surfaces i and j meet in a crease.
+    let mut meets = vec![0u64; surfaces.len()];
+    for &w in &ring {
+        let own = on(w);
+        if own == 0 {
+            continue;
+        }
+        let mut near = own;
+        for c in run.table.vertex_corners(VertexId(w)) {
+            near |= on(run.cv(next(c.index())));
+        }
+        for (i, m) in meets.iter_mut().enumerate() {
+            if own >> i & 1 != 0 {
+                *m |= near & !(1 << i);
+            }
+        }
+        // Symmetric: a neighbour's surface meets the vertex's own.
+        for j in 0..surfaces.len() {
+            if near >> j & 1 != 0 {
+                meets[j] |= own & !(1 << j);
+            }
+        }
+    }
+    [(0, 1), (0, 2), (1, 2)].iter().all(|&(i, j)| {
+        meets[i] >> j & 1 != 0
+            || (3..surfaces.len()).any(|k| {
+                meets[i] >> k & 1 != 0
+                    && meets[j] >> k & 1 != 0
+                    && (q - surfaces[k].plane.point)
+                        .dot(surfaces[k].plane.normal)
+                        .abs()
+                        <= tol
+            })
+    })
 }
 
 /// Whether moving input vertex `v` to `w` keeps its fan unfolded (every triangle facing as
