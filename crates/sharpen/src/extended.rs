@@ -2095,8 +2095,10 @@ fn region_sizes(run: &Run) -> Vec<u32> {
 /// widened by [`acute_reach`] like the support test). The corner triangles of the papers need
 /// a label at each of their vertices, so a corner whose cut left such a vertex in its middle
 /// had none (synth fandisk at 96-128). A vertex with a corner triangle in its two-ring is left
-/// to that triangle (its centre would snap to the same point). Candidates are found first and
-/// moved nearest first (ties by index), so the result does not depend on the vertex order.
+/// to that triangle (its centre would snap to the same point). A vertex farther than
+/// [`CORNER_ON_FACE`] from all three planes also needs the three surfaces to meet pairwise
+/// around it ([`creases_meet`]). Candidates are found first and moved nearest first (ties by
+/// index), so the result does not depend on the vertex order.
 fn unlabelled_corner_vertices(run: &mut Run, placed: &mut Vec<DVec3>, moved: &mut Vec<u32>) {
     let nv = run.mesh.positions.len();
     let region_size = region_sizes(run);
@@ -2205,12 +2207,17 @@ fn unlabelled_corner_vertices(run: &mut Run, placed: &mut Vec<DVec3>, moved: &mu
 /// creases.
 pub(crate) const CORNER_CREASE_RINGS: usize = 3;
 
-/// Most vertices [`creases_meet`] visits: around a vertex of very high valence it stops
-/// there, and a crease it did not reach refuses the corner (the move is the risk).
+/// Most vertices [`creases_meet`] gathers; a crease it did not reach refuses the corner (the
+/// move is the risk).
 const CORNER_CREASE_VERTICES: usize = 128;
 
+/// Most triangles around one vertex [`creases_meet`] walks: a vertex of higher valence (no
+/// marching-cubes vertex has more than a dozen) refuses the corner, so the test stays bounded
+/// on any input.
+const CORNER_CREASE_VALENCE: usize = 32;
+
 /// Whether every two of a corner's three planes meet near vertex `v` (within
-/// [`CORNER_CREASE_RINGS`]) in a crease, or both meet a fourth surface there whose plane holds
+/// [`CORNER_CREASE_RINGS`], a neighbour of the last ring counting) in a crease, or both meet a fourth surface there whose plane holds
 /// the corner point `q` too (within `tol`: the apex of four or more faces, of which the
 /// triple holds two that are not adjacent). Two surfaces meet in a crease where a vertex lies
 /// on both, or lies on one with a neighbour on the other: the chamfer edges and vertices of a
@@ -2221,13 +2228,26 @@ const CORNER_CREASE_VERTICES: usize = 128;
 /// the vertex at the face's end onto it put a spike 1.2 edges out, 0.68 % of the diagonal
 /// off the part (docs/results.md, "A narrow face's end is no cut corner").
 fn creases_meet(run: &Run, v: u32, q: DVec3, triple: [&LabelPlane; 3], tol: f64) -> bool {
+    // The fan of `w`, or `None` past the valence cap.
+    let fan = |w: u32| {
+        let id = VertexId(w);
+        let small = run
+            .table
+            .vertex_corners(id)
+            .nth(CORNER_CREASE_VALENCE)
+            .is_none();
+        small.then(|| run.table.vertex_corners(id))
+    };
     // The vertices within the rings, breadth first.
     let mut ring: Vec<u32> = vec![v];
     let mut start = 0;
     'rings: for _ in 0..CORNER_CREASE_RINGS {
         let end = ring.len();
         for i in start..end {
-            for c in run.table.vertex_corners(VertexId(ring[i])) {
+            let Some(corners) = fan(ring[i]) else {
+                return false;
+            };
+            for c in corners {
                 let w = run.cv(next(c.index()));
                 if !ring.contains(&w) {
                     if ring.len() == CORNER_CREASE_VERTICES {
@@ -2248,13 +2268,13 @@ fn creases_meet(run: &Run, v: u32, q: DVec3, triple: [&LabelPlane; 3], tol: f64)
             }
         }
     }
+    // Each label plane stands for the first surface it is the same as (`same_surface` is
+    // not transitive: a plane of one surface's label, parallel to another, is not both).
     let on = |w: u32| {
         let mut bits = 0u64;
         for lp in planes_of(run, w) {
-            for (i, o) in surfaces.iter().enumerate() {
-                if same_surface(run, o, lp) {
-                    bits |= 1 << i;
-                }
+            if let Some(i) = surfaces.iter().position(|o| same_surface(run, o, lp)) {
+                bits |= 1 << i;
             }
         }
         bits
@@ -2266,8 +2286,11 @@ fn creases_meet(run: &Run, v: u32, q: DVec3, triple: [&LabelPlane; 3], tol: f64)
         if own == 0 {
             continue;
         }
+        let Some(corners) = fan(w) else {
+            return false;
+        };
         let mut near = own;
-        for c in run.table.vertex_corners(VertexId(w)) {
+        for c in corners {
             near |= on(run.cv(next(c.index())));
         }
         for (i, m) in meets.iter_mut().enumerate() {
