@@ -88,6 +88,24 @@ impl<'a> SignedDistance<'a> {
     }
 }
 
+/// A shared fixture turned by `rotation` and sampled by marching cubes of its signed distance
+/// at `resolution` cells: the turned fixture (the reference) and the sampling. Parts a user
+/// sends come at any angle; the figure tables sample the fixtures only in their own,
+/// mostly axis-aligned, orientation.
+pub fn turned_sampling(
+    original: &Mesh,
+    rotation: DQuat,
+    resolution: usize,
+) -> Result<(Mesh, Mesh), whet_synth::Error> {
+    let truth = Mesh::new(
+        original.positions.iter().map(|&p| rotation * p).collect(),
+        original.triangles.clone(),
+    );
+    let sd = SignedDistance::new(&truth);
+    let input = whet_synth::marching_cubes_fn(|p| sd.eval(p), &truth.bounding_box(), resolution)?;
+    Ok((truth, input))
+}
+
 /// The stand-in for a SwingWrapper-decoded mesh until the swing codec lands: marching cubes of
 /// the signed distance to `original` at the resolution whose output has about `ratio` times
 /// the original's vertex count. Like SwingWrapper it samples the surface uniformly without
