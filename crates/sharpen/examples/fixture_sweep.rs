@@ -19,7 +19,7 @@
 mod support;
 use glam::{DQuat, DVec3};
 use whet_mesh::Mesh;
-use whet_sharpen::{sharpen, Method, SharpenOptions};
+use whet_sharpen::{sharpen, SharpenOptions};
 use whet_testkit::Lcg;
 
 /// The shared fixtures whose creases are sharp (the organic scans and rocker_arm, whose
@@ -38,14 +38,8 @@ const FIXTURES: [&str; 10] = [
 ];
 
 fn main() {
-    let args: Vec<String> = std::env::args().collect();
-    let seed: u64 = args.get(1).and_then(|a| a.parse().ok()).unwrap_or(1);
-    let n: usize = args.get(2).and_then(|a| a.parse().ok()).unwrap_or(20);
-    let method = match args.get(3).map(String::as_str) {
-        Some("papers") => Method::Papers,
-        _ => Method::Extended,
-    };
-    let only = args.get(4);
+    let (seed, n, method, rest) = support::sweep_args(1, 20);
+    let only = rest.first();
     let write_dir = std::env::var_os("FIXTURE_SWEEP_WRITE").map(std::path::PathBuf::from);
     let only_case: Option<usize> = std::env::var("FIXTURE_SWEEP_CASE")
         .ok()

@@ -16,19 +16,13 @@
 #![allow(clippy::unwrap_used)] // a measurement tool
 mod support;
 use glam::{DQuat, DVec3};
-use whet_sharpen::{sharpen, Method, SharpenOptions};
+use whet_sharpen::{sharpen, SharpenOptions};
 use whet_synth::{marching_cubes, Shape, ShapeKind, ShapeParams};
 use whet_testkit::Lcg;
 
 fn main() {
-    let args: Vec<String> = std::env::args().collect();
-    let seed: u64 = args.get(1).and_then(|a| a.parse().ok()).unwrap_or(7);
-    let n: usize = args.get(2).and_then(|a| a.parse().ok()).unwrap_or(40);
-    let method = match args.get(3).map(String::as_str) {
-        Some("papers") => Method::Papers,
-        _ => Method::Extended,
-    };
-    let angle_scale: f64 = args.get(4).and_then(|a| a.parse().ok()).unwrap_or(1.0);
+    let (seed, n, method, rest) = support::sweep_args(7, 40);
+    let angle_scale: f64 = rest.first().and_then(|a| a.parse().ok()).unwrap_or(1.0);
     let kinds: Vec<ShapeKind> = ShapeKind::ALL
         .into_iter()
         .filter(|k| k.has_sharp_edges())
