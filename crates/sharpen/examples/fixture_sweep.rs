@@ -17,7 +17,7 @@
 //! turned fixture, input and output as OFF.
 #![allow(clippy::unwrap_used)] // a measurement tool
 mod support;
-use glam::{DQuat, DVec3};
+use glam::DQuat;
 use whet_mesh::Mesh;
 use whet_sharpen::{sharpen, SharpenOptions};
 use whet_testkit::Lcg;
@@ -60,13 +60,7 @@ fn main() {
     for i in 0..n {
         let k = i % names.len();
         let res = 32 + (rng.unit() * 96.0) as usize;
-        let axis = DVec3::new(
-            rng.unit() * 2.0 - 1.0,
-            rng.unit() * 2.0 - 1.0,
-            rng.unit() * 2.0 - 1.0 + 1e-3,
-        )
-        .normalize();
-        let angle = rng.unit() * std::f64::consts::PI;
+        let (axis, angle) = support::random_turn(&mut rng, 1.0);
         let q = DQuat::from_axis_angle(axis, angle);
         if only_case.is_some_and(|c| c != i) {
             continue;

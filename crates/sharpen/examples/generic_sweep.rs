@@ -15,7 +15,7 @@
 //! with 90 cases are the sweeps docs/results.md quotes ("Tubes of thin facets").
 #![allow(clippy::unwrap_used)] // a measurement tool
 mod support;
-use glam::{DQuat, DVec3};
+use glam::DQuat;
 use whet_sharpen::{sharpen, SharpenOptions};
 use whet_synth::{marching_cubes, Shape, ShapeKind, ShapeParams};
 use whet_testkit::Lcg;
@@ -32,13 +32,7 @@ fn main() {
     for i in 0..n {
         let kind = kinds[i % kinds.len()];
         let res = 24 + (rng.unit() * 80.0) as usize;
-        let axis = DVec3::new(
-            rng.unit() * 2.0 - 1.0,
-            rng.unit() * 2.0 - 1.0,
-            rng.unit() * 2.0 - 1.0 + 1e-3,
-        )
-        .normalize();
-        let angle = rng.unit() * std::f64::consts::PI * angle_scale;
+        let (axis, angle) = support::random_turn(&mut rng, angle_scale);
         let shape = Shape::new(
             kind,
             &ShapeParams::default().with_rotation(DQuat::from_axis_angle(axis, angle)),

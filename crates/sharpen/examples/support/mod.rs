@@ -101,6 +101,18 @@ pub fn sweep_args(seed: u64, cases: usize) -> (u64, usize, whet_sharpen::Method,
     (seed, cases, method, args.into_iter().skip(4).collect())
 }
 
+/// A random rotation axis and angle (radians, under `pi * angle_scale`) drawn from `rng`, as
+/// the sweeps draw them (each line of their output prints both).
+pub fn random_turn(rng: &mut whet_testkit::Lcg, angle_scale: f64) -> (DVec3, f64) {
+    let axis = DVec3::new(
+        rng.unit() * 2.0 - 1.0,
+        rng.unit() * 2.0 - 1.0,
+        rng.unit() * 2.0 - 1.0 + 1e-3,
+    )
+    .normalize();
+    (axis, rng.unit() * std::f64::consts::PI * angle_scale)
+}
+
 /// A shared fixture turned by `rotation` and sampled by marching cubes of its signed distance
 /// at `resolution` cells: the turned fixture (the reference) and the sampling. Parts a user
 /// sends come at any angle; the figure tables sample the fixtures only in their own,
