@@ -124,7 +124,8 @@ pub(crate) struct NewVertex {
     pub rest: DVec3,
     /// [`SNAPPED`] or 1 + reason index.
     pub status: u8,
-    /// The planes it was snapped onto (two for an edge, three or two for a corner).
+    /// The planes it was snapped onto (two for an edge, or three where a face cuts its crease
+    /// off on marching cubes; three or two for a corner).
     pub planes: Planes,
 }
 

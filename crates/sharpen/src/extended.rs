@@ -1509,7 +1509,8 @@ pub(crate) fn is_chamfer_edge(run: &Run, a: u32, b: u32) -> bool {
 }
 
 /// Snaps the new vertex of chamfer edge `a`-`b`: the plane pair whose line point is closest
-/// to the midpoint.
+/// to the midpoint; on marching cubes, where a convex neighbouring face cuts an acute crease
+/// off ([`convex_cut`]), the crease's end on that face (three planes).
 pub(crate) fn edge_snap(
     run: &Run,
     a: u32,
@@ -1535,13 +1536,19 @@ pub(crate) fn edge_snap(
                         reason = UnmovedReason::Curved;
                         continue;
                     }
+                    // A crease end lies farther from the anchor than the line's closest point
+                    // `p`: when `p` cannot beat the best, neither can the end (skip the scan).
+                    if !better(best.as_ref().map(|b| b.0), p.distance_squared(anchor)) {
+                        continue;
+                    }
                     let (p, planes) = match convex_cut(run, p, &[(a, x), (b, y)], scale) {
                         None => (p, Planes::two(x.plane, y.plane)),
+                        // The end lies on `z`, so `z` cannot cut it again; another plane that
+                        // still does refuses the snap.
                         Some(z) => match crease_end(run, &x.plane, &y.plane, &z, p) {
                             Some(q)
                                 if supported(run, q, &[a, b])
-                                    && convex_cut(run, q, &[(a, x), (b, y)], scale)
-                                        .is_none_or(|w| w == z) =>
+                                    && convex_cut(run, q, &[(a, x), (b, y)], scale).is_none() =>
                             {
                                 (q, Planes::three(x.plane, y.plane, z))
                             }
@@ -1727,7 +1734,9 @@ pub(crate) const CUTTING_TURN_COS: f64 = 0.5;
 /// ([`CUTTING_TURN_COS`]) with a flat side ([`flat_sided_crease`]), meets each convexly (the
 /// source vertices on or under it, its own vertex on or under each source plane, within
 /// [`CUT_OFF_TOLERANCE`] scales) and has `p` above it by more than that; at a concave
-/// meeting the crease may run on past the plane, and nothing is cut.
+/// meeting the crease may run on past the plane, and nothing is cut. "Above" assumes outward
+/// normals (counter-clockwise seen from outside), as marching cubes writes them; with the
+/// opposite winding convex meetings read as concave and nothing is cut.
 fn convex_cut(run: &Run, p: DVec3, sources: &[(u32, &LabelPlane)], scale: f64) -> Option<Plane> {
     let acute = sources.iter().enumerate().any(|(i, &(_, x))| {
         sources[i + 1..]
@@ -2066,8 +2075,8 @@ pub(crate) fn corner_snap(
 
 /// Marching cubes: whether corner point `q` of a triangle's triple of planes (`chosen` labels)
 /// lies off a surface that two of the triangle's vertices both lie on (`planes`: each vertex's
-/// label planes) and that the triple leaves out, by more than [`CURVED_TOLERANCE`] times
-/// `scale`. Two vertices on one surface put that surface between them, so a corner inside the
+/// label planes) and that the triple leaves out, by more than [`CURVED_TOLERANCE`] times the
+/// larger of `scale` and the mean edge (the plane is vertex `i`'s of the pair that shares it). Two vertices on one surface put that surface between them, so a corner inside the
 /// triangle lies on it: where four faces meet two by two (rotated cad_bracket at 41 cells:
 /// one vertex on faces A and C, one on A and D, one on B), the point of B, C and D stood 1.85
 /// units (0.8 mean edges) above A, and only the triples with A give the two real corners. At

@@ -88,15 +88,16 @@ impl<'a> SignedDistance<'a> {
     }
 }
 
-/// The sweeps' first three arguments: `[seed] [cases] [papers|extended]` (the extended
-/// method unless `papers`), with the given defaults; the rest of the arguments follow.
+/// The sweeps' first three arguments: `[seed] [cases] [papers|extended]` (extended when
+/// absent), with the given defaults; the rest of the arguments follow.
 pub fn sweep_args(seed: u64, cases: usize) -> (u64, usize, whet_sharpen::Method, Vec<String>) {
     let args: Vec<String> = std::env::args().collect();
     let seed = args.get(1).and_then(|a| a.parse().ok()).unwrap_or(seed);
     let cases = args.get(2).and_then(|a| a.parse().ok()).unwrap_or(cases);
     let method = match args.get(3).map(String::as_str) {
         Some("papers") => whet_sharpen::Method::Papers,
-        _ => whet_sharpen::Method::Extended,
+        None | Some("extended") => whet_sharpen::Method::Extended,
+        Some(other) => panic!("method {other:?}: expected papers or extended"),
     };
     (seed, cases, method, args.into_iter().skip(4).collect())
 }
