@@ -1541,22 +1541,11 @@ pub(crate) fn edge_snap(
                     if !better(best.as_ref().map(|b| b.0), p.distance_squared(anchor)) {
                         continue;
                     }
-                    let (p, planes) = match convex_cut(run, p, &[(a, x), (b, y)], scale) {
-                        None => (p, Planes::two(x.plane, y.plane)),
-                        // The end lies on `z`, so `z` cannot cut it again; another plane that
-                        // still does refuses the snap.
-                        Some(z) => match crease_end(run, &x.plane, &y.plane, &z, p) {
-                            Some(q)
-                                if supported(run, q, &[a, b])
-                                    && convex_cut(run, q, &[(a, x), (b, y)], scale).is_none() =>
-                            {
-                                (q, Planes::three(x.plane, y.plane, z))
-                            }
-                            _ => {
-                                reason = UnmovedReason::Curved;
-                                continue;
-                            }
-                        },
+                    let Some((p, planes)) =
+                        uncut_crease_point(run, p, [(a, x), (b, y)], scale, &[a, b])
+                    else {
+                        reason = UnmovedReason::Curved;
+                        continue;
                     };
                     let d = p.distance_squared(anchor);
                     if better(best.as_ref().map(|b| b.0), d) {
@@ -1773,6 +1762,27 @@ fn convex_cut(run: &Run, p: DVec3, sources: &[(u32, &LabelPlane)], scale: f64) -
         }
     }
     None
+}
+
+/// Marching cubes: crease point `p` of the planes of `pair` (vertex and label plane), or,
+/// where a convex neighbouring face cuts the crease off ([`convex_cut`]), the crease's end on
+/// that face (three planes); `None` when the end is unsupported by the input around `around`
+/// or another plane still cuts it off. The end lies on the cutting plane, so that plane
+/// cannot cut it again.
+fn uncut_crease_point(
+    run: &Run,
+    p: DVec3,
+    pair: [(u32, &LabelPlane); 2],
+    scale: f64,
+    around: &[u32],
+) -> Option<(DVec3, Planes)> {
+    let [(_, x), (_, y)] = pair;
+    match convex_cut(run, p, &pair, scale) {
+        None => Some((p, Planes::two(x.plane, y.plane))),
+        Some(z) => crease_end(run, &x.plane, &y.plane, &z, p)
+            .filter(|&q| supported(run, q, around) && convex_cut(run, q, &pair, scale).is_none())
+            .map(|q| (q, Planes::three(x.plane, y.plane, z))),
+    }
 }
 
 /// Where the crease line of planes `x` and `y`, through `p`, crosses plane `z`; `None` when the
@@ -2062,9 +2072,15 @@ pub(crate) fn corner_snap(
                     {
                         continue;
                     }
+                    // An acute wedge ends at the face that cuts it off, here as in `edge_snap`.
+                    let Some((q, planes)) =
+                        uncut_crease_point(run, q, [(tri[i], x), (tri[j], y)], scale, &tri)
+                    else {
+                        continue;
+                    };
                     let d = q.distance_squared(anchor);
                     if better(best.as_ref().map(|b| b.0), d) {
-                        best = Some((d, q, Planes::two(x.plane, y.plane)));
+                        best = Some((d, q, planes));
                     }
                 }
             }
