@@ -73,6 +73,17 @@ pub enum Error {
     /// The output would need more vertices than 32-bit indices address.
     #[error("the sampling is too large: more than {0} vertices")]
     TooLarge(u64),
+    /// The sampled function broke the 1-Lipschitz contract of
+    /// [`marching_cubes_fn`]: the surface crosses a grid edge at `at`
+    /// inside a block whose value said it could not, so part of the surface would be missing.
+    #[error(
+        "the sampled function is not 1-Lipschitz near {at}: the surface crosses a grid edge \
+         there that the function's values ruled out (divide an L-Lipschitz function by L)"
+    )]
+    NotLipschitz {
+        /// A grid point of the edge the surface crosses.
+        at: glam::DVec3,
+    },
     /// A broken internal invariant (a bug): reported instead of panicking.
     #[error("internal error in whet-synth: {0}")]
     Internal(&'static str),

@@ -21,7 +21,11 @@
 //! 2^3 cells are skipped when the function's magnitude at their centre exceeds their
 //! half-diagonal: for a 1-Lipschitz function no surface passes through them. Per-slab results
 //! are concatenated in slab order; the vertices of edges on the plane between two slabs belong
-//! to the upper slab, and the lower slab's references to them are resolved at assembly.
+//! to the upper slab, and the lower slab's references to them are resolved at assembly. A
+//! function that is not 1-Lipschitz can make a slab skip a block its neighbour finds crossed;
+//! where that shows on the plane between two slabs the sampling fails with
+//! [`Error::NotLipschitz`] rather than return a surface with a hole (elsewhere the narrow band
+//! cannot see it: the contract is the caller's).
 
 mod table;
 
@@ -126,7 +130,7 @@ where
             },
         )
         .collect::<Result<_, _>>()?;
-    assemble(outs)
+    assemble(outs, &grid)
 }
 
 struct SlabOut {
@@ -136,7 +140,7 @@ struct SlabOut {
     bottom: Vec<(u32, u32)>,
 }
 
-fn assemble(outs: Vec<SlabOut>) -> Result<Mesh, Error> {
+fn assemble(outs: Vec<SlabOut>, grid: &Grid) -> Result<Mesh, Error> {
     let mut offsets = Vec::with_capacity(outs.len() + 1);
     let mut total: u64 = 0;
     for o in &outs {
@@ -159,10 +163,20 @@ fn assemble(outs: Vec<SlabOut>) -> Result<Mesh, Error> {
                     let next = outs
                         .get(s + 1)
                         .ok_or(Error::Internal("foreign vertex in the last slab"))?;
+                    // The slab above found no crossing on this edge of their shared
+                    // plane: its narrow band skipped the block holding it, which a
+                    // 1-Lipschitz function cannot make it do (the edge lies in both slabs'
+                    // blocks, and a zero on it bounds the value at either centre).
                     let i = next
                         .bottom
                         .binary_search_by_key(&key, |&(k, _)| k)
-                        .map_err(|_| Error::Internal("unresolved vertex between slabs"))?;
+                        .map_err(|_| {
+                            let p = (key / 2) as usize;
+                            let nx1 = grid.cells[0] + 1;
+                            Error::NotLipschitz {
+                                at: grid.point(p % nx1, p / nx1, (s + 1) * BLOCK),
+                            }
+                        })?;
                     offsets[s + 1] as u32 + next.bottom[i].1
                 };
             }
@@ -516,6 +530,35 @@ mod tests {
         assert_eq!(m, marching_cubes_fn(sdf, &b, 20).unwrap());
         for p in &m.positions {
             assert!((p.length() - 0.5).abs() < 0.01);
+        }
+    }
+
+    #[test]
+    fn a_function_that_is_not_1_lipschitz_is_an_error_naming_it() {
+        // Below the plane between the first two slabs a cylinder crosses it; above, the
+        // function jumps to 100, so the second slab's narrow band skips the blocks on the
+        // plane while the first slab's cells find crossings on its edges.
+        let b = Aabb {
+            min: DVec3::splat(-1.0),
+            max: DVec3::splat(1.0),
+        };
+        let res = 3 * BLOCK;
+        let grid = Grid::new(&b, res).unwrap();
+        let plane = grid.point(0, 0, BLOCK).z;
+        let h = grid.cell;
+        let f = move |p: DVec3| {
+            if p.z < plane + 0.5 * h {
+                p.x.hypot(p.y) - 0.5
+            } else {
+                100.0
+            }
+        };
+        match marching_cubes_fn(f, &b, res) {
+            Err(Error::NotLipschitz { at }) => {
+                assert!((at.z - plane).abs() < 1e-9, "{at}");
+                assert!((at.x.hypot(at.y) - 0.5).abs() < 2.0 * h, "{at}");
+            }
+            other => panic!("expected NotLipschitz, got {other:?}"),
         }
     }
 
