@@ -81,17 +81,9 @@ fn main() {
         let out = sharpen(&input, &SharpenOptions::DEFAULT.with_method(method)).unwrap();
         let b = support::error(&truth, &input, Some(50_000));
         let a = support::error(&truth, &out.mesh, Some(50_000));
-        let (bad, fine) = support::sweep_verdict(&truth, &input, &out.mesh, &b, &a);
-        if bad {
-            worse += 1;
-        } else if !fine.is_empty() {
-            unconfirmed += 1;
-        }
-        let flag = match (bad, fine.is_empty()) {
-            (true, _) => "WORSE ",
-            (false, false) => "UNCONFIRMED ",
-            (false, true) => "",
-        };
+        let verdict = support::sweep_verdict(&truth, &input, &out.mesh, &b, &a);
+        worse += usize::from(verdict.worse);
+        unconfirmed += usize::from(verdict.unconfirmed);
         if let Some(dir) = &write_dir {
             let stem = format!("{}-{res}-{i}", names[k].trim_end_matches(".off"));
             let opts = whet_io::WriteOptions::DEFAULT;
@@ -103,7 +95,7 @@ fn main() {
         }
         println!(
             "{}{} res {res} case {i} rot {},{},{},{}: {} triangles, RMS {:.4} -> {:.4} ({:.2}x), max {:.3} -> {:.3} ({:.2}x){}",
-            flag,
+            verdict.flag,
             names[k],
             axis.x,
             axis.y,
@@ -116,7 +108,7 @@ fn main() {
             b.max_pct,
             a.max_pct,
             b.max_pct / a.max_pct,
-            fine
+            verdict.suffix
         );
     }
     println!("{worse} of {n} worse ({unconfirmed} more worse at 50k samples only)");

@@ -45,20 +45,12 @@ fn main() {
         let truth = shape.truth_mesh();
         let b = support::error(&truth, &input, Some(50_000));
         let a = support::error(&truth, &out.mesh, Some(50_000));
-        let (bad, fine) = support::sweep_verdict(&truth, &input, &out.mesh, &b, &a);
-        if bad {
-            worse += 1;
-        } else if !fine.is_empty() {
-            unconfirmed += 1;
-        }
-        let flag = match (bad, fine.is_empty()) {
-            (true, _) => "WORSE ",
-            (false, false) => "UNCONFIRMED ",
-            (false, true) => "",
-        };
+        let verdict = support::sweep_verdict(&truth, &input, &out.mesh, &b, &a);
+        worse += usize::from(verdict.worse);
+        unconfirmed += usize::from(verdict.unconfirmed);
         println!("{}{} res {res} DIAG_ROT={},{},{},{}: RMS {:.4} -> {:.4} ({:.2}x), max {:.3} -> {:.3} ({:.2}x){}",
-            flag, kind.name(), axis.x, axis.y, axis.z, angle,
-            b.rms_pct, a.rms_pct, b.rms_pct / a.rms_pct, b.max_pct, a.max_pct, b.max_pct / a.max_pct, fine);
+            verdict.flag, kind.name(), axis.x, axis.y, axis.z, angle,
+            b.rms_pct, a.rms_pct, b.rms_pct / a.rms_pct, b.max_pct, a.max_pct, b.max_pct / a.max_pct, verdict.suffix);
     }
     println!("{worse} of {n} worse ({unconfirmed} more worse at 50k samples only)");
 }

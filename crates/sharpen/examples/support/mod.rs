@@ -203,32 +203,51 @@ pub fn error(reference: &Mesh, test: &Mesh, samples: Option<usize>) -> Error {
     }
 }
 
+/// The sweeps' verdict on one case, as they print it.
+pub struct SweepVerdict {
+    /// Worse at the sweep's sampling and again at 1M samples.
+    pub worse: bool,
+    /// Worse at the sweep's sampling only.
+    pub unconfirmed: bool,
+    /// The line's prefix: `"WORSE "`, `"UNCONFIRMED "` or nothing.
+    pub flag: &'static str,
+    /// The line's suffix: the errors at 1M samples, when they were measured.
+    pub suffix: String,
+}
+
 /// The sweeps' verdict on one case (`before`, `after`: the errors of the input and of the
-/// output at the sweep's sampling): whether it got worse, in RMS or max, and the line's suffix.
-/// A max is the largest of the samples' distances, so two samplings of 50k a direction can
-/// rank a case's input and output apart by sampling alone (rotated sharp_sphere at 41 cells:
-/// max 3.082 -> 3.139 % at 50k, 3.145 -> 3.127 % at 300k). A case worse at the sweep's
-/// sampling is measured again at Metro's default (at least 1M samples a direction) and counts
-/// as worse only if it still is.
+/// output at the sweep's sampling): whether it got worse, in RMS or max. A max is the largest
+/// of the samples' distances, so two samplings of 50k a direction can rank a case's input and
+/// output apart by sampling alone (rotated sharp_sphere at 41 cells: max 3.082 -> 3.139 % at
+/// 50k, 3.145 -> 3.127 % at 300k). A case worse at the sweep's sampling is measured again at
+/// Metro's default (at least 1M samples a direction) and counts as worse only if it still is.
 pub fn sweep_verdict(
     truth: &Mesh,
     input: &Mesh,
     output: &Mesh,
     before: &Error,
     after: &Error,
-) -> (bool, String) {
-    let worse = |b: &Error, a: &Error| a.rms_pct > b.rms_pct || a.max_pct > b.max_pct;
-    if !worse(before, after) {
-        return (false, String::new());
+) -> SweepVerdict {
+    let grew = |b: &Error, a: &Error| a.rms_pct > b.rms_pct || a.max_pct > b.max_pct;
+    if !grew(before, after) {
+        return SweepVerdict {
+            worse: false,
+            unconfirmed: false,
+            flag: "",
+            suffix: String::new(),
+        };
     }
     let (b, a) = (error(truth, input, None), error(truth, output, None));
-    (
-        worse(&b, &a),
-        format!(
+    let worse = grew(&b, &a);
+    SweepVerdict {
+        worse,
+        unconfirmed: !worse,
+        flag: if worse { "WORSE " } else { "UNCONFIRMED " },
+        suffix: format!(
             "; at 1M samples RMS {:.4} -> {:.4}, max {:.3} -> {:.3}",
             b.rms_pct, a.rms_pct, b.max_pct, a.max_pct
         ),
-    )
+    }
 }
 
 /// What the issue requires of every output, measured from the outside.
