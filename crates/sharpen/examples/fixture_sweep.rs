@@ -95,7 +95,7 @@ fn main() {
         }
         println!(
             "{}{} res {res} case {i} rot {},{},{},{}: {} triangles, RMS {:.4} -> {:.4} ({:.2}x), max {:.3} -> {:.3} ({:.2}x){}",
-            verdict.flag,
+            verdict.flag(),
             names[k],
             axis.x,
             axis.y,

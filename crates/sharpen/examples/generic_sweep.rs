@@ -49,7 +49,7 @@ fn main() {
         worse += usize::from(verdict.worse);
         unconfirmed += usize::from(verdict.unconfirmed);
         println!("{}{} res {res} DIAG_ROT={},{},{},{}: RMS {:.4} -> {:.4} ({:.2}x), max {:.3} -> {:.3} ({:.2}x){}",
-            verdict.flag, kind.name(), axis.x, axis.y, axis.z, angle,
+            verdict.flag(), kind.name(), axis.x, axis.y, axis.z, angle,
             b.rms_pct, a.rms_pct, b.rms_pct / a.rms_pct, b.max_pct, a.max_pct, b.max_pct / a.max_pct, verdict.suffix);
     }
     println!("{worse} of {n} worse ({unconfirmed} more worse at 50k samples only)");

@@ -209,10 +209,19 @@ pub struct SweepVerdict {
     pub worse: bool,
     /// Worse at the sweep's sampling only.
     pub unconfirmed: bool,
-    /// The line's prefix: `"WORSE "`, `"UNCONFIRMED "` or nothing.
-    pub flag: &'static str,
     /// The line's suffix: the errors at 1M samples, when they were measured.
     pub suffix: String,
+}
+
+impl SweepVerdict {
+    /// The line's prefix: `"WORSE "`, `"UNCONFIRMED "` or nothing.
+    pub fn flag(&self) -> &'static str {
+        match (self.worse, self.unconfirmed) {
+            (true, _) => "WORSE ",
+            (false, true) => "UNCONFIRMED ",
+            (false, false) => "",
+        }
+    }
 }
 
 /// The sweeps' verdict on one case (`before`, `after`: the errors of the input and of the
@@ -233,7 +242,6 @@ pub fn sweep_verdict(
         return SweepVerdict {
             worse: false,
             unconfirmed: false,
-            flag: "",
             suffix: String::new(),
         };
     }
@@ -242,7 +250,6 @@ pub fn sweep_verdict(
     SweepVerdict {
         worse,
         unconfirmed: !worse,
-        flag: if worse { "WORSE " } else { "UNCONFIRMED " },
         suffix: format!(
             "; at 1M samples RMS {:.4} -> {:.4}, max {:.3} -> {:.3}",
             b.rms_pct, a.rms_pct, b.max_pct, a.max_pct
